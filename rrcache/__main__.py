@@ -1,0 +1,3 @@
+from rrcache.cli import main
+
+main()
