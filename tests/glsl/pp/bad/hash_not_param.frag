@@ -1,0 +1,2 @@
+// ERROR 2:14 '#' must be followed by a macro parameter
+#define S(x) # y

@@ -1,0 +1,2 @@
+// ERROR 2:3 unknown preprocessor directive '#frobnicate'
+# frobnicate 3

@@ -1,0 +1,3 @@
+// ERROR 3:2 #version must come before anything else
+float a;
+#version 330

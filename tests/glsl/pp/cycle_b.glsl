@@ -1,0 +1,2 @@
+float b;
+#include "cycle_a.glsl"

@@ -1,0 +1,2 @@
+#include "hash.glsl"
+float noise(vec2 p) { return HASH(p); }

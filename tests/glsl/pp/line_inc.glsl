@@ -1,0 +1,3 @@
+/* first line of line_inc */ float inc;
+#line 50
+float inc50;
