@@ -1,0 +1,319 @@
+"""`CacheRuntime`: runs a cached shader variant inside any moderngl render loop.
+
+The runtime owns everything the cache needs on the GL side: the double-buffered payload and
+inverse-depth textures, the depth buffer the passes share, the refresh-offset texture, the clock
+and the occlusion queries that count shaded fragments. The application owns its geometry: each
+frame it hands the runtime a ``draw(program, pass_name)`` callback that sets its own uniforms on
+``program`` (including ``u_prevModelViewProjectionMatrix`` per object, for reprojection) and
+renders its vertex arrays with it.
+
+Passes (DESIGN.md §3; Sitthi-amorn 2008a §3):
+
+three-pass (default; programs ``reproject``, ``payload``, ``shade``)
+    1. ``reproject`` — depth test ``<`` with depth writes. At a hit it writes the reconstructed
+       payload and this pixel's inverse depth to this frame's cache; at a miss or a refresh it
+       *discards*, so neither depth nor cache is written there. ``discard`` keeps early depth
+       testing on llvmpipe, and no nudged depth is needed.
+    2. ``payload`` — depth test ``<`` with depth writes: it runs only where pass 1 left no depth
+       for this surface (misses and refreshes; at hits the stored depth equals the fragment's, so
+       ``<`` fails and early-z culls the fragment). It computes the payload from scratch.
+    3. ``shade`` — depth test ``<=`` without writes against the now complete depth buffer: the
+       original shader with the cached value replaced by ``rr_current()``, into the colour target.
+two-pass (programs ``hit``, ``miss``; Nehab 2007 §3.4)
+    1. ``hit`` shades hit pixels completely (colour, payload, depth); misses discard.
+    2. ``miss`` computes payload and colour at the remaining pixels (three render targets).
+one-pass (program ``single``): a dynamic branch in one shader.
+
+All passes rely on identical vertex processing to reproduce identical depths; the compiler emits
+one vertex shader for all of them.
+
+Counting: ``FrameStats.misses`` is the number of fragments the miss pass shaded (an occlusion
+query; it includes overdraw among missed fragments), ``covered`` the number of visible pixels
+(the query of the final three-pass pass). Exact per-pixel hit maps come from
+:meth:`CacheRuntime.hit_map`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import moderngl
+import numpy as np
+
+from rrcache.runtime import glsl as G
+from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_offsets
+
+ALGORITHMS = {
+    "three-pass": ("reproject", "payload", "shade"),
+    "two-pass": ("hit", "miss"),
+    "one-pass": ("single",),
+}
+
+PAYLOAD_DTYPES = ("f2", "f4")
+
+DrawCallback = Callable[[moderngl.Program, str], None]
+
+_UNIT_PREV_PAYLOAD, _UNIT_PREV_INVDEPTH, _UNIT_REFRESH, _UNIT_CUR_PAYLOAD = 12, 13, 14, 15
+
+
+@dataclass
+class FrameStats:
+    """What one cached frame did. ``None`` where the algorithm cannot count it with queries."""
+
+    frame: int
+    covered: Optional[int]
+    misses: Optional[int]
+
+    @property
+    def hits(self) -> Optional[int]:
+        if self.covered is None or self.misses is None:
+            return None
+        return max(self.covered - self.misses, 0)
+
+
+class CacheRuntime:
+    """Run a compiled cache variant frame by frame.
+
+    ``programs`` maps the pass names of ``algorithm`` (see :data:`ALGORITHMS`) to linked
+    programs. ``size`` is (width, height). ``period`` (Δn), ``block`` (k), ``refresh`` and
+    ``depth_epsilon`` can be changed between frames (they are uniforms or small textures).
+
+    Example, inside a render loop (``draw`` renders the scene with the given program)::
+
+        rt = CacheRuntime(ctx, programs, "three-pass", (640, 480), period=16)
+        for frame in range(100):
+            stats = rt.frame(draw)
+            image = rt.read_color()
+    """
+
+    def __init__(
+        self,
+        ctx: moderngl.Context,
+        programs: dict[str, moderngl.Program],
+        algorithm: str = "three-pass",
+        size: tuple[int, int] = (640, 480),
+        *,
+        period: int = 8,
+        block: int = 4,
+        refresh: str = "random",
+        seed: int = 0,
+        payload_dtype: str = "f4",
+        depth_epsilon: float = 1e-3,
+        clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
+        cull_back_faces: bool = True,
+    ):
+        if algorithm not in ALGORITHMS:
+            raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
+        missing = [p for p in ALGORITHMS[algorithm] if p not in programs]
+        if missing:
+            raise ValueError(f"{algorithm} needs programs for passes {missing}")
+        if payload_dtype not in PAYLOAD_DTYPES:
+            raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+        if refresh not in REFRESH_MODES:
+            raise ValueError(f"refresh must be one of {REFRESH_MODES}, not {refresh!r}")
+        if block not in BLOCK_SIZES:
+            raise ValueError(f"block must be one of {BLOCK_SIZES}, not {block}")
+        self.ctx = ctx
+        self.programs = programs
+        self.algorithm = algorithm
+        self.payload_dtype = payload_dtype
+        self.clear_color = clear_color
+        self.cull_back_faces = cull_back_faces
+        self.depth_epsilon = float(depth_epsilon)
+        self.seed = seed
+        self._period = 1
+        self.period = period
+        self._block = block
+        self._refresh_mode = refresh
+        self.clock = 0
+        self._index = 0
+        self._valid = False
+        self._resources: list = []
+        self._query = ctx.query(samples=True)
+        self._refresh_tex: Optional[moderngl.Texture] = None
+        self.size = (0, 0)
+        self.resize(size)
+
+    # ------------------------------------------------------------------ configuration
+
+    @property
+    def period(self) -> int:
+        return self._period
+
+    @period.setter
+    def period(self, value: int) -> None:
+        value = int(value)
+        if value < 1:
+            raise ValueError(f"the refresh period must be at least 1, not {value}")
+        self._period = value
+
+    def set_refresh(self, mode: Optional[str] = None, block: Optional[int] = None, seed: Optional[int] = None) -> None:
+        """Change the refresh pattern (mode ``random``/``tiled``, block size k, seed)."""
+        if mode is not None:
+            if mode not in REFRESH_MODES:
+                raise ValueError(f"refresh must be one of {REFRESH_MODES}, not {mode!r}")
+            self._refresh_mode = mode
+        if block is not None:
+            if block not in BLOCK_SIZES:
+                raise ValueError(f"block must be one of {BLOCK_SIZES}, not {block}")
+            self._block = block
+        if seed is not None:
+            self.seed = seed
+        self._make_refresh_texture()
+
+    # ------------------------------------------------------------------ resources
+
+    def resize(self, size: tuple[int, int]) -> None:
+        """(Re)allocate every target for a new viewport size; the cache starts empty."""
+        w, h = int(size[0]), int(size[1])
+        if w < 1 or h < 1:
+            raise ValueError(f"viewport size must be positive, not {w}x{h}")
+        self._release_targets()
+        ctx = self.ctx
+        self.size = (w, h)
+        self.depth = ctx.depth_texture((w, h))
+        self.color = ctx.texture((w, h), 4, dtype="f4")
+        self._payload = [ctx.texture((w, h), 4, dtype=self.payload_dtype) for _ in range(2)]
+        self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
+        for tex in self._payload + self._invdepth:
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+        if self.algorithm == "three-pass":
+            self._cache_fbos = [ctx.framebuffer([self._payload[i], self._invdepth[i]], self.depth) for i in range(2)]
+        else:
+            self._cache_fbos = [
+                ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
+            ]
+        self._out_fbo = ctx.framebuffer([self.color], self.depth)
+        self._color_only_fbo = ctx.framebuffer([self.color])
+        self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
+                           self._out_fbo, self._color_only_fbo]
+        self._make_refresh_texture()
+        self.reset()
+
+    def _make_refresh_texture(self) -> None:
+        if self._refresh_tex is not None:
+            self._refresh_tex.release()
+        data = refresh_offsets(self.size, self._block, self._refresh_mode, self.seed)
+        rows, cols = data.shape
+        self._refresh_tex = self.ctx.texture((cols, rows), 1, data=np.ascontiguousarray(data).tobytes(), dtype="f4")
+        self._refresh_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+
+    def reset(self) -> None:
+        """Forget the cache: the next frame misses everywhere (as after a camera cut)."""
+        self._valid = False
+
+    def _release_targets(self) -> None:
+        for res in self._resources:
+            res.release()
+        self._resources = []
+
+    def release(self) -> None:
+        """Release every GL object the runtime made (not the programs, which the caller owns)."""
+        self._release_targets()
+        if self._refresh_tex is not None:
+            self._refresh_tex.release()
+            self._refresh_tex = None
+        self._query = None
+
+    # ------------------------------------------------------------------ the frame
+
+    def _set(self, program: moderngl.Program, name: str, value) -> None:
+        if name in program:
+            program[name].value = value
+
+    def _bind_cache_uniforms(self, program: moderngl.Program) -> None:
+        prev = 1 - self._index
+        self._payload[prev].use(_UNIT_PREV_PAYLOAD)
+        self._invdepth[prev].use(_UNIT_PREV_INVDEPTH)
+        self._refresh_tex.use(_UNIT_REFRESH)
+        if self.algorithm == "three-pass":
+            self._payload[self._index].use(_UNIT_CUR_PAYLOAD)
+        self._set(program, G.PREV_PAYLOAD, _UNIT_PREV_PAYLOAD)
+        self._set(program, G.PREV_INVDEPTH, _UNIT_PREV_INVDEPTH)
+        self._set(program, G.REFRESH, _UNIT_REFRESH)
+        self._set(program, G.CUR_PAYLOAD, _UNIT_CUR_PAYLOAD)
+        self._set(program, "rr_period", self._period)
+        self._set(program, "rr_clock", self.clock)
+        self._set(program, "rr_blockSize", self._block)
+        self._set(program, "rr_valid", self._valid)
+        self._set(program, "rr_depthEpsilon", self.depth_epsilon)
+
+    def _run(self, pass_name: str, draw: DrawCallback, count: bool) -> Optional[int]:
+        program = self.programs[pass_name]
+        self._bind_cache_uniforms(program)
+        if not count:
+            draw(program, pass_name)
+            return None
+        with self._query:
+            draw(program, pass_name)
+        return int(self._query.samples)
+
+    def frame(self, draw: DrawCallback, count: bool = True, after_first_pass: Optional[Callable[[], None]] = None) -> FrameStats:
+        """Render one frame with the cache and advance the clock.
+
+        ``after_first_pass`` (diagnostics only; it breaks timing) runs after the reprojection
+        pass, e.g. to read the hit map.
+        """
+        ctx = self.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        if self.cull_back_faces:
+            ctx.enable(moderngl.CULL_FACE)
+        else:
+            ctx.disable(moderngl.CULL_FACE)
+        cache_fbo = self._cache_fbos[self._index]
+        cache_fbo.depth_mask = True
+        cache_fbo.use()
+        cache_fbo.clear(*self.clear_color, depth=1.0)
+        ctx.depth_func = "<"
+        covered = misses = None
+        if self.algorithm == "three-pass":
+            self._run("reproject", draw, count=False)
+            if after_first_pass:
+                after_first_pass()
+                cache_fbo.use()
+            misses = self._run("payload", draw, count)
+            self._color_only_fbo.use()
+            self._color_only_fbo.clear(*self.clear_color)
+            self._out_fbo.depth_mask = False
+            self._out_fbo.use()
+            ctx.depth_func = "<="
+            covered = self._run("shade", draw, count)
+            self._out_fbo.depth_mask = True
+        elif self.algorithm == "two-pass":
+            hits = self._run("hit", draw, count)
+            if after_first_pass:
+                after_first_pass()
+                cache_fbo.use()
+            misses = self._run("miss", draw, count)
+            covered = None if hits is None else hits + misses
+        else:
+            self._run("single", draw, count=False)
+        ctx.depth_func = "<"
+        stats = FrameStats(self.clock, covered, misses)
+        self._index = 1 - self._index
+        self._valid = True
+        self.clock += 1
+        return stats
+
+    # ------------------------------------------------------------------ read-back
+
+    def _read(self, tex: moderngl.Texture, components: int) -> np.ndarray:
+        w, h = self.size
+        data = np.frombuffer(tex.read(), dtype=np.float32 if tex.dtype == "f4" else np.float16)
+        return data.reshape(h, w, components)[::-1].astype(np.float32)
+
+    def read_color(self) -> np.ndarray:
+        """The last frame's colour, float32 (height, width, 4), row 0 = top of the image."""
+        return self._read(self.color, 4)
+
+    def read_payload(self) -> np.ndarray:
+        """The last frame's cache payload, float32 (height, width, 4), row 0 = top."""
+        return self._read(self._payload[1 - self._index], 4)
+
+    def read_inverse_depth(self, current: bool = False) -> np.ndarray:
+        """1/w of the visible surface per pixel (0 where nothing is cached), row 0 = top.
+        ``current=True`` reads the target being written in the frame in progress (for
+        ``after_first_pass`` diagnostics: after pass 1 it is non-zero exactly at the hits)."""
+        index = self._index if current else 1 - self._index
+        return self._read(self._invdepth[index], 1)[..., 0]

@@ -1,0 +1,144 @@
+"""The GLSL side of the reprojection cache, shared by every pass the compiler emits.
+
+The cache is two screen-sized textures, double-buffered (one read, one written, swapped each
+frame): the payload (``RGBA16F`` or ``RGBA32F``, up to four channels of the cached value) and the
+inverse depth ``1/w`` of the visible surface (``R32F``; 0 where nothing was drawn).
+
+Why ``1/w``: it is an affine function of window position over a planar triangle, so the bilinear
+reconstruction of the previous frame's depth is exact on flat surfaces and fails (a miss) across
+depth edges, where it mixes foreground and background (Nehab 2007 §3.2). Comparing it *relative*
+to the expected value keeps the test meaningful for any near/far range (1e-4 to 1e6 included),
+unlike window depth, which saturates near 1.
+
+Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (DESIGN.md §3):
+
+    expected = 1 / rr_prevClip.w;  uv = rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5
+    hit = rr_valid && uv inside [0,1]² && |bilinear(prevInvDepth, uv) - expected| <= ε · expected
+
+and the pixel is refreshed by the rule in :mod:`rrcache.runtime.refresh`.
+
+Payload reconstruction filters: ``nearest``, ``bilinear`` (hardware), and ``catmull-rom`` (a
+16-tap bicubic that blurs less under repeated resampling; its result is clamped to the range of
+the four bilinear neighbours so that its negative lobes cannot overshoot or pull in a value
+from across an edge).
+"""
+from __future__ import annotations
+
+FILTERS = ("nearest", "bilinear", "catmull-rom")
+
+# Names the runtime binds. Kept in one place so the compiler and the runtime agree.
+PREV_PAYLOAD = "rr_prevPayload"
+PREV_INVDEPTH = "rr_prevInvDepth"
+CUR_PAYLOAD = "rr_curPayload"
+REFRESH = "rr_refresh"
+PREV_CLIP = "rr_prevClip"
+OUT_PAYLOAD = "rr_outPayload"
+OUT_INVDEPTH = "rr_outInvDepth"
+OUT_COLOR_TWO_PASS = "rr_outColor"
+
+_COMMON = """\
+// ---- rrcache reverse reprojection cache (rrcache.runtime) ----
+in vec4 rr_prevClip;
+uniform sampler2D rr_prevPayload;
+uniform sampler2D rr_prevInvDepth;
+uniform sampler2D rr_refresh;
+uniform int rr_period;
+uniform int rr_clock;
+uniform int rr_blockSize;
+uniform bool rr_valid;
+uniform float rr_depthEpsilon;
+vec2 rr_uv;
+
+bool rr_refreshNow() {
+    float h = texelFetch(rr_refresh, ivec2(gl_FragCoord.xy) / rr_blockSize, 0).r;
+    return (int(h * float(rr_period)) + rr_clock) % rr_period == 0;
+}
+
+bool rr_hit() {
+    if (!rr_valid || rr_prevClip.w <= 0.0) return false;
+    rr_uv = rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5;
+    if (any(lessThan(rr_uv, vec2(0.0))) || any(greaterThan(rr_uv, vec2(1.0)))) return false;
+    float expected = 1.0 / rr_prevClip.w;
+    float stored = texture(rr_prevInvDepth, rr_uv).r;
+    return abs(stored - expected) <= rr_depthEpsilon * expected;
+}
+"""
+
+_NEAREST = """
+vec4 rr_previous() {
+    ivec2 size = textureSize(rr_prevPayload, 0);
+    ivec2 texel = clamp(ivec2(floor(rr_uv * vec2(size))), ivec2(0), size - 1);
+    return texelFetch(rr_prevPayload, texel, 0);
+}
+"""
+
+_BILINEAR = """
+vec4 rr_previous() {
+    return texture(rr_prevPayload, rr_uv);
+}
+"""
+
+_CATMULL_ROM = """
+vec4 rr_previous() {
+    ivec2 size = textureSize(rr_prevPayload, 0);
+    vec2 p = rr_uv * vec2(size) - 0.5;
+    ivec2 base = ivec2(floor(p));
+    vec2 f = p - vec2(base);
+    vec2 w[4];
+    w[0] = f * (-0.5 + f * (1.0 - 0.5 * f));
+    w[1] = 1.0 + f * f * (-2.5 + 1.5 * f);
+    w[2] = f * (0.5 + f * (2.0 - 1.5 * f));
+    w[3] = f * f * (-0.5 + 0.5 * f);
+    vec4 sum = vec4(0.0);
+    vec4 lo = vec4(1e38);
+    vec4 hi = vec4(-1e38);
+    for (int j = 0; j < 4; j++) {
+        for (int i = 0; i < 4; i++) {
+            vec4 v = texelFetch(rr_prevPayload, clamp(base + ivec2(i - 1, j - 1), ivec2(0), size - 1), 0);
+            sum += v * (w[i].x * w[j].y);
+            if (i >= 1 && i <= 2 && j >= 1 && j <= 2) {
+                lo = min(lo, v);
+                hi = max(hi, v);
+            }
+        }
+    }
+    return clamp(sum, lo, hi);
+}
+"""
+
+_CURRENT = """
+vec4 rr_current() {
+    return texelFetch(rr_curPayload, ivec2(gl_FragCoord.xy), 0);
+}
+"""
+
+
+def lookup_glsl(filter: str = "bilinear") -> str:
+    """Declarations and functions for a pass that reads the *previous* frame's cache:
+    ``rr_hit()``, ``rr_refreshNow()`` and ``rr_previous()`` (valid after ``rr_hit()`` returned
+    true). Include it after the ``#version`` line of a fragment shader.
+    """
+    if filter not in FILTERS:
+        raise ValueError(f"cache filter must be one of {FILTERS}, not {filter!r}")
+    body = {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM}[filter]
+    return _COMMON + body
+
+
+def current_glsl() -> str:
+    """Declarations for the final pass of the three-pass algorithm: ``rr_current()`` reads this
+    frame's payload at this pixel."""
+    return "uniform sampler2D rr_curPayload;\n" + _CURRENT
+
+
+def output_glsl(first_location: int = 0) -> str:
+    """The cache outputs of a pass that writes the cache: payload and inverse depth."""
+    return (
+        f"layout(location = {first_location}) out vec4 rr_outPayload;\n"
+        f"layout(location = {first_location + 1}) out float rr_outInvDepth;\n"
+    )
+
+
+def vertex_glsl() -> str:
+    """What a vertex shader adds for the cache: the previous-frame clip position ``rr_prevClip``,
+    computed from ``u_prevModelViewProjectionMatrix`` (the application supplies it per object)."""
+    return "uniform mat4 u_prevModelViewProjectionMatrix;\nout vec4 rr_prevClip;\n"
