@@ -24,8 +24,9 @@ class Node:
 
     def children(self) -> Iterator["Node"]:
         """Direct child nodes, in source order."""
+        skip = ("loc", "type") if isinstance(self, Expr) else ("loc",)
         for f in fields(self):
-            if f.name in ("loc", "type"):
+            if f.name in skip or not f.compare:
                 continue
             value = getattr(self, f.name)
             if isinstance(value, Node):

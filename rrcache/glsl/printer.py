@@ -1,0 +1,385 @@
+"""GLSL printer: the AST of :mod:`rrcache.glsl.ast` back to source text.
+
+:func:`print_glsl` writes readable GLSL (4-space indentation, one statement a line) with the
+fewest parentheses that make a re-parse give the same tree: each expression is printed with the
+precedence its context needs and wrapped in ``(...)`` only when its own precedence is lower.
+Literals are re-printed from their ``text`` when it still matches their value; generated floats
+are always valid float literals (``1.0``, ``2.5e-07``). :func:`print_with_map` also returns, for
+each printed line, the :class:`~rrcache.errors.SourceLoc` of the statement or declaration printed
+there, so that driver error logs can be mapped back to the original file.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+from rrcache.errors import SourceLoc
+from rrcache.glsl import ast as A
+from rrcache.glsl.parser import BINARY_PRECEDENCE
+
+INDENT = "    "
+
+# Precedence levels used for parenthesisation (higher binds tighter).
+P_SEQUENCE, P_ASSIGN, P_TERNARY, P_UNARY, P_POSTFIX, P_PRIMARY = 0, 1, 2, 14, 15, 16
+
+
+def _float_text(value: float, double: bool) -> str:
+    if math.isnan(value):
+        text = "(0.0 / 0.0)"
+    elif math.isinf(value):
+        text = "(1.0 / 0.0)" if value > 0 else "(-1.0 / 0.0)"
+    else:
+        text = repr(float(value))
+        if "." not in text and "e" not in text and "E" not in text:
+            text += ".0"
+    return text + "lf" if double and text[-1] != ")" else text
+
+
+def _literal_ok(text: Optional[str], value, is_float: bool) -> bool:
+    """Whether a kept spelling still denotes ``value`` (a pass may have changed the value)."""
+    if not text:
+        return False
+    try:
+        if is_float:
+            stripped = text.rstrip("fFlL")
+            return float(stripped) == value
+        stripped = text.rstrip("uU")
+        if stripped[:2].lower() == "0x":
+            return int(stripped, 16) == value
+        if len(stripped) > 1 and stripped[0] == "0":
+            return int(stripped, 8) == value
+        return int(stripped) == value
+    except ValueError:
+        return False
+
+
+def expr_precedence(e: A.Expr) -> int:
+    """The precedence level of an expression node (see the ``P_*`` constants).
+
+    >>> expr_precedence(A.Binary("+", A.Ident("a"), A.Ident("b"))) < expr_precedence(A.Ident("a"))
+    True
+    """
+    if isinstance(e, A.Sequence):
+        return P_SEQUENCE
+    if isinstance(e, A.Assign):
+        return P_ASSIGN
+    if isinstance(e, A.Ternary):
+        return P_TERNARY
+    if isinstance(e, A.Binary):
+        return BINARY_PRECEDENCE[e.op]
+    if isinstance(e, A.Unary):
+        return P_POSTFIX if e.postfix else P_UNARY
+    if isinstance(e, (A.Index, A.Field, A.Length, A.Call)):
+        return P_POSTFIX
+    if isinstance(e, (A.IntLit, A.FloatLit)) and e.value < 0:
+        return P_UNARY
+    return P_PRIMARY
+
+
+def print_expr(e: A.Expr, need: int = P_SEQUENCE) -> str:
+    """Print an expression, parenthesised when its precedence is below ``need``.
+
+    >>> print_expr(A.Binary("*", A.Binary("+", A.Ident("a"), A.Ident("b")), A.Ident("c")))
+    '(a + b) * c'
+    """
+    text = _expr(e)
+    return f"({text})" if expr_precedence(e) < need else text
+
+
+def _dims(dims) -> str:
+    if not dims:
+        return ""
+    return "".join("[]" if d is None else f"[{print_expr(d)}]" for d in dims)
+
+
+def _expr(e: A.Expr) -> str:
+    if isinstance(e, A.Ident):
+        return e.name
+    if isinstance(e, A.IntLit):
+        if _literal_ok(e.text, e.value, False) and (e.text[-1] in "uU") == e.unsigned:
+            return e.text
+        return f"{e.value}{'u' if e.unsigned else ''}"
+    if isinstance(e, A.FloatLit):
+        if _literal_ok(e.text, e.value, True) and e.text.lower().endswith("lf") == e.double:
+            return e.text
+        return _float_text(e.value, e.double)
+    if isinstance(e, A.BoolLit):
+        return "true" if e.value else "false"
+    if isinstance(e, A.Binary):
+        p = BINARY_PRECEDENCE[e.op]
+        return f"{print_expr(e.left, p)} {e.op} {print_expr(e.right, p + 1)}"
+    if isinstance(e, A.Unary):
+        if e.postfix:
+            return print_expr(e.operand, P_POSTFIX) + e.op
+        inner = print_expr(e.operand, P_UNARY)
+        if e.op in ("+", "-", "++", "--") and inner[:1] in ("+", "-"):
+            inner = f"({inner})"
+        return e.op + inner
+    if isinstance(e, A.Assign):
+        return f"{print_expr(e.target, P_TERNARY + 1)} {e.op} {print_expr(e.value, P_ASSIGN)}"
+    if isinstance(e, A.Ternary):
+        return (f"{print_expr(e.cond, P_TERNARY + 1)} ? {print_expr(e.then, P_SEQUENCE)} : "
+                f"{print_expr(e.else_, P_ASSIGN)}")
+    if isinstance(e, A.Sequence):
+        return ", ".join(print_expr(x, P_ASSIGN) for x in e.exprs)
+    if isinstance(e, A.Call):
+        args = ", ".join(print_expr(a, P_ASSIGN) for a in e.args)
+        return f"{e.name}{_dims(e.array_dims)}({args})"
+    if isinstance(e, (A.Field, A.Length, A.Index)):
+        obj = print_expr(e.obj, P_POSTFIX)
+        if isinstance(e.obj, (A.IntLit, A.FloatLit)) and not obj.startswith("("):
+            obj = f"({obj})"
+        if isinstance(e, A.Field):
+            return f"{obj}.{e.name}"
+        if isinstance(e, A.Length):
+            return f"{obj}.length()"
+        return f"{obj}[{print_expr(e.index)}]"
+    if isinstance(e, A.InitList):
+        return "{" + ", ".join(print_expr(x, P_ASSIGN) for x in e.items) + "}"
+    raise TypeError(f"cannot print {type(e).__name__} as an expression")
+
+
+def _qualifiers(quals) -> str:
+    words = []
+    for q in quals:
+        if isinstance(q, A.Layout):
+            items = ", ".join(n if v is None else f"{n} = {print_expr(v, P_TERNARY)}"
+                              for n, v in q.items)
+            words.append(f"layout({items})")
+        else:
+            words.append(q)
+    return " ".join(words)
+
+
+def _join(*parts: str) -> str:
+    return " ".join(p for p in parts if p)
+
+
+def _declarators(decls: list[A.Declarator]) -> str:
+    out = []
+    for d in decls:
+        text = d.name + _dims(d.array_dims)
+        if d.init is not None:
+            text += " = " + print_expr(d.init, P_ASSIGN)
+        out.append(text)
+    return ", ".join(out)
+
+
+class _Printer:
+    def __init__(self) -> None:
+        self.lines: list[tuple[str, Optional[SourceLoc]]] = []
+        self.level = 0
+
+    def emit(self, text: str, loc: Optional[SourceLoc]) -> None:
+        self.lines.append((INDENT * self.level + text if text else "", loc))
+
+    # ------------------------------------------------------------------ types
+    def struct_inline(self, s: A.StructSpecifier) -> str:
+        members = " ".join(f"{self.type_inline(m.type)} {_declarators(m.declarators)};"
+                           for m in s.members)
+        return _join("struct", s.name or "", "{ " + members + " }")
+
+    def spec_inline(self, spec: A.TypeSpecifier) -> str:
+        base = self.struct_inline(spec.struct) if spec.struct else spec.name
+        return base + _dims(spec.array_dims)
+
+    def type_inline(self, t: A.FullType) -> str:
+        return _join(_qualifiers(t.qualifiers), self.spec_inline(t.spec))
+
+    def members(self, members: list[A.StructMember]) -> None:
+        self.level += 1
+        for m in members:
+            if m.type.spec.struct is not None:
+                self.block_decl(_qualifiers(m.type.qualifiers), m.type.spec.struct,
+                                m.type.spec.array_dims, _declarators(m.declarators), m.loc)
+            else:
+                self.emit(f"{self.type_inline(m.type)} {_declarators(m.declarators)};", m.loc)
+        self.level -= 1
+
+    def block_decl(self, quals: str, s: A.StructSpecifier, spec_dims, tail: str, loc) -> None:
+        self.emit(_join(quals, "struct", s.name or "", "{"), loc)
+        self.members(s.members)
+        self.emit(_join("}" + _dims(spec_dims), tail) + ";", None)
+
+    # ------------------------------------------------------------------ declarations
+    def decl_inline(self, d) -> str:
+        """A declaration on one line, without the final ';' (for-loop initialisers)."""
+        if isinstance(d, A.VariableDecl):
+            return _join(self.type_inline(d.type), _declarators(d.declarators))
+        if isinstance(d, A.PrecisionDecl):
+            return f"precision {d.precision} {self.spec_inline(d.spec)}"
+        if isinstance(d, A.QualifierDecl):
+            return _join(_qualifiers(d.qualifiers), ", ".join(d.names))
+        raise TypeError(f"cannot print {type(d).__name__} on one line")
+
+    def declaration(self, d) -> None:
+        if isinstance(d, A.FunctionDecl):
+            params = ", ".join(
+                _join(self.type_inline(p.type), (p.name or "") + _dims(p.array_dims))
+                for p in d.params)
+            head = f"{self.type_inline(d.return_type)} {d.name}({params})"
+            if d.body is None:
+                self.emit(head + ";", d.loc)
+            else:
+                self.emit(head, d.loc)
+                self.compound(d.body)
+        elif isinstance(d, A.InterfaceBlock):
+            self.emit(_join(_qualifiers(d.qualifiers), d.block_name, "{"), d.loc)
+            self.members(d.members)
+            tail = (d.instance_name or "") + _dims(d.array_dims)
+            self.emit(_join("}", tail) + ";", None)
+        elif isinstance(d, A.VariableDecl) and d.type.spec.struct is not None:
+            self.block_decl(_qualifiers(d.type.qualifiers), d.type.spec.struct,
+                            d.type.spec.array_dims, _declarators(d.declarators), d.loc)
+        else:
+            self.emit(self.decl_inline(d) + ";", d.loc)
+
+    # ------------------------------------------------------------------ statements
+    def compound(self, c: A.Compound, switch: bool = False) -> None:
+        self.emit("{", c.loc)
+        self.level += 1
+        in_case = False
+        for s in c.stmts:
+            if switch and isinstance(s, A.Case):
+                if in_case:
+                    self.level -= 1
+                self.statement(s)
+                self.level += 1
+                in_case = True
+            else:
+                self.statement(s)
+        if in_case:
+            self.level -= 1
+        self.level -= 1
+        self.emit("}", None)
+
+    def sub(self, s: A.Stmt) -> None:
+        if isinstance(s, A.Compound):
+            self.compound(s)
+        else:
+            self.level += 1
+            self.statement(s)
+            self.level -= 1
+
+    def statement(self, s: A.Stmt) -> None:
+        loc = s.loc
+        if isinstance(s, A.Compound):
+            self.compound(s)
+        elif isinstance(s, A.DeclStmt):
+            self.declaration(s.decl)
+        elif isinstance(s, A.ExprStmt):
+            self.emit(";" if s.expr is None else print_expr(s.expr) + ";", loc)
+        elif isinstance(s, A.If):
+            self.emit(f"if ({print_expr(s.cond)})", loc)
+            then = s.then
+            if s.else_ is not None and _dangles(then):
+                then = A.Compound([then], loc=then.loc)
+            self.sub(then)
+            if s.else_ is not None:
+                self.emit("else", None)
+                self.sub(s.else_)
+        elif isinstance(s, A.For):
+            if s.init is None:
+                init = ""
+            elif isinstance(s.init, A.DeclStmt):
+                init = self.decl_inline(s.init.decl)
+            else:
+                init = "" if s.init.expr is None else print_expr(s.init.expr)
+            step = "" if s.step is None else " " + print_expr(s.step)
+            self.emit(f"for ({init}; {self.condition(s.cond)};{step})".replace("; ;", ";;"), loc)
+            self.sub(s.body)
+        elif isinstance(s, A.While):
+            self.emit(f"while ({self.condition(s.cond)})", loc)
+            self.sub(s.body)
+        elif isinstance(s, A.DoWhile):
+            self.emit("do", loc)
+            self.sub(s.body)
+            self.emit(f"while ({print_expr(s.cond)});", None)
+        elif isinstance(s, A.Switch):
+            self.emit(f"switch ({print_expr(s.expr)})", loc)
+            self.compound(s.body, switch=True)
+        elif isinstance(s, A.Case):
+            self.emit("default:" if s.expr is None else f"case {print_expr(s.expr, P_TERNARY)}:", loc)
+        elif isinstance(s, A.Return):
+            self.emit("return;" if s.expr is None else f"return {print_expr(s.expr)};", loc)
+        elif isinstance(s, A.Break):
+            self.emit("break;", loc)
+        elif isinstance(s, A.Continue):
+            self.emit("continue;", loc)
+        elif isinstance(s, A.Discard):
+            self.emit("discard;", loc)
+        else:
+            raise TypeError(f"cannot print {type(s).__name__} as a statement")
+
+    def condition(self, c) -> str:
+        if c is None:
+            return ""
+        if isinstance(c, A.VariableDecl):
+            return self.decl_inline(c)
+        return print_expr(c)
+
+
+def _dangles(s: A.Stmt) -> bool:
+    """Whether an ``else`` printed after ``s`` would attach to an ``if`` inside ``s``."""
+    while True:
+        if isinstance(s, A.If):
+            if s.else_ is None:
+                return True
+            s = s.else_
+        elif isinstance(s, (A.For, A.While)):
+            s = s.body
+        else:
+            return False
+
+
+def _header(unit: A.TranslationUnit) -> list[str]:
+    lines = []
+    if unit.version is not None:
+        profile = unit.profile
+        if profile == "es" and unit.version < 300:
+            profile = None
+        if profile in ("core", "compatibility") and unit.version < 150:
+            profile = None
+        lines.append(_join(f"#version {unit.version}", profile or ""))
+    for name, behavior in unit.extensions:
+        lines.append(f"#extension {name} : {behavior}")
+    return lines
+
+
+def print_with_map(unit: A.TranslationUnit) -> tuple[str, list[Optional[SourceLoc]]]:
+    """Print a unit and map each printed line to the place it came from.
+
+    ``line_map[i]`` is the SourceLoc of the statement or declaration on printed line ``i + 1``,
+    or None (blank lines, closing braces, the ``#version`` line).
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> text, line_map = print_with_map(parse_source("void main()\\n{ gl_FragColor = vec4(1.0); }", "a.frag"))
+    >>> text.splitlines()[2], str(line_map[2])
+    ('    gl_FragColor = vec4(1.0);', 'a.frag:2:3')
+    """
+    p = _Printer()
+    for line in _header(unit):
+        p.emit(line, None)
+    prev = None
+    for d in unit.decls:
+        spacious = isinstance(d, (A.FunctionDecl, A.InterfaceBlock)) or (
+            isinstance(d, A.VariableDecl) and d.type.spec.struct is not None)
+        if p.lines and (spacious or prev) and p.lines[-1][0]:
+            p.emit("", None)
+        p.declaration(d)
+        prev = spacious
+    text = "\n".join(line for line, _ in p.lines) + "\n"
+    return text, [loc for _, loc in p.lines]
+
+
+def print_glsl(unit: A.TranslationUnit) -> str:
+    """Print a unit as GLSL source.
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> print(print_glsl(parse_source("float f(float x){return (x*(x+1.0));}")), end="")
+    float f(float x)
+    {
+        return x * (x + 1.0);
+    }
+    """
+    return print_with_map(unit)[0]

@@ -1,0 +1,4 @@
+// expect: 3:5 reserved word
+void main() {
+    goto end;
+}

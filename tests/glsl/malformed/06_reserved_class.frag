@@ -1,0 +1,3 @@
+// expect: 2:1 reserved word
+class Foo;
+void main() {}

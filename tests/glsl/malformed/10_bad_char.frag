@@ -1,0 +1,4 @@
+// expect: 3:15 unexpected character '@'
+void main() {
+    float a = @b;
+}

@@ -1,0 +1,3 @@
+// expect: 2:9 unknown type name 'Foo'
+uniform Foo bar;
+void main() {}

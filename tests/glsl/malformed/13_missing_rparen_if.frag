@@ -1,0 +1,4 @@
+// expect: 3:14 expected ')' after the if condition
+void main() {
+    if (true ; ) {}
+}

@@ -1,0 +1,4 @@
+// expect: 3:5 'else' without a matching 'if'
+void main() {
+    else { }
+}

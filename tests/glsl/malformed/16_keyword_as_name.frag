@@ -1,0 +1,3 @@
+// expect: 2:7 expected a name in the declaration, found keyword 'uniform'
+float uniform;
+void main() {}

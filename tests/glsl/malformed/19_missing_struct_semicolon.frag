@@ -1,0 +1,5 @@
+// expect: 5:1 expected ';' after declaration
+struct S {
+    float a;
+} s
+void main() {}

@@ -1,0 +1,4 @@
+// expect: 3:10 functions cannot be declared inside a function
+void main() {
+    void inner() {}
+}

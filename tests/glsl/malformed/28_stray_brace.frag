@@ -1,0 +1,5 @@
+// expect: 5:1 expected a declaration, found '}'
+void main() {
+    float a = 1.0;
+}
+}

@@ -1,0 +1,3 @@
+// expect: 2:1 expected a declaration, found 'foo'
+foo() {}
+void main() {}

@@ -1,0 +1,4 @@
+// expect: 3:13 unexpected character
+void main() {
+    int a = "text";
+}
