@@ -1,0 +1,219 @@
+"""The GLSL front-end entry point: source text or file → checked :class:`Shader`.
+
+``parse_shader`` runs the stages in order (preprocess → lex → parse → check) and rejects shaders
+rrcache does not handle (other stages than fragment, several colour outputs) with an
+:class:`~rrcache.errors.UnsupportedShaderError`. ``load_shader`` reads the file first.
+
+>>> shader = parse_shader("uniform float u_time;\\nvarying vec2 v_texcoord;\\n"
+...                       "void main() { gl_FragColor = vec4(v_texcoord, sin(u_time), 1.0); }")
+>>> shader.version, list(shader.uniforms), list(shader.inputs)
+(110, ['u_time'], ['v_texcoord'])
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass, field
+from typing import Iterable, Mapping, Optional
+
+from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
+from rrcache.glsl import ast as A
+from rrcache.glsl.builtins import NON_FRAGMENT_VARIABLES
+from rrcache.glsl.lexer import lex
+from rrcache.glsl.parser import parse
+from rrcache.glsl.preprocessor import preprocess
+from rrcache.glsl.semantic import SemanticInfo, check
+from rrcache.glsl.types import Type
+
+__all__ = ["Shader", "load_shader", "parse_shader"]
+
+# Layout qualifiers that belong to compute, geometry and tessellation shaders.
+_OTHER_STAGE_LAYOUTS = {
+    "local_size_x": "compute", "local_size_y": "compute", "local_size_z": "compute",
+    "max_vertices": "geometry", "invocations": "geometry", "triangles_adjacency": "geometry",
+    "lines_adjacency": "geometry", "line_strip": "geometry", "triangle_strip": "geometry",
+    "vertices": "tessellation control", "isolines": "tessellation evaluation",
+    "equal_spacing": "tessellation evaluation", "fractional_even_spacing":
+    "tessellation evaluation", "fractional_odd_spacing": "tessellation evaluation",
+}
+_OTHER_STAGE_FUNCTIONS = {"EmitVertex": "geometry", "EndPrimitive": "geometry",
+                          "EmitStreamVertex": "geometry", "EndStreamPrimitive": "geometry",
+                          "ftransform": "vertex", "barrier": "compute or tessellation"}
+
+
+@dataclass
+class Shader:
+    """A checked fragment shader.
+
+    ``unit`` is the type-checked AST, ``info`` its :class:`SemanticInfo`; ``uniforms``,
+    ``samplers`` and ``inputs`` map names to ``(Type, SourceLoc)`` in declaration order
+    (``uniforms`` are the non-opaque plain uniforms, ``samplers`` the opaque ones, ``inputs`` the
+    user-declared inputs the shader reads); ``hash`` is a sha256 over every file read and the
+    defines; ``files`` lists those files (the main one first).
+    """
+
+    path: Optional[str]
+    source: str
+    unit: A.TranslationUnit
+    info: SemanticInfo
+    version: int
+    profile: Optional[str]
+    hash: str
+    uniforms: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
+    samplers: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
+    inputs: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
+    outputs: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
+    defines: dict[str, object] = field(default_factory=dict)
+    files: list[str] = field(default_factory=list)
+
+    @property
+    def varyings(self) -> dict[str, tuple[Type, SourceLoc]]:
+        """The inputs (varyings) the shader reads; the same as :attr:`inputs`."""
+        return self.inputs
+
+    @property
+    def es(self) -> bool:
+        """Whether the shader is GLSL ES."""
+        return self.info.es
+
+
+def parse_shader(source: str, filename: str = "<string>",
+                 defines: Optional[Mapping[str, object]] = None,
+                 include_dirs: Iterable[str] = ()) -> Shader:
+    """Preprocess, parse and type-check the fragment shader ``source``.
+
+    Raises the stage's :class:`~rrcache.errors.GLSLError` subclass on invalid input, and
+    :class:`~rrcache.errors.UnsupportedShaderError` for a vertex/geometry/compute shader or a
+    shader with several colour outputs.
+
+    >>> s = parse_shader("#version 330\\nout vec4 c;\\nuniform sampler2D tex;\\nin vec2 uv;\\n"
+    ...                  "void main() { c = texture(tex, uv); }", "a.frag")
+    >>> list(s.samplers), s.outputs["c"][0]
+    (['tex'], Type('vec4'))
+    """
+    defines = dict(defines or {})
+    pp = preprocess(source, filename, defines, tuple(include_dirs))
+    tokens = lex(pp.tokens, pp.version, pp.profile, filename=filename)
+    unit = parse(tokens, pp.version, pp.profile)
+    unit.extensions = list(pp.extensions)
+    frag_data = _reject_other_stages(unit, filename)
+    info = check(unit, filename)
+    _reject_multiple_outputs(frag_data, info)
+    path = None if filename.startswith("<") else filename
+    files = list(pp.files) or ([filename] if path else [])
+    return Shader(
+        path=path, source=source, unit=unit, info=info, version=info.version,
+        profile=unit.profile or ("es" if info.es else None),
+        hash=_hash(source, files, defines, filename),
+        uniforms={n: (s.type, s.loc) for n, s in info.uniforms.items()
+                  if isinstance(s.decl, A.VariableDecl) and not s.type.contains_opaque()},
+        samplers={n: (s.type, s.loc) for n, s in info.uniforms.items()
+                  if s.type.contains_opaque()},
+        inputs={n: (s.type, s.loc) for n, s in info.inputs.items() if n in info.used_globals},
+        outputs={n: (s.type, s.loc) for n, s in info.outputs.items()},
+        defines=defines, files=files)
+
+
+def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, object]] = None,
+                include_dirs: Iterable[str] = ()) -> Shader:
+    """Read the fragment shader file ``path`` and return the checked :class:`Shader`.
+
+    A missing or unreadable file raises :class:`~rrcache.errors.GLSLError` naming the path.
+
+    >>> shader = load_shader("shaders/marble.glsl")  # doctest: +SKIP
+    >>> shader.uniforms["u_camera"][0]  # doctest: +SKIP
+    Type('vec3')
+    """
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        raise GLSLError(f"cannot read shader file '{path}': {e.strerror or e}", None,
+                        "check the path" if isinstance(e, FileNotFoundError) else None) from None
+    try:
+        source = data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        line = data.count(b"\n", 0, e.start) + 1
+        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
+        raise GLSLError("the shader file is not valid UTF-8", SourceLoc(path, line, col),
+                        "save the shader as UTF-8") from None
+    return parse_shader(source, path, defines, include_dirs)
+
+
+def _hash(source: str, files: list[str], defines: Mapping[str, object], filename: str) -> str:
+    h = hashlib.sha256()
+    h.update(source.encode("utf-8"))
+    for path in files:
+        if path == filename or path.startswith("<"):
+            continue
+        h.update(b"\0file\0" + path.encode("utf-8") + b"\0")
+        try:
+            with open(path, "rb") as f:
+                h.update(f.read())
+        except OSError:
+            h.update(b"<unreadable>")
+    for name in sorted(defines):
+        h.update(f"\0define\0{name}={defines[name]!r}".encode("utf-8"))
+    return h.hexdigest()
+
+
+def _unsupported(what: str, loc: Optional[SourceLoc], filename: str) -> UnsupportedShaderError:
+    return UnsupportedShaderError(
+        f"this looks like a {what}; rrcache optimizes fragment shaders only", loc or
+        SourceLoc(filename, 1, 1), "pass the fragment (pixel) shader")
+
+
+def _reject_other_stages(unit: A.TranslationUnit, filename: str) -> list[A.Index]:
+    """Raise for a non-fragment stage; returns the ``gl_FragData[...]`` index nodes. Runs before
+    :func:`check`, so that a vertex shader is reported as one rather than as an undeclared
+    ``gl_Position``."""
+    frag_data: list[A.Index] = []
+    for node in unit.walk():
+        if (isinstance(node, A.Index) and isinstance(node.obj, A.Ident)
+                and node.obj.name == "gl_FragData"):
+            frag_data.append(node)
+        if isinstance(node, A.Ident) and node.name in NON_FRAGMENT_VARIABLES:
+            raise _unsupported(f"non-fragment shader (it uses '{node.name}')", node.loc,
+                               filename)
+        if isinstance(node, A.Call) and node.name in _OTHER_STAGE_FUNCTIONS:
+            raise _unsupported(f"{_OTHER_STAGE_FUNCTIONS[node.name]} shader (it calls "
+                               f"'{node.name}')", node.loc, filename)
+        if isinstance(node, A.FullType) and "attribute" in node.qualifiers:
+            raise _unsupported("vertex shader (it declares an 'attribute')", node.loc, filename)
+        if isinstance(node, A.Layout):
+            for name, _ in node.items:
+                if name in _OTHER_STAGE_LAYOUTS:
+                    raise _unsupported(f"{_OTHER_STAGE_LAYOUTS[name]} shader "
+                                       f"(layout '{name}')", node.loc, filename)
+        if isinstance(node, A.VariableDecl):
+            for d in node.declarators:
+                if d.name in NON_FRAGMENT_VARIABLES:
+                    raise _unsupported(f"non-fragment shader (it declares '{d.name}')",
+                                       d.loc or node.loc, filename)
+        if isinstance(node, A.InterfaceBlock) and node.block_name == "gl_PerVertex":
+            raise _unsupported("non-fragment shader (it declares 'gl_PerVertex')", node.loc,
+                               filename)
+    return frag_data
+
+
+def _reject_multiple_outputs(frag_data: list[A.Index], info: SemanticInfo) -> None:
+    outs = [s for s in info.outputs.values()]
+    arrays = [s for s in outs if s.type.dims and s.type.dims[0] != 1]
+    if len(outs) > 1 or arrays:
+        names = ", ".join(f"'{s.name}'" for s in outs)
+        first = (arrays or outs[1:])[0]
+        raise UnsupportedShaderError(
+            f"the shader has several colour outputs ({names}); rrcache handles one",
+            first.loc, "write the final colour to a single 'out vec4'")
+    legacy = {"gl_FragColor", "gl_FragData"} & info.used_globals
+    if outs and legacy:
+        raise UnsupportedShaderError(
+            f"the shader writes both '{outs[0].name}' and '{sorted(legacy)[0]}'",
+            outs[0].loc, "use only one colour output")
+    for node in frag_data:
+        idx = node.index
+        if not (isinstance(idx, A.IntLit) and idx.value == 0):
+            raise UnsupportedShaderError(
+                "the shader writes several colour outputs through gl_FragData", node.loc,
+                "write the final colour to gl_FragData[0] or gl_FragColor only")
