@@ -1,0 +1,245 @@
+"""``load_session(path) -> Session``: read, validate and assemble a session file.
+
+Steps: read and parse the JSON (syntax errors give line and column; duplicate keys, NaN and
+Infinity are rejected), check ``rrcache_session`` is 1, validate against ``schema.json``, then
+build the camera, light, objects (mesh files and procedural meshes), uniforms and textures.
+Meshes and images are decoded eagerly, so every missing or unreadable asset is reported here
+as an AssetError naming the session file, the JSON path and the resolved file. ``Session.hash``
+is a sha256 over the canonical JSON and the bytes of every asset file read.
+
+>>> s = load_session("tests/data/sessions/minimal.json")
+>>> s.camera_at(0).view.shape
+(4, 4)
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+from typing import Any
+
+from rrcache.errors import AssetError, SessionError
+from rrcache.session import procedural, textures as tex
+from rrcache.session.meshes import MeshLoadError, load_mesh_file
+from rrcache.session.model import MeshData, SceneObject, Session, TextureAsset
+from rrcache.session.scene import camera_function, light_function, model_function
+from rrcache.session.uniforms import BUILTIN_UNIFORMS, uniform_function
+from rrcache.session.validation import json_path, validate_document
+
+#: Bumped whenever the meshes or images built from the same files would change.
+LOADER_VERSION = 1
+
+
+class _DuplicateKey(Exception):
+    pass
+
+
+def _pairs(pairs: list) -> dict:
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not a valid JSON number")
+
+
+def parse_json(text: str, file: str) -> Any:
+    """Parse session text; a syntax error becomes SessionError with its line and column."""
+    try:
+        return json.loads(text, object_pairs_hook=_pairs, parse_constant=_no_constant)
+    except json.JSONDecodeError as e:
+        err = SessionError(f"invalid JSON at line {e.lineno}, column {e.colno}: {e.msg}", file, None,
+                           "check for a missing comma, quote or bracket near that place")
+        err.line, err.col = e.lineno, e.colno
+        raise err from None
+    except _DuplicateKey as e:
+        raise SessionError(f"duplicate key {e.args[0]!r}", file, None, "each key may appear once per object") from None
+    except (ValueError, RecursionError) as e:
+        raise SessionError(f"invalid JSON: {e}", file, None) from None
+
+
+def _check_numbers(value: Any, file: str, parts: list) -> None:
+    if isinstance(value, float) and not math.isfinite(value):
+        raise SessionError(f"number {value} is out of range", file, json_path(parts))
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2 ** 63 - 1:
+        raise SessionError("integer is out of range", file, json_path(parts))
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _check_numbers(v, file, parts + [k])
+    elif isinstance(value, list):
+        for k, v in enumerate(value):
+            _check_numbers(v, file, parts + [k])
+
+
+def check_version(doc: Any, file: str) -> None:
+    """The document must be an object with ``"rrcache_session": 1``."""
+    if not isinstance(doc, dict):
+        raise SessionError(f"a session is a JSON object, got {type(doc).__name__}", file, None,
+                           'start the file with {"rrcache_session": 1, ...}')
+    if "rrcache_session" not in doc:
+        raise SessionError("not an rrcache session: the key 'rrcache_session' is missing", file, None,
+                           'add "rrcache_session": 1')
+    v = doc["rrcache_session"]
+    if isinstance(v, bool) or v != 1:
+        raise SessionError(f"unsupported session format version {json.dumps(v)}", file, "rrcache_session",
+                           "this rrcache reads version 1")
+
+
+class _Assets:
+    """Resolves asset paths, loads each file once and records the files for the hash."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.base = os.path.dirname(os.path.abspath(file))
+        self.files: list[tuple[str, str]] = []  # (path as written, resolved)
+        self.meshes: dict[str, MeshData] = {}
+
+    def resolve(self, written: str) -> str:
+        return os.path.normpath(os.path.join(self.base, os.path.expanduser(written)))
+
+    def mesh(self, written: str, where: str) -> tuple[MeshData, str]:
+        path = self.resolve(written)
+        if path not in self.meshes:
+            try:
+                self.meshes[path] = load_mesh_file(path)
+            except MeshLoadError as e:
+                raise AssetError(f"{e}: {path}", self.file, where,
+                                 "mesh paths are relative to the session file's folder") from None
+            self.files.append((written, path))
+        return self.meshes[path], path
+
+    def image(self, written: str, where: str):
+        path = self.resolve(written)
+        try:
+            data = tex.read_image(path)
+        except tex.ImageLoadError as e:
+            raise AssetError(f"{e}: {path}", self.file, where,
+                             "image paths are relative to the session file's folder") from None
+        self.files.append((written, path))
+        return data, path
+
+    def digest(self, doc: dict) -> str:
+        h = hashlib.sha256(f"rrcache-session-1 loader-{LOADER_VERSION}\0".encode())
+        h.update(json.dumps(doc, sort_keys=True, separators=(",", ":"), ensure_ascii=False).encode())
+        for written, path in self.files:
+            try:
+                with open(path, "rb") as f:
+                    data = f.read()
+            except OSError as e:
+                raise AssetError(f"cannot read {path}: {e.strerror}", self.file, None) from None
+            h.update(f"\0{written}\0{len(data)}\0".encode())
+            h.update(data)
+        return h.hexdigest()
+
+
+def _objects(doc: dict, file: str, assets: _Assets) -> list[SceneObject]:
+    objects, used = [], set()
+    for i, spec in enumerate(doc["objects"]):
+        base = ["objects", i]
+        if "mesh" in spec:
+            mesh, source = assets.mesh(spec["mesh"], json_path(base + ["mesh"]))
+            default_name = os.path.splitext(os.path.basename(spec["mesh"]))[0] or f"object{i}"
+        else:
+            proc = spec["procedural"]
+            mesh = procedural.make_mesh(proc, file, json_path(base + ["procedural"]))
+            source, default_name = f"procedural:{proc['type']}", proc["type"]
+        if "name" in spec:
+            name = spec["name"]
+            if name in used:
+                raise SessionError(f"another object is already named {name!r}", file, json_path(base + ["name"]))
+        else:
+            name, n = default_name, 2
+            while name in used:
+                name, n = f"{default_name}_{n}", n + 1
+        used.add(name)
+        objects.append(SceneObject(name, mesh, model_function(spec.get("keyframes", []), file, i), source))
+    return objects
+
+
+def _textures(doc: dict, file: str, assets: _Assets) -> dict[str, TextureAsset]:
+    out = {}
+    for name in sorted(doc.get("textures", {})):
+        spec = doc["textures"][name]
+        spec = {"path": spec} if isinstance(spec, str) else spec
+        base = ["textures", name]
+        where = json_path(base)
+        if name in BUILTIN_UNIFORMS:
+            raise SessionError(f"{name} is a built-in uniform, not a sampler", file, where)
+        if name in doc.get("uniforms", {}):
+            raise SessionError(f"{name} is also set in 'uniforms'", file, where, "give each name once")
+        kind = spec.get("kind", "cube" if "faces" in spec else "2d")
+        if "faces" in spec and kind != "cube":
+            raise SessionError("six 'faces' make a cube map; kind must be \"cube\"", file,
+                               json_path(base + ["kind"]))
+        if "faces" in spec:
+            faces, files = [], []
+            for k, face in enumerate(spec["faces"]):
+                data, path = assets.image(face, json_path(base + ["faces", k]))
+                faces.append(data)
+                files.append(path)
+            try:
+                data = tex.stack_cube_faces(faces)
+            except tex.ImageLoadError as e:
+                raise AssetError(str(e), file, json_path(base + ["faces"])) from None
+        else:
+            at = where if isinstance(doc["textures"][name], str) else json_path(base + ["path"])
+            data, path = assets.image(spec["path"], at)
+            files = [path]
+            if kind == "cube":
+                try:
+                    data = tex.split_cube_strip(data)
+                except tex.ImageLoadError as e:
+                    raise AssetError(f"{e}: {path}", file, at) from None
+        out[name] = TextureAsset(name=name, path=files[0], kind=kind, data=data,
+                                 filter=spec.get("filter", "linear"),
+                                 wrap=spec.get("wrap", "clamp" if kind == "cube" else "repeat"),
+                                 files=tuple(files))
+    return out
+
+
+def _uniforms(doc: dict, file: str):
+    functions = {name: uniform_function(name, value, file) for name, value in doc.get("uniforms", {}).items()}
+    return lambda frame: {name: f(frame) for name, f in functions.items()}
+
+
+def load_session(path: str | os.PathLike) -> Session:
+    """Load and validate the session file at ``path``.
+
+    Raises SessionError (bad JSON, schema violation, inconsistent values) or AssetError (a mesh
+    or image that is missing or unreadable), each naming the file and the JSON path.
+
+    >>> s = load_session("tests/data/sessions/minimal.json")
+    >>> s.frames, [o.name for o in s.objects]
+    (4, ['torus'])
+    """
+    file = os.fspath(path)
+    try:
+        with open(file, "rb") as f:
+            raw = f.read()
+    except OSError as e:
+        raise SessionError(f"cannot read the session file: {e.strerror}", file, None) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise SessionError(f"the session file is not UTF-8 text (byte {e.start})", file, None) from None
+    doc = parse_json(text, file)
+    check_version(doc, file)
+    _check_numbers(doc, file, [])
+    validate_document(doc, file)
+    assets = _Assets(file)
+    camera = camera_function(doc["camera"], file)
+    light = light_function(doc.get("light"), camera, file)
+    objects = _objects(doc, file, assets)
+    uniforms = _uniforms(doc, file)
+    textures = _textures(doc, file, assets)
+    return Session(
+        path=file, resolution=(int(doc["resolution"][0]), int(doc["resolution"][1])),
+        frames=int(doc["frames"]), fps=float(doc.get("fps", 30)), objects=objects, textures=textures,
+        hash=assets.digest(doc), name=doc.get("name", ""), description=doc.get("description", ""),
+        background=tuple(float(c) for c in doc.get("background", (0.0, 0.0, 0.0, 0.0))), document=doc,
+        _camera=camera, _light=light, _uniforms=uniforms)

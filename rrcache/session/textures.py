@@ -1,0 +1,74 @@
+"""Image files → float32 arrays through OpenImageIO (PNG, JPEG, EXR, HDR, TIFF, ...).
+
+Images are decoded eagerly when the session loads, so a missing or corrupt file is reported
+at load time. 8/16-bit integer images are scaled to 0..1; float and half images are kept
+exactly (float data textures are used as arrays of records). Row 0 of the result is the
+image's top row (see :class:`rrcache.session.model.TextureAsset` for how to upload it).
+A cube map is six files (+X −X +Y −Y +Z −Z) of equal square size, or one image holding the six
+faces side by side (a 6:1 horizontal strip) or stacked (a 1:6 vertical strip) in that order.
+
+>>> read_image("tests/data/sessions/textures/checker.png").shape
+(4, 4, 3)
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+
+class ImageLoadError(Exception):
+    """Raised by the readers; the loader turns it into an AssetError with the JSON path."""
+
+
+def read_image(path: str) -> np.ndarray:
+    """Decode the first subimage of ``path`` into float32 H×W×C (row 0 = top row)."""
+    import OpenImageIO as oiio
+
+    if not os.path.isfile(path):
+        raise ImageLoadError("image file not found")
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise ImageLoadError(f"cannot read image: {oiio.geterror() or 'unknown format'}")
+    try:
+        spec = inp.spec()
+        data = inp.read_image(0, 0, 0, spec.nchannels, oiio.FLOAT)
+        err = inp.geterror()
+    finally:
+        inp.close()
+    if data is None or err:
+        raise ImageLoadError(f"cannot decode image: {err or 'read failed'}")
+    data = np.asarray(data, dtype=np.float32)
+    if data.ndim == 2:
+        data = data[:, :, None]
+    if data.ndim == 4:  # a volume image: keep the first slice
+        data = data[0]
+    if data.shape[0] < 1 or data.shape[1] < 1:
+        raise ImageLoadError("the image is empty")
+    return np.ascontiguousarray(data)
+
+
+def split_cube_strip(image: np.ndarray) -> np.ndarray:
+    """A 6:1 horizontal or 1:6 vertical strip → 6×S×S×C faces.
+
+    >>> split_cube_strip(np.zeros((2, 12, 3), np.float32)).shape
+    (6, 2, 2, 3)
+    """
+    h, w = image.shape[:2]
+    if w == 6 * h:
+        return np.ascontiguousarray(np.stack([image[:, k * h:(k + 1) * h] for k in range(6)]))
+    if h == 6 * w:
+        return np.ascontiguousarray(np.stack([image[k * w:(k + 1) * w] for k in range(6)]))
+    raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip of square faces, got {w}×{h}")
+
+
+def stack_cube_faces(faces: list[np.ndarray]) -> np.ndarray:
+    """Six decoded faces → 6×S×S×C; raises ImageLoadError naming the face index on a mismatch."""
+    first = faces[0].shape
+    if first[0] != first[1]:
+        raise ImageLoadError(f"cube faces must be square, face 0 is {first[1]}×{first[0]}", )
+    for k, f in enumerate(faces):
+        if f.shape != first:
+            raise ImageLoadError(f"cube face {k} is {f.shape[1]}×{f.shape[0]}×{f.shape[2]}, "
+                                 f"face 0 is {first[1]}×{first[0]}×{first[2]}")
+    return np.ascontiguousarray(np.stack(faces))
