@@ -1,0 +1,107 @@
+"""``rrcache render SHADER SESSION``: replay a session through a shader and report per frame.
+
+    rrcache render marble.frag session.json --frames 10 --out frames/ -D OCTAVES=5
+    rrcache render marble.frag session.json --resolution 64x48 --json
+
+With ``--out`` each frame is written as ``frame_NNNN.exr`` (float, exact) and ``frame_NNNN.png``.
+The summary is a table (or, with ``--json``, an object with ``frames``, ``resolution``,
+``ms_per_frame`` and ``covered_pixels``); notes on the session (uniforms the shader does not use)
+go to stderr.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from rrcache.harness.images import write_image
+from rrcache.harness.prepare import prepare_file
+from rrcache.harness.renderer import frame_indices, parse_resolution, render
+from rrcache.session import load_session
+
+
+def parse_defines(items) -> dict[str, str]:
+    """``("A=1", "B")`` → ``{"A": "1", "B": "1"}``; a bad name is a ``click.BadParameter``.
+
+    >>> parse_defines(["OCTAVES=5", "FAST"])
+    {'OCTAVES': '5', 'FAST': '1'}
+    """
+    defines = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not name.isidentifier():
+            raise click.BadParameter(f"{item!r} is not NAME or NAME=VALUE", param_hint="-D")
+        defines[name] = value if sep else "1"
+    return defines
+
+
+def _resolution(ctx, param, value):
+    if value is None:
+        return None
+    try:
+        return parse_resolution(value)
+    except ValueError as err:
+        raise click.BadParameter(str(err)) from None
+
+
+@click.command("render")
+@click.argument("shader", type=click.Path(dir_okay=False))
+@click.argument("session", type=click.Path(dir_okay=False))
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), default=None,
+              help="Write every frame here as EXR and PNG.")
+@click.option("--frames", "frame_count", type=click.IntRange(min=1), default=None,
+              help="Render only the first N frames (default: all).")
+@click.option("--resolution", callback=_resolution, default=None, metavar="WxH",
+              help="Render at this size instead of the session's.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
+@click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+def command(shader, session, out_dir, frame_count, resolution, as_json, defines):
+    """Render SESSION through the fragment shader SHADER and report time and coverage per frame."""
+    err_console = Console(stderr=True)
+    loaded = load_session(session)
+    prepared = prepare_file(shader, loaded, parse_defines(defines))
+    indices = frame_indices(loaded, frame_count)
+    out = Path(out_dir) if out_dir else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+
+    show_progress = len(indices) > 1 and err_console.is_terminal
+    progress = Progress(TextColumn("rendering"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                        console=err_console, transient=True, disable=not show_progress)
+    with progress:
+        task = progress.add_task("render", total=len(indices))
+
+        def done(frame):
+            if out is not None:
+                stem = out / f"frame_{frame.index:04d}"
+                write_image(stem.with_suffix(".exr"), frame.image)
+                write_image(stem.with_suffix(".png"), frame.image)
+            progress.advance(task)
+
+        result = render(prepared, loaded, indices, resolution=resolution, progress=done)
+
+    for note in result.notes:
+        err_console.print(f"note: {note}", highlight=False, markup=False)
+    if as_json:
+        click.echo(json.dumps({
+            "frames": len(result.frames),
+            "resolution": list(result.resolution),
+            "ms_per_frame": result.ms_per_frame,
+            "covered_pixels": [f.covered_pixels for f in result.frames],
+        }))
+        return
+    table = Table(title=f"{prepared.path} × {loaded.path}  ({result.resolution[0]}×{result.resolution[1]})")
+    table.add_column("frame", justify="right")
+    table.add_column("covered pixels", justify="right")
+    table.add_column("ms", justify="right")
+    for frame in result.frames:
+        table.add_row(str(frame.index), str(frame.covered_pixels), f"{frame.ms:.2f}")
+    console = Console()
+    console.print(table)
+    console.print(f"median {result.ms_per_frame:.2f} ms per frame over {len(result.frames)} frames"
+                  + (f"; images in {out}" if out is not None else ""), highlight=False)

@@ -1,0 +1,48 @@
+"""Writing rendered frames as image files through OpenImageIO.
+
+EXR keeps the float32 RGBA values bit-exact; PNG (and other 8-bit formats) clamp to [0, 1] and
+quantise, with straight (unassociated) alpha, since shaders write straight colour.
+
+>>> import numpy as np
+>>> write_image("frame.exr", np.zeros((4, 4, 4), np.float32))   # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from rrcache.errors import AssetError
+
+_FLOAT_FORMATS = (".exr", ".hdr", ".tif", ".tiff")
+
+
+def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
+    """Write an H×W×C float image (row 0 = top) to ``path``; the extension picks the format.
+
+    EXR/HDR/TIFF are written as 32-bit float, anything else as 8 bits per channel. Raises
+    :class:`AssetError` when OpenImageIO cannot write the file.
+    """
+    import OpenImageIO as oiio
+
+    path = os.fspath(path)
+    pixels = np.ascontiguousarray(np.asarray(image, dtype=np.float32))
+    if pixels.ndim == 2:
+        pixels = pixels[:, :, None]
+    h, w, c = pixels.shape
+    is_float = path.lower().endswith(_FLOAT_FORMATS)
+    if not is_float:
+        pixels = np.clip(np.nan_to_num(pixels, nan=0.0), 0.0, 1.0)
+    spec = oiio.ImageSpec(w, h, c, oiio.FLOAT if is_float else oiio.UINT8)
+    if c == 4:
+        spec.attribute("oiio:UnassociatedAlpha", 1)
+    out = oiio.ImageOutput.create(path)
+    if out is None:
+        raise AssetError(f"cannot write an image: {oiio.geterror()}", path,
+                         hint="use a .exr or .png file name")
+    ok = out.open(path, spec) and out.write_image(pixels)
+    message = out.geterror()
+    out.close()
+    if not ok:
+        raise AssetError(f"cannot write the image: {message or 'unknown OpenImageIO error'}", path,
+                         hint="check that the directory exists and is writable")

@@ -1,0 +1,147 @@
+"""A fragment shader made ready for the GL: core-profile text plus what the harness must know.
+
+:class:`PreparedShader` is all the harness needs from the GLSL front-end: the ``#version 330
+core`` fragment text the driver compiles, the printer's line map (so driver errors name the
+original ``file:line``), the declared uniforms/samplers and fragment inputs with the place of their
+declaration, the source path and a content hash. :func:`prepare` makes one from a front-end
+``Shader``; :func:`prepare_file` loads a shader file with the ``MODEL_VERTEX_*`` defines of a
+session's meshes first.
+
+>>> p = PreparedShader(source="#version 330 core\\nout vec4 c;\\nvoid main(){c=vec4(1);}",
+...                    path="white.frag", hash="h1")
+>>> p.declaration("u_missing") is None
+True
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping, Optional, Sequence
+
+from rrcache.errors import SourceLoc
+from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes
+
+
+@dataclass(frozen=True)
+class Decl:
+    """A global declaration of the fragment shader: its GLSL type name (``vec3``, ``sampler2D``;
+    array dimensions left out) and where it is declared (None when unknown)."""
+
+    type: str
+    loc: Optional[SourceLoc] = None
+
+
+@dataclass
+class PreparedShader:
+    """A core-profile fragment shader and its declarations, independent of front-end internals.
+
+    ``uniforms`` holds every declared uniform, samplers included; ``inputs`` the fragment inputs
+    (varyings). ``line_map[i]`` is the original place of line ``i + 1`` of ``source``.
+    """
+
+    source: str
+    path: str
+    hash: str
+    line_map: Optional[Sequence[Optional[SourceLoc]]] = None
+    uniforms: dict[str, Decl] = field(default_factory=dict)
+    inputs: dict[str, Decl] = field(default_factory=dict)
+    defines: dict[str, str] = field(default_factory=dict)
+
+    def declaration(self, name: str) -> Optional[Decl]:
+        """The declaration of uniform or input ``name`` (None when the shader declares none)."""
+        return self.uniforms.get(name) or self.inputs.get(name)
+
+    def where(self, name: str) -> str:
+        """``file:line:col`` of the declaration of ``name``, or the shader path when unknown."""
+        decl = self.declaration(name)
+        return str(decl.loc) if decl is not None and decl.loc is not None else self.path
+
+
+def _qualifier_names(qualifiers) -> set[str]:
+    return {q for q in qualifiers if isinstance(q, str)}
+
+
+def declarations(unit) -> tuple[dict[str, Decl], dict[str, Decl]]:
+    """The global uniforms and fragment inputs (``in``/``varying``) of a translation unit.
+
+    Interface blocks are skipped (the harness binds no uniform blocks).
+    """
+    from rrcache.glsl import ast
+
+    uniforms: dict[str, Decl] = {}
+    inputs: dict[str, Decl] = {}
+    for decl in unit.decls:
+        if not isinstance(decl, ast.VariableDecl):
+            continue
+        quals = _qualifier_names(decl.type.qualifiers)
+        spec = decl.type.spec
+        type_name = spec.name if spec.name else (spec.struct.name if spec.struct is not None else "struct")
+        for d in decl.declarators:
+            entry = Decl(type_name or "struct", d.loc or decl.loc)
+            if "uniform" in quals:
+                uniforms[d.name] = entry
+            elif "in" in quals or "varying" in quals:
+                inputs[d.name] = entry
+    return uniforms, inputs
+
+
+def prepare(shader, defines: Optional[Mapping[str, str]] = None) -> PreparedShader:
+    """A :class:`PreparedShader` from a front-end ``Shader``: rewritten to ``#version 330 core``
+    (``rrcache.glsl.legacy.to_core``) and printed with a line map.
+
+    ``defines`` are recorded (the shader must already have been loaded with them).
+
+    >>> from rrcache.glsl.frontend import parse_shader          # doctest: +SKIP
+    >>> prepare(parse_shader(open("marble.frag").read(), "marble.frag")).source[:17]  # doctest: +SKIP
+    '#version 330 core'
+    """
+    from rrcache.glsl.legacy import to_core
+    from rrcache.glsl.printer import print_with_map
+
+    core = to_core(shader.unit)
+    text, line_map = print_with_map(core)
+    uniforms, inputs = declarations(core)
+    # the front-end's table knows the original declaration places even where the rewrite moved them
+    for table in (getattr(shader, "uniforms", None), getattr(shader, "samplers", None)):
+        if isinstance(table, Mapping):
+            for name, entry in table.items():
+                loc = entry[1] if isinstance(entry, tuple) and len(entry) > 1 else None
+                if name in uniforms and loc is not None:
+                    uniforms[name] = Decl(uniforms[name].type, loc)
+    used_inputs = getattr(shader, "inputs", None)
+    if isinstance(used_inputs, Mapping):
+        # an input the harness does not know about matters only when the shader reads it
+        inputs = {name: d for name, d in inputs.items() if name in VARYINGS or name in used_inputs}
+    return PreparedShader(
+        source=text,
+        path=str(shader.path) if getattr(shader, "path", None) else "<string>",
+        hash=shader.hash,
+        line_map=list(line_map),
+        uniforms=uniforms,
+        inputs=inputs,
+        defines=dict(defines or {}),
+    )
+
+
+def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping[str, str]] = None,
+                 include_dirs=()) -> PreparedShader:
+    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes and
+    prepare it.
+
+    ``session_or_attributes`` is a session (the union of its meshes' attributes counts) or an
+    iterable of attribute names (``normal texcoord color tangent``). ``extra_defines`` (e.g. from
+    ``-D`` on the command line) are added and win over the mesh defines.
+
+    >>> prepared = prepare_file("marble.frag", {"normal", "texcoord"})   # doctest: +SKIP
+    >>> prepared.defines                                                 # doctest: +SKIP
+    {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
+    """
+    from rrcache.glsl.frontend import load_shader
+
+    if hasattr(session_or_attributes, "objects"):
+        attrs = session_attributes(session_or_attributes)
+    else:
+        attrs = frozenset(session_or_attributes)
+    defines = mesh_defines(attrs)
+    defines.update(extra_defines or {})
+    shader = load_shader(path, defines=defines, include_dirs=include_dirs)
+    return prepare(shader, defines)

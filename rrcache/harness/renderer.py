@@ -1,0 +1,317 @@
+"""Replaying a session through a fragment shader.
+
+:class:`Renderer` compiles the shader with the generated vertex shader, checks that the session
+supplies every uniform and sampler the program uses, uploads meshes and textures once, and then
+renders frames into an RGBA32F colour target plus a depth texture: depth test on, back faces
+drawn, cleared to the session background. Per frame it returns a :class:`FrameResult`: the image
+(H×W×4 float32, row 0 = top), the covered pixels (where geometry was drawn: depth written), the
+samples that passed the depth test (an occlusion query: shaded fragments, overdraw included) and
+the wall time of the draws (``time.perf_counter()`` around clear, draws and ``ctx.finish()``,
+after one untimed warm-up draw of the program, since llvmpipe compiles on the first draw).
+
+>>> from rrcache.session import load_session                      # doctest: +SKIP
+>>> session = load_session("scenes/marble/session.json")          # doctest: +SKIP
+>>> result = render("scenes/marble/marble.frag", session, frames=3)  # doctest: +SKIP
+>>> result.frames[0].image.shape, result.ms_per_frame > 0          # doctest: +SKIP
+((480, 640, 4), True)
+"""
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Optional
+
+import moderngl
+import numpy as np
+
+from rrcache.errors import SessionError, UnsupportedShaderError
+from rrcache.gl.context import get_context
+from rrcache.gl.program import build_program
+from rrcache.gl.resources import GLScope
+from rrcache.gl.textures import texture_from_asset
+from rrcache.gl.uniforms import write_uniform
+from rrcache.harness.bindings import BUILTINS, lookup, plan_bindings
+from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
+from rrcache.harness.vertex import ATTRIBUTES, vertex_source
+
+# value for a vertex attribute the mesh does not have
+_DEFAULTS = {"normal": (0.0, 0.0, 1.0), "texcoord": (0.0, 0.0), "color": (1.0, 1.0, 1.0, 1.0),
+             "tangent": (1.0, 0.0, 0.0, 1.0)}
+_FIELDS = {"position": "positions", "normal": "normals", "texcoord": "texcoords", "color": "colors",
+           "tangent": "tangents"}
+
+
+@dataclass
+class FrameResult:
+    """One rendered frame: ``image`` H×W×4 float32 (row 0 = top), ``mask`` H×W bool (covered
+    pixels), ``covered_pixels`` = ``mask.sum()``, ``samples_passed`` (fragments that passed the
+    depth test, overdraw counted), ``ms`` wall time of the draws."""
+
+    index: int
+    image: np.ndarray
+    covered_pixels: int
+    ms: float
+    mask: np.ndarray
+    samples_passed: int = 0
+
+
+@dataclass
+class RenderResult:
+    """Every rendered frame, the notes on the session (unused uniforms...), the median ms per frame
+    and the resolution (w, h)."""
+
+    frames: list[FrameResult]
+    notes: list[str] = field(default_factory=list)
+    ms_per_frame: float = float("nan")
+    resolution: tuple[int, int] = (0, 0)
+
+
+def parse_resolution(text: str) -> tuple[int, int]:
+    """``"640x480"`` → ``(640, 480)``; raises ``ValueError`` on anything else.
+
+    >>> parse_resolution("64x48")
+    (64, 48)
+    """
+    parts = text.lower().replace("×", "x").split("x")
+    if len(parts) != 2 or not all(p.strip().isdigit() for p in parts):
+        raise ValueError(f"expected WIDTHxHEIGHT such as 640x480, got {text!r}")
+    w, h = (int(p) for p in parts)
+    if w < 1 or h < 1:
+        raise ValueError(f"resolution must be positive, got {text!r}")
+    return w, h
+
+
+def _normal_matrix(model: np.ndarray) -> np.ndarray:
+    m3 = np.asarray(model, dtype=np.float64)[:3, :3]
+    try:
+        return np.linalg.inv(m3).T
+    except np.linalg.LinAlgError:  # a zero scale: no meaningful normals, keep the rotation part
+        return m3
+
+
+class Renderer:
+    """Renders frames of ``session`` through ``prepared`` at ``resolution`` (default: the session's).
+
+    Holds GL objects until :meth:`release` (or the end of a ``with`` block). ``notes`` lists what
+    the session supplies that the shader does not use.
+
+    >>> with Renderer(prepared, session) as r:                # doctest: +SKIP
+    ...     first = r.render_frame(0)
+    """
+
+    def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
+                 cull_back_faces: bool = False, ctx: Optional[moderngl.Context] = None):
+        self.ctx = ctx or get_context()
+        self.prepared = prepared
+        self.session = session
+        self.size = tuple(int(v) for v in (resolution or session.resolution))
+        self.cull_back_faces = cull_back_faces
+        self._warm = False
+        self._scope = GLScope()
+        try:
+            self._setup()
+        except BaseException:
+            self._scope.release()
+            raise
+
+    # ------------------------------------------------------------------ setup
+    def _setup(self) -> None:
+        ctx, prepared = self.ctx, self.prepared
+        inputs = {name: d.type for name, d in prepared.inputs.items()}
+        locs = {name: d.loc for name, d in prepared.inputs.items()}
+        self.vertex_source = vertex_source(inputs, locs)
+        self.program = self._scope.own(build_program(
+            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path))
+        self.plan = plan_bindings(self.program, prepared, self.session)
+        self.notes = list(self.plan.notes)
+        self._textures = []
+        for unit, (name, uniform, _kind) in enumerate(self.plan.samplers):
+            tex = self._scope.own(texture_from_asset(self.ctx, self.session.textures[name]))
+            uniform.value = unit
+            self._textures.append((unit, tex))
+        self._vaos = [self._object_vao(obj) for obj in self.session.objects]
+        w, h = self.size
+        self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
+        self._depth = self._scope.own(ctx.depth_texture((w, h)))
+        self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
+        # moderngl's Query has no release(); it goes with the Python object
+        self._query = ctx.query(samples=True)
+
+    def _object_vao(self, obj):
+        mesh = obj.mesh
+        n = int(np.asarray(mesh.positions).shape[0])
+        content = []
+        for attr, (glsl_type, _define) in ATTRIBUTES.items():
+            name = f"a_{attr}"
+            if name not in self.program or not isinstance(self.program[name], moderngl.Attribute):
+                continue
+            data = getattr(mesh, _FIELDS[attr], None)
+            size = int(glsl_type[-1])
+            if data is None:
+                data = np.tile(np.asarray(_DEFAULTS[attr], np.float32), (n, 1))
+            data = np.ascontiguousarray(np.asarray(data, np.float32).reshape(n, size))
+            vbo = self._scope.own(self.ctx.buffer(data.tobytes()))
+            content.append((vbo, f"{size}f", name))
+        indices = np.ascontiguousarray(np.asarray(mesh.indices, np.uint32).reshape(-1))
+        ibo = self._scope.own(self.ctx.buffer(indices.tobytes()))
+        return obj, self._scope.own(self.ctx.vertex_array(self.program, content, ibo, index_element_size=4))
+
+    # ------------------------------------------------------------------ per frame
+    def _check_frame(self, index: int) -> int:
+        index = int(index)
+        if not 0 <= index < self.session.frames:
+            raise SessionError(f"frame {index} is outside the session's {self.session.frames} frames (0..{self.session.frames - 1})",
+                               str(self.session.path), "frames")
+        return index
+
+    def _set_builtin(self, name: str, value) -> None:
+        uniform = self.plan.builtins.get(name)
+        if uniform is None:
+            return
+        try:
+            write_uniform(uniform, value)
+        except ValueError:
+            decl = self.prepared.declaration(name)
+            raise UnsupportedShaderError(
+                f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
+                decl.loc if decl is not None else None,
+                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
+
+    def _frame_uniforms(self, index: int) -> list[tuple[object, np.ndarray, np.ndarray]]:
+        session = self.session
+        w, h = self.size
+        prev = max(index - 1, 0)
+        cam, cam_prev = session.camera_at(index), session.camera_at(prev)
+        view, proj = cam.view, cam.projection(w / h)
+        view_proj = proj @ view
+        prev_view_proj = cam_prev.projection(w / h) @ cam_prev.view
+        light = session.light_at(index)
+        self._set_builtin("u_camera", cam.eye)
+        self._set_builtin("u_light", light.position)
+        self._set_builtin("u_lightColor", light.color)
+        self._set_builtin("u_resolution", (float(w), float(h)))
+        self._set_builtin("u_time", index / session.fps)
+        self._set_builtin("u_frame", index)
+        self._set_builtin("u_viewMatrix", view)
+        self._set_builtin("u_projectionMatrix", proj)
+        values = session.uniform_values(index)
+        for name, uniform in self.plan.session:
+            write_uniform(uniform, lookup(values, name))
+        for unit, tex in self._textures:
+            tex.use(location=unit)
+        per_object = []
+        for obj, vao in self._vaos:
+            model = obj.model_matrix(index)
+            per_object.append((vao, model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev)))
+        return per_object
+
+    def _draw(self, index: int) -> tuple[float, int]:
+        ctx = self.ctx
+        per_object = self._frame_uniforms(index)
+        ctx.enable(moderngl.DEPTH_TEST)
+        if self.cull_back_faces:
+            ctx.enable(moderngl.CULL_FACE)
+            ctx.cull_face = "back"
+        else:
+            ctx.disable(moderngl.CULL_FACE)
+        ctx.depth_func = "<"
+        self.fbo.use()
+        self.fbo.viewport = (0, 0, *self.size)
+        background = tuple(getattr(self.session, "background", None) or (0.0, 0.0, 0.0, 0.0))
+        background = (background + (1.0,))[:4] if len(background) == 3 else background
+        ctx.finish()
+        start = time.perf_counter()
+        self.fbo.clear(*background, depth=1.0)
+        with self._query:
+            for vao, model, mvp, prev_mvp in per_object:
+                self._set_builtin("u_modelMatrix", model)
+                self._set_builtin("u_modelViewProjectionMatrix", mvp)
+                self._set_builtin("u_normalMatrix", _normal_matrix(model))
+                self._set_builtin("u_prevModelViewProjectionMatrix", prev_mvp)
+                vao.render(moderngl.TRIANGLES)
+        ctx.finish()
+        ms = (time.perf_counter() - start) * 1000.0
+        return ms, int(self._query.samples)
+
+    def render_frame(self, index: int) -> FrameResult:
+        """Render frame ``index`` (an int in ``0..session.frames-1``) and read it back.
+
+        The first call draws once untimed (llvmpipe compiles the shader on its first draw).
+        """
+        index = self._check_frame(index)
+        if not self._warm:
+            self._draw(index)
+            self._warm = True
+        ms, samples = self._draw(index)
+        w, h = self.size
+        image = np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4)[::-1].copy()
+        depth = np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w)[::-1]
+        mask = depth < 1.0
+        return FrameResult(index, image, int(mask.sum()), ms, mask, samples)
+
+    def frames(self, indices: Iterable[int]):
+        """Yield a :class:`FrameResult` per frame index, in order."""
+        for index in indices:
+            yield self.render_frame(index)
+
+    def release(self) -> None:
+        """Release every GL object of this renderer (safe to call twice)."""
+        self._scope.release()
+
+    def __enter__(self) -> "Renderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+def frame_indices(session, frames=None) -> list[int]:
+    """``None`` → every frame; an int ``n`` → the first ``n`` (at most all); an iterable → as given.
+
+    >>> from types import SimpleNamespace
+    >>> frame_indices(SimpleNamespace(frames=5), 3)
+    [0, 1, 2]
+    """
+    if frames is None:
+        return list(range(session.frames))
+    if isinstance(frames, (int, np.integer)):
+        if frames < 1:
+            raise SessionError(f"asked for {frames} frames; at least 1 is needed", str(getattr(session, "path", "")), "frames")
+        return list(range(min(int(frames), session.frames)))
+    return [int(f) for f in frames]
+
+
+def as_prepared(shader, session, defines=None) -> PreparedShader:
+    """A :class:`PreparedShader` from a prepared shader, a front-end ``Shader`` or a shader path
+    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``)."""
+    if isinstance(shader, PreparedShader):
+        return shader
+    if hasattr(shader, "unit"):
+        return prepare(shader, defines)
+    return prepare_file(shader, session, defines)
+
+
+def render(shader, session, frames=None, resolution=None, defines=None,
+           progress: Optional[Callable[[FrameResult], None]] = None) -> RenderResult:
+    """Render ``frames`` of ``session`` (None: all, an int: the first n, or a list of indices).
+
+    ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
+    called with each :class:`FrameResult` as it is done.
+
+    >>> result = render("marble.frag", load_session("session.json"), frames=2)   # doctest: +SKIP
+    >>> [f.index for f in result.frames]                                          # doctest: +SKIP
+    [0, 1]
+    """
+    prepared = as_prepared(shader, session, defines)
+    indices = frame_indices(session, frames)
+    results = []
+    with Renderer(prepared, session, resolution) as renderer:
+        for result in renderer.frames(indices):
+            results.append(result)
+            if progress is not None:
+                progress(result)
+        notes = renderer.notes
+        size = renderer.size
+    ms = statistics.median(r.ms for r in results) if results else float("nan")
+    return RenderResult(results, notes, ms, size)

@@ -1,0 +1,144 @@
+"""The generated vertex shader and the mesh-attribute defines.
+
+The harness draws every mesh with a vertex shader written here (``#version 330 core``) that
+outputs the glslViewer varyings a fragment shader may read (DESIGN.md §4), in world space:
+
+=====================  ======  =========================================================
+``v_position``         vec4    world position (``u_modelMatrix * position``)
+``v_normal``           vec3    world normal (``normalize(u_normalMatrix * normal)``)
+``v_texcoord``         vec2    texture coordinates (0 when the mesh has none)
+``v_color``            vec4    vertex colour (opaque white when the mesh has none)
+``v_tangent``          vec4    world tangent, w = handedness (0 when the mesh has none)
+``v_objectPosition``   vec3    object-space position (solid textures on moving objects)
+``rr_prevClip``        vec4    clip position at the previous frame (reprojection cache)
+=====================  ======  =========================================================
+
+Only the varyings the fragment shader declares are written, converted to the declared size
+(``in vec3 v_position`` gets ``.xyz``). Vertex attributes are ``a_position`` (vec3), ``a_normal``
+(vec3), ``a_texcoord`` (vec2), ``a_color`` (vec4) and ``a_tangent`` (vec4).
+
+>>> src = vertex_source({"v_normal": "vec3"})
+>>> "out vec3 v_normal;" in src and "v_texcoord" not in src
+True
+>>> mesh_defines({"texcoord", "normal"})
+{'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
+"""
+from __future__ import annotations
+
+from typing import Iterable, Mapping, Optional
+
+from rrcache.errors import SourceLoc, UnsupportedShaderError
+
+# attribute -> (GLSL type, define set when the mesh has it)
+ATTRIBUTES = {
+    "position": ("vec3", None),
+    "normal": ("vec3", "MODEL_VERTEX_NORMAL"),
+    "texcoord": ("vec2", "MODEL_VERTEX_TEXCOORD"),
+    "color": ("vec4", "MODEL_VERTEX_COLOR"),
+    "tangent": ("vec4", "MODEL_VERTEX_TANGENT"),
+}
+
+# varying -> (natural size, value expression, attributes it reads, padding for a larger declaration)
+VARYINGS = {
+    "v_position": (4, "rr_world", ("position",), "1.0"),
+    "v_normal": (3, "normalize(u_normalMatrix * a_normal)", ("normal",), "0.0"),
+    "v_texcoord": (2, "a_texcoord", ("texcoord",), "0.0"),
+    "v_color": (4, "a_color", ("color",), "1.0"),
+    "v_tangent": (4, "vec4(normalize(mat3(u_modelMatrix) * a_tangent.xyz), a_tangent.w)", ("tangent",), "0.0"),
+    "v_objectPosition": (3, "a_position", ("position",), "1.0"),
+    "rr_prevClip": (4, "u_prevModelViewProjectionMatrix * vec4(a_position, 1.0)", ("position",), "1.0"),
+}
+
+# uniforms the vertex shader reads (set per object by the renderer)
+VERTEX_UNIFORMS = ("u_modelMatrix", "u_modelViewProjectionMatrix", "u_normalMatrix", "u_prevModelViewProjectionMatrix")
+
+_FLOAT_TYPES = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
+
+
+def mesh_attributes(mesh) -> frozenset[str]:
+    """The optional attributes a ``MeshData`` carries (``normal texcoord color tangent``).
+
+    >>> from types import SimpleNamespace
+    >>> sorted(mesh_attributes(SimpleNamespace(normals=[0], texcoords=None, colors=[1], tangents=None)))
+    ['color', 'normal']
+    """
+    present = set()
+    for attr, field in (("normal", "normals"), ("texcoord", "texcoords"), ("color", "colors"), ("tangent", "tangents")):
+        if getattr(mesh, field, None) is not None:
+            present.add(attr)
+    return frozenset(present)
+
+
+def session_attributes(session) -> frozenset[str]:
+    """The union of the optional attributes of every object's mesh in a session."""
+    found: set[str] = set()
+    for obj in session.objects:
+        found |= mesh_attributes(obj.mesh)
+    return frozenset(found)
+
+
+def mesh_defines(attributes: Iterable[str]) -> dict[str, str]:
+    """The ``MODEL_VERTEX_*`` defines (value ``"1"``) for a set of mesh attributes, sorted by name.
+
+    >>> mesh_defines(["color"])
+    {'MODEL_VERTEX_COLOR': '1'}
+    """
+    names = []
+    for attr in attributes:
+        if attr not in ATTRIBUTES:
+            raise ValueError(f"unknown mesh attribute {attr!r}; expected one of {', '.join(ATTRIBUTES)}")
+        define = ATTRIBUTES[attr][1]
+        if define:
+            names.append(define)
+    return {name: "1" for name in sorted(names)}
+
+
+def _convert(expr: str, size: int, pad: str, declared: int) -> str:
+    if declared == size:
+        return expr
+    if declared < size:
+        return f"({expr}).{'xyzw'[:declared]}"
+    fill = ", ".join(["0.0"] * (declared - size - 1) + [pad])
+    return f"vec{declared}({expr}, {fill})"
+
+
+def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None) -> str:
+    """The vertex shader text writing the fragment inputs ``inputs`` (name → declared GLSL type).
+
+    Raises :class:`UnsupportedShaderError` (at the declaration when ``locs`` knows it) for an input
+    the harness cannot supply or a type it cannot convert to.
+
+    >>> print(vertex_source({"v_texcoord": "vec2"}).splitlines()[0])
+    #version 330 core
+    """
+    locs = locs or {}
+    attrs = {"position"}
+    outs = []
+    for name, declared in sorted(inputs.items()):
+        if name not in VARYINGS:
+            raise UnsupportedShaderError(
+                f"fragment input `{name}` is not a varying the harness supplies",
+                locs.get(name),
+                hint=f"use one of {', '.join(VARYINGS)} (DESIGN.md §4)",
+            )
+        if declared not in _FLOAT_TYPES:
+            raise UnsupportedShaderError(
+                f"fragment input `{name}` is declared `{declared}`; the harness supplies it as a float vector",
+                locs.get(name),
+                hint=f"declare it as vec{VARYINGS[name][0]}",
+            )
+        size, expr, reads, pad = VARYINGS[name]
+        attrs.update(reads)
+        outs.append((name, declared, _convert(expr, size, pad, _FLOAT_TYPES[declared])))
+    lines = ["#version 330 core"]
+    lines += [f"in {ATTRIBUTES[a][0]} a_{a};" for a in ATTRIBUTES if a in attrs]
+    lines += ["uniform mat4 u_modelMatrix;", "uniform mat4 u_modelViewProjectionMatrix;"]
+    if "normal" in attrs:
+        lines.append("uniform mat3 u_normalMatrix;")
+    if "rr_prevClip" in inputs:
+        lines.append("uniform mat4 u_prevModelViewProjectionMatrix;")
+    lines += [f"out {declared} {name};" for name, declared, _ in outs]
+    lines += ["void main() {", "    vec4 rr_world = u_modelMatrix * vec4(a_position, 1.0);"]
+    lines += [f"    {name} = {value};" for name, _, value in outs]
+    lines += ["    gl_Position = u_modelViewProjectionMatrix * vec4(a_position, 1.0);", "}", ""]
+    return "\n".join(lines)

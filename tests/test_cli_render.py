@@ -1,0 +1,115 @@
+"""``rrcache render`` end to end: real front-end, real session loader, tiny renders."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from rrcache.cli import main
+from rrcache.cli.render import parse_defines
+from rrcache.harness.prepare import prepare_file
+from rrcache.harness.renderer import render
+from rrcache.session import load_session
+
+SESSION = {
+    "rrcache_session": 1, "resolution": [64, 48], "frames": 3, "fps": 30,
+    "camera": {"fov": 45, "near": 0.1, "far": 100,
+               "keyframes": [{"frame": 0, "eye": [0, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0]},
+                             {"frame": 2, "eye": [1, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0]}]},
+    "light": {"color": [1, 1, 1], "keyframes": [{"frame": 0, "position": [2, 2, 2]}]},
+    "objects": [{"procedural": {"type": "icosphere", "subdivisions": 2},
+                 "keyframes": [{"frame": 0, "translate": [0, 0, 0]}]}],
+    "uniforms": {"u_gain": 0.5, "u_unused": 3},
+}
+
+SHADER = """#ifdef GL_ES
+precision mediump float;
+#endif
+uniform vec3 u_light;
+uniform float u_gain;
+varying vec4 v_position;
+varying vec3 v_normal;
+void main() {
+    vec3 l = normalize(u_light - v_position.xyz);
+    float d = max(dot(normalize(v_normal), l), 0.0) * u_gain;
+#ifdef RED
+    gl_FragColor = vec4(d, 0.0, 0.0, 1.0);
+#else
+    gl_FragColor = vec4(vec3(d), 1.0);
+#endif
+}
+"""
+
+
+@pytest.fixture
+def files(tmp_path):
+    session = tmp_path / "session.json"
+    session.write_text(json.dumps(SESSION))
+    shader = tmp_path / "lit.frag"
+    shader.write_text(SHADER)
+    return shader, session
+
+
+def test_parse_defines():
+    assert parse_defines(["A=1", "B", "C="]) == {"A": "1", "B": "1", "C": ""}
+    import click
+    with pytest.raises(click.BadParameter):
+        parse_defines(["1X=2"])
+
+
+def test_json_summary(gl_ctx, files, capsys):
+    shader, session = files
+    main([ "render", str(shader), str(session), "--json", "--frames", "2"])
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    assert set(summary) == {"frames", "resolution", "ms_per_frame", "covered_pixels"}
+    assert summary["frames"] == 2 and summary["resolution"] == [64, 48]
+    assert summary["ms_per_frame"] > 0
+    loaded = load_session(session)
+    direct = render(prepare_file(shader, loaded), loaded, frames=2)
+    assert summary["covered_pixels"] == [f.covered_pixels for f in direct.frames]
+    assert all(0 < c < 64 * 48 for c in summary["covered_pixels"])
+    assert "u_unused" in captured.err   # the note goes to stderr
+
+
+def test_out_writes_exr_and_png(gl_ctx, files, tmp_path, capsys):
+    import OpenImageIO as oiio
+
+    shader, session = files
+    out = tmp_path / "frames"
+    main(["render", str(shader), str(session), "--out", str(out), "--resolution", "32x24", "-D", "RED"])
+    assert "median" in capsys.readouterr().out
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [f"frame_{i:04d}.{ext}" for i in range(3) for ext in ("exr", "png")]
+    inp = oiio.ImageInput.open(str(out / "frame_0001.exr"))
+    exr = inp.read_image(oiio.FLOAT)
+    inp.close()
+    loaded = load_session(session)
+    expected = render(prepare_file(shader, loaded, {"RED": "1"}), loaded, frames=[1], resolution=(32, 24)).frames[0]
+    np.testing.assert_array_equal(exr, expected.image)
+    assert exr[..., 1].max() == 0.0 and exr[..., 0].max() > 0.1   # -D RED took effect
+    png = oiio.ImageInput.open(str(out / "frame_0001.png"))
+    assert (png.spec().width, png.spec().height, png.spec().format) == (32, 24, oiio.TypeDesc("uint8"))
+    png.close()
+
+
+def test_missing_uniform_is_a_one_line_error(gl_ctx, files, capsys):
+    shader, session = files
+    doc = dict(SESSION)
+    doc["uniforms"] = {}
+    session.write_text(json.dumps(doc))
+    with pytest.raises(SystemExit) as info:
+        main(["render", str(shader), str(session)])
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("rrcache: error: ") and len(err.splitlines()) == 1
+    assert f"{shader}:5:" in err and str(session) in err and '"u_gain"' in err
+
+
+def test_bad_resolution_is_a_usage_error(files, capsys):
+    shader, session = files
+    with pytest.raises(SystemExit) as info:
+        main(["render", str(shader), str(session), "--resolution", "big"])
+    assert info.value.code == 2
+    assert "WIDTHxHEIGHT" in capsys.readouterr().err
