@@ -1,8 +1,17 @@
 """rrcache: automated reverse-reprojection-cache optimisation of GLSL pixel shaders.
 
-The public API (see README.md). The CLI and the notebooks use nothing else.
+The public API; the CLI and the notebooks use nothing else.
+
+>>> import rrcache
+>>> shader = rrcache.load_shader("shaders/marble.glsl")          # doctest: +SKIP
+>>> session = rrcache.load_session("sessions/marble.json")       # doctest: +SKIP
+>>> result = rrcache.render(shader, session, frames=[0, 1])       # doctest: +SKIP
+
+Names are imported lazily so that ``import rrcache`` stays cheap.
 """
 from __future__ import annotations
+
+import importlib
 
 __version__ = "0.1.0"
 
@@ -18,3 +27,32 @@ from rrcache.errors import (  # noqa: F401
     SourceLoc,
     UnsupportedShaderError,
 )
+
+# public name -> module that defines it
+_LAZY = {
+    "load_shader": "rrcache.glsl.frontend",
+    "parse_shader": "rrcache.glsl.frontend",
+    "Shader": "rrcache.glsl.frontend",
+    "load_session": "rrcache.session",
+    "Session": "rrcache.session",
+    "render": "rrcache.harness",
+    "Renderer": "rrcache.harness",
+    "ReferenceCache": "rrcache.harness",
+    "mean_l2": "rrcache.harness",
+    "psnr": "rrcache.harness",
+    "CacheRuntime": "rrcache.runtime",
+    "get_context": "rrcache.gl",
+}
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'rrcache' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))

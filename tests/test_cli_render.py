@@ -113,3 +113,19 @@ def test_bad_resolution_is_a_usage_error(files, capsys):
         main(["render", str(shader), str(session), "--resolution", "big"])
     assert info.value.code == 2
     assert "WIDTHxHEIGHT" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("double_sided", [False, True])
+def test_back_faces_are_culled_unless_the_object_is_double_sided(tmp_path, double_sided):
+    """A plane seen from behind: culled (nothing covered) unless the session says double_sided."""
+    session = dict(SESSION, frames=1, uniforms={"u_gain": 0.5})
+    session["objects"] = [{"procedural": {"type": "plane", "size": [2, 2]}, "double_sided": double_sided,
+                           # the plane faces +Y; rotate it to face away from the camera at +Z
+                           "keyframes": [{"frame": 0, "rotate": [-90, 1, 0, 0]}]}]
+    path = tmp_path / "plane.json"
+    path.write_text(json.dumps(session))
+    shader = tmp_path / "lit.frag"
+    shader.write_text(SHADER)
+    result = render(str(shader), load_session(path), frames=1)
+    covered = result.frames[0].covered_pixels
+    assert (covered > 100) if double_sided else (covered == 0)

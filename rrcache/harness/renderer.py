@@ -93,7 +93,9 @@ def _normal_matrix(model: np.ndarray) -> np.ndarray:
 class Renderer:
     """Renders frames of ``session`` through ``prepared`` at ``resolution`` (default: the session's).
 
-    Holds GL objects until :meth:`release` (or the end of a ``with`` block). ``notes`` lists what
+    Back faces are culled for every object the session does not mark ``double_sided`` (pass
+    ``cull_back_faces`` to override). Holds GL objects until :meth:`release` (or the end of a
+    ``with`` block). ``notes`` lists what
     the session supplies that the shader does not use.
 
     >>> with Renderer(prepared, session) as r:                # doctest: +SKIP
@@ -101,7 +103,7 @@ class Renderer:
     """
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
-                 cull_back_faces: bool = False, ctx: Optional[moderngl.Context] = None):
+                 cull_back_faces: Optional[bool] = None, ctx: Optional[moderngl.Context] = None):
         self.ctx = ctx or get_context()
         self.prepared = prepared
         self.session = session
@@ -203,18 +205,15 @@ class Renderer:
         per_object = []
         for obj, vao in self._vaos:
             model = obj.model_matrix(index)
-            per_object.append((vao, model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev)))
+            cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
+            per_object.append((vao, model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev), cull))
         return per_object
 
     def _draw(self, index: int) -> tuple[float, int]:
         ctx = self.ctx
         per_object = self._frame_uniforms(index)
         ctx.enable(moderngl.DEPTH_TEST)
-        if self.cull_back_faces:
-            ctx.enable(moderngl.CULL_FACE)
-            ctx.cull_face = "back"
-        else:
-            ctx.disable(moderngl.CULL_FACE)
+        ctx.cull_face = "back"
         ctx.depth_func = "<"
         self.fbo.use()
         self.fbo.viewport = (0, 0, *self.size)
@@ -224,7 +223,11 @@ class Renderer:
         start = time.perf_counter()
         self.fbo.clear(*background, depth=1.0)
         with self._query:
-            for vao, model, mvp, prev_mvp in per_object:
+            for vao, model, mvp, prev_mvp, cull in per_object:
+                if cull:
+                    ctx.enable(moderngl.CULL_FACE)
+                else:
+                    ctx.disable(moderngl.CULL_FACE)
                 self._set_builtin("u_modelMatrix", model)
                 self._set_builtin("u_modelViewProjectionMatrix", mvp)
                 self._set_builtin("u_normalMatrix", _normal_matrix(model))

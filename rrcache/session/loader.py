@@ -157,7 +157,8 @@ def _objects(doc: dict, file: str, assets: _Assets) -> list[SceneObject]:
             while name in used:
                 name, n = f"{default_name}_{n}", n + 1
         used.add(name)
-        objects.append(SceneObject(name, mesh, model_function(spec.get("keyframes", []), file, i), source))
+        objects.append(SceneObject(name, mesh, model_function(spec.get("keyframes", []), file, i), source,
+                                   bool(spec.get("double_sided", False))))
     return objects
 
 

@@ -102,6 +102,7 @@ class SceneObject:
     mesh: MeshData
     _model: Callable[[int], np.ndarray] = field(repr=False)
     source: str = ""  # the resolved mesh file, or "procedural:<type>"
+    double_sided: bool = False  # draw back faces (open meshes); closed meshes cull them
 
     def model_matrix(self, frame: int) -> np.ndarray:
         """The 4×4 object-to-world matrix at ``frame`` (an int)."""
