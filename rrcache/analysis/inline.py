@@ -1,0 +1,558 @@
+"""Pass: inline every user-function call site.
+
+After this pass each call's subexpressions are distinct AST nodes (the paper's per-octave nodes
+inside ``noise()`` exist only this way). The result is a valid GLSL program equivalent to the
+input, built as follows.
+
+- Function bodies are processed callee-first, so a body that is inlined no longer contains
+  inlinable calls itself.
+- A call ``f(a, b)`` inside a statement becomes, *before* that statement::
+
+      float _rr_f_7;                       // the result (non-void functions)
+      {
+          vec3 _rr_p_8 = a;                // ``in``/``inout`` parameters copy their argument
+          float _rr_q_9;                   // ``out`` parameters start undefined
+          ...body, every local renamed _rr_<name>_<n>, ``return e`` -> ``_rr_f_7 = e``...
+          b = _rr_q_9;                     // ``out``/``inout`` write-backs, in parameter order
+      }
+
+  and the call itself becomes ``_rr_f_7``. Calls are hoisted in evaluation order (arguments
+  first, left to right). When a hoisted call has side effects (it writes a global or an
+  ``out`` parameter, or calls a side-effecting built-in) or an operand evaluated before it has
+  side effects (an assignment, ``++``), those earlier operands are hoisted into temporaries too,
+  so the order of effects is kept. Index expressions of ``out`` arguments are evaluated once.
+- Conditionally evaluated operands stay conditional: a call on the right of ``&&``/``||`` or in
+  a branch of ``?:`` turns that operator into an ``if``.
+- Calls in a ``while``/``for`` condition move into the loop (``for (;;) { ...; if (!c) break;
+  ... }``); in a ``for`` step or ``do``-``while`` condition they move to the end of the body
+  unless the body has a ``continue``, in which case that call is not inlined.
+- Early returns: ``return`` inside ``if``/``else`` nests becomes an assignment to the result plus
+  ``_rr_live_<n> = false``, and the statements after it run under ``if (_rr_live_<n>)`` (the
+  cacheable-node analysis treats such guards like code after a ``return``: not dynamic).
+  A function with a ``return`` inside a loop or ``switch`` is *not inlined*: it stays a function,
+  and the cacheable-node analysis marks the nodes in its body ``dynamic``.
+- Functions no longer called are removed. Names starting with ``_rr`` are reserved.
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> s = parse_shader("float sq(float x) { return x * x; }\\n"
+...                  "void main() { gl_FragColor = vec4(sq(gl_FragCoord.x)); }")
+>>> out = inline_calls(s)
+>>> [d.name for d in out.unit.decls]
+['main']
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Optional
+
+from rrcache.glsl import ast as A
+from rrcache.glsl.semantic import check
+
+from rrcache.analysis._tree import (
+    NameAllocator, assign, check_reserved_names, children, clone, declare, declare_typed,
+    is_literal, out_qualifiers, param_qualifier, rewrite_scoped, walk, with_chain,
+)
+
+__all__ = ["inline_calls", "inline_unit"]
+
+_RET = "$ret"      # placeholders in a prepared body; renamed at each call site
+_LIVE = "$live"
+
+
+def inline_calls(shader):
+    """Return a copy of ``shader`` with every user-function call site inlined (see the module
+    docstring for how). The input is not modified; the result is type-checked again.
+
+    >>> from rrcache.glsl.frontend import parse_shader
+    >>> s = parse_shader("float f(float x) { return x + 1.0; }\\n"
+    ...                  "void main() { gl_FragColor = vec4(f(gl_FragCoord.x)); }")
+    >>> from rrcache.glsl.printer import print_glsl
+    >>> "f(" in print_glsl(inline_calls(s).unit)
+    False
+    """
+    unit = inline_unit(shader.unit)
+    info = check(unit, shader.path or "<string>")
+    return dataclasses.replace(shader, unit=unit, info=info)
+
+
+def inline_unit(unit: A.TranslationUnit) -> A.TranslationUnit:
+    """The inlining pass on a checked translation unit; returns a new, *unchecked* unit."""
+    check_reserved_names(unit)
+    return _Inliner(unit).run()
+
+
+class _Template:
+    """A function body prepared for inlining: returns converted to placeholder assignments."""
+
+    def __init__(self, decl: A.FunctionDecl, body: A.Compound, needs_flag: bool):
+        self.decl = decl
+        self.body = body
+        self.needs_flag = needs_flag
+
+
+def _returns_in_loops(s: A.Node, inside: bool = False) -> bool:
+    if isinstance(s, A.Return):
+        return inside
+    if isinstance(s, A.Expr):
+        return False
+    loopish = isinstance(s, (A.For, A.While, A.DoWhile, A.Switch))
+    return any(_returns_in_loops(c, inside or loopish) for c in _stmt_children(s))
+
+
+def _stmt_children(s: A.Node):
+    if isinstance(s, A.Compound):
+        return s.stmts
+    if isinstance(s, A.If):
+        return [x for x in (s.then, s.else_) if x is not None]
+    if isinstance(s, (A.For, A.While, A.DoWhile)):
+        return [s.body]
+    if isinstance(s, A.Switch):
+        return [s.body]
+    return []
+
+
+def _has_return(s: A.Node) -> bool:
+    if isinstance(s, A.Return):
+        return True
+    return any(_has_return(c) for c in _stmt_children(s))
+
+
+def _has_continue(s: A.Node) -> bool:
+    """A ``continue`` that belongs to the loop whose body is ``s``."""
+    if isinstance(s, A.Continue):
+        return True
+    if isinstance(s, (A.For, A.While, A.DoWhile)):
+        return False
+    return any(_has_continue(c) for c in _stmt_children(s))
+
+
+def _convert_returns(stmts: list, is_void: bool, needs_flag: bool) -> list:
+    out: list = []
+    for i, s in enumerate(stmts):
+        if not _has_return(s):
+            out.append(s)
+            continue
+        if isinstance(s, A.Return):
+            if s.expr is not None and not is_void:
+                out.append(assign(_RET, s.expr, s.loc))
+            if needs_flag:
+                out.append(assign(_LIVE, A.BoolLit(False, loc=s.loc), s.loc))
+            return out          # the rest of this block is dead code
+        out.append(_convert_stmt(s, is_void, needs_flag))
+        rest = stmts[i + 1:]
+        if rest:
+            out.append(A.If(A.Ident(_LIVE, loc=s.loc), A.Compound(
+                _convert_returns(rest, is_void, needs_flag), loc=s.loc), loc=s.loc))
+        return out
+    return out
+
+
+def _convert_stmt(s, is_void, needs_flag):
+    if isinstance(s, A.Compound):
+        return A.Compound(_convert_returns(s.stmts, is_void, needs_flag), loc=s.loc)
+    if isinstance(s, A.If):
+        def branch(b):
+            if b is None:
+                return None
+            stmts = b.stmts if isinstance(b, A.Compound) else [b]
+            return A.Compound(_convert_returns(stmts, is_void, needs_flag), loc=b.loc)
+        return A.If(s.cond, branch(s.then), branch(s.else_), loc=s.loc)
+    if isinstance(s, A.Return):
+        return A.Compound(_convert_returns([s], is_void, needs_flag), loc=s.loc)
+    raise AssertionError("returns inside loops are not inlined")
+
+
+def _wrap(stmts: list, loc) -> A.Stmt:
+    return stmts[0] if len(stmts) == 1 else A.Compound(stmts, loc=loc)
+
+
+class _Inliner:
+    def __init__(self, unit: A.TranslationUnit):
+        self.unit = clone(unit)
+        self.names = NameAllocator(unit)
+        # original FunctionDecl (call targets) -> its copy in self.unit
+        self.copy_of = {id(o): c for o, c in zip(unit.decls, self.unit.decls)
+                        if isinstance(o, A.FunctionDecl)}
+        self.defs = [d for d in self.unit.decls if isinstance(d, A.FunctionDecl) and d.body]
+        self.templates: dict[int, _Template] = {}
+        self.inlinable: dict[int, bool] = {}
+        self.effectful: dict[int, bool] = {}
+        self._calls_memo: dict[int, tuple] = {}
+        self._effects_memo: dict[int, tuple] = {}
+
+    # ------------------------------------------------------------------ driver
+    def run(self) -> A.TranslationUnit:
+        for d in self.defs:
+            self.inlinable[id(d)] = d.name != "main" and not _returns_in_loops(d.body)
+        done: set[int] = set()
+        for d in self.defs:
+            self._process(d, done)
+        return self._prune()
+
+    def _target(self, call: A.Call) -> Optional[A.FunctionDecl]:
+        if call.kind != "function" or not isinstance(call.target, A.FunctionDecl):
+            return None
+        return self.copy_of.get(id(call.target), call.target if call.target.body else None)
+
+    def _process(self, d: A.FunctionDecl, done: set) -> None:
+        if id(d) in done:
+            return
+        done.add(id(d))
+        for n in walk(d.body):
+            if isinstance(n, A.Call):
+                t = self._target(n)
+                if t is not None:
+                    self._process(t, done)
+        self.effectful[id(d)] = self._body_effectful(d)
+        d.body = A.Compound(self.block(d.body.stmts), loc=d.body.loc)
+        if self.inlinable[id(d)]:
+            stmts = d.body.stmts
+            last_only = all(not _has_return(s) for s in stmts[:-1]) and (
+                not stmts or isinstance(stmts[-1], A.Return) or not _has_return(stmts[-1]))
+            is_void = d.return_type.spec.name == "void"
+            body = clone(d.body)
+            body.stmts = _convert_returns(body.stmts, is_void, not last_only)
+            self.templates[id(d)] = _Template(d, body, not last_only)
+
+    def _body_effectful(self, d: A.FunctionDecl) -> bool:
+        if any(param_qualifier(p) != "in" for p in d.params):
+            return True
+        local = {p.name for p in d.params if p.name}
+        for n in walk(d.body):
+            if isinstance(n, A.Declarator):
+                local.add(n.name)
+            elif isinstance(n, A.Call):
+                t = self._target(n)
+                if t is not None and self.effectful.get(id(t), True):
+                    return True
+                if n.kind == "builtin" and getattr(n.target, "side_effects", False):
+                    return True
+            elif isinstance(n, (A.Assign, A.Unary)):
+                tgt = n.target if isinstance(n, A.Assign) else (
+                    n.operand if n.op in ("++", "--") else None)
+                while isinstance(tgt, (A.Field, A.Index)):
+                    tgt = tgt.obj
+                if isinstance(tgt, A.Ident):
+                    sym = tgt.symbol
+                    if sym is None or sym.kind not in ("local", "param"):
+                        return True
+        return False
+
+    def _prune(self) -> A.TranslationUnit:
+        """Drop functions (and prototypes) no longer called from main or a kept function."""
+        by_name: dict[str, list[A.FunctionDecl]] = {}
+        for d in self.defs:
+            by_name.setdefault(d.name, []).append(d)
+        keep: set[int] = set()
+        stack = [d for d in self.defs if d.name == "main"]
+        roots = [x for x in self.unit.decls if not isinstance(x, A.FunctionDecl)]
+        for r in roots:
+            for n in walk(r):
+                if isinstance(n, A.Call) and n.name in by_name:
+                    stack.extend(by_name[n.name])
+        while stack:
+            d = stack.pop()
+            if id(d) in keep:
+                continue
+            keep.add(id(d))
+            for n in walk(d.body):
+                if isinstance(n, A.Call) and n.name in by_name:
+                    stack.extend(by_name[n.name])
+        kept_names = {d.name for d in self.defs if id(d) in keep}
+        decls = []
+        for x in self.unit.decls:
+            if isinstance(x, A.FunctionDecl):
+                if x.body is not None and id(x) not in keep:
+                    continue
+                if x.body is None and x.name not in kept_names:
+                    continue
+            decls.append(x)
+        self.unit.decls = decls
+        return self.unit
+
+    # ------------------------------------------------------------------ predicates
+    def has_call(self, e) -> bool:
+        """Whether the expression contains a call that will be inlined."""
+        if e is None or not isinstance(e, A.Node):
+            return False
+        key = id(e)
+        got = self._calls_memo.get(key, (None, None))[1]
+        if got is None:
+            got = False
+            if isinstance(e, A.Call):
+                t = self._target(e)
+                got = t is not None and self.inlinable.get(id(t), False)
+            if not got:
+                got = any(self.has_call(c) for c in children(e))
+            self._calls_memo[key] = (e, got)
+        return got
+
+    def has_effects(self, e) -> bool:
+        """Whether evaluating the expression has side effects."""
+        if e is None:
+            return False
+        key = id(e)
+        got = self._effects_memo.get(key, (None, None))[1]
+        if got is None:
+            if isinstance(e, A.Assign) or (isinstance(e, A.Unary) and e.op in ("++", "--")):
+                got = True
+            elif isinstance(e, A.Call) and (
+                    (self._target(e) is not None and self.effectful.get(id(self._target(e)), True))
+                    or getattr(e.target, "side_effects", False)):
+                got = True
+            else:
+                got = any(self.has_effects(c) for c in children(e))
+            self._effects_memo[key] = (e, got)
+        return got
+
+    # ------------------------------------------------------------------ statements
+    def block(self, stmts: list) -> list:
+        out: list = []
+        for s in stmts:
+            out.extend(self.stmt(s))
+        return out
+
+    def stmt(self, s) -> list:
+        if isinstance(s, A.Compound):
+            return [A.Compound(self.block(s.stmts), loc=s.loc)]
+        if isinstance(s, A.DeclStmt):
+            return self.decl_stmt(s)
+        if isinstance(s, A.ExprStmt):
+            if not self.has_call(s.expr):
+                return [s]
+            pre: list = []
+            e = self.expr(s.expr, pre, value_used=False)
+            return pre + ([A.ExprStmt(e, loc=s.loc)] if e is not None else [])
+        if isinstance(s, A.If):
+            pre = []
+            cond = self.expr(s.cond, pre)
+            then = _wrap(self.stmt(s.then), s.then.loc)
+            else_ = _wrap(self.stmt(s.else_), s.else_.loc) if s.else_ is not None else None
+            return pre + [A.If(cond, then, else_, loc=s.loc)]
+        if isinstance(s, A.Switch):
+            pre = []
+            e = self.expr(s.expr, pre)
+            return pre + [A.Switch(e, A.Compound(self.block(s.body.stmts), loc=s.body.loc),
+                                   loc=s.loc)]
+        if isinstance(s, A.Return):
+            pre = []
+            e = self.expr(s.expr, pre) if s.expr is not None else None
+            return pre + [A.Return(e, loc=s.loc)]
+        if isinstance(s, A.For):
+            return self.for_stmt(s)
+        if isinstance(s, A.While):
+            body = _wrap(self.stmt(s.body), s.body.loc)
+            if isinstance(s.cond, A.Expr) and self.has_call(s.cond):
+                pre: list = []
+                cond = self.expr(s.cond, pre)
+                body = A.Compound(pre + [self._exit_unless(cond), body], loc=s.loc)
+                return [A.While(A.BoolLit(True, loc=s.loc), body, loc=s.loc)]
+            return [A.While(s.cond, body, loc=s.loc)]
+        if isinstance(s, A.DoWhile):
+            body = _wrap(self.stmt(s.body), s.body.loc)
+            if self.has_call(s.cond) and not _has_continue(s.body):
+                pre = []
+                cond = self.expr(s.cond, pre)
+                return [A.DoWhile(A.Compound([body] + pre, loc=s.loc), cond, loc=s.loc)]
+            return [A.DoWhile(body, s.cond, loc=s.loc)]
+        return [s]
+
+    def _exit_unless(self, cond: A.Expr) -> A.If:
+        return A.If(A.Unary("!", cond, loc=cond.loc), A.Break(loc=cond.loc), loc=cond.loc)
+
+    def decl_stmt(self, s: A.DeclStmt) -> list:
+        decl = s.decl
+        if not isinstance(decl, A.VariableDecl) or not any(
+                self.has_call(d.init) for d in decl.declarators):
+            return [s]
+        out: list = []
+        for i, d in enumerate(decl.declarators):
+            pre: list = []
+            if d.init is not None:
+                d.init = self.expr(d.init, pre)
+            full = decl.type
+            if i > 0 and full.spec.struct is not None and full.spec.struct.name:
+                full = A.FullType(full.qualifiers, A.TypeSpecifier(full.spec.struct.name),
+                                  loc=full.loc)
+            out += pre + [A.DeclStmt(A.VariableDecl(full, [d], loc=decl.loc), loc=s.loc)]
+        return out
+
+    def for_stmt(self, s: A.For) -> list:
+        pre_init: list = []
+        init = s.init
+        if init is not None:
+            lowered = self.stmt(init)
+            pre_init, init = lowered[:-1], lowered[-1]
+        body = _wrap(self.stmt(s.body), s.body.loc)
+        cond, step = s.cond, s.step
+        if isinstance(cond, A.Expr) and self.has_call(cond):
+            pre: list = []
+            c = self.expr(cond, pre)
+            body = A.Compound(pre + [self._exit_unless(c), body], loc=s.loc)
+            cond = None
+        if step is not None and self.has_call(step) and not _has_continue(s.body):
+            pre = []
+            e = self.expr(step, pre, value_used=False)
+            body = A.Compound([body] + pre + ([A.ExprStmt(e, loc=step.loc)] if e else []),
+                              loc=s.loc)
+            step = None
+        loop = A.For(init, cond, step, body, loc=s.loc)
+        if pre_init:
+            return [A.Compound(pre_init + [loop], loc=s.loc)]
+        return [loop]
+
+    # ------------------------------------------------------------------ expressions
+    def hoist(self, e: A.Expr, pre: list) -> A.Expr:
+        """Evaluate ``e`` now, into a fresh temporary."""
+        if is_literal(e) or e.type is None or getattr(e, "_rr_temp", False):
+            return e
+        name = self.names.fresh("t")
+        pre.append(declare_typed(name, e.type, e, e.loc))
+        ident = A.Ident(name, loc=e.loc, type=e.type)
+        ident._rr_temp = True
+        return ident
+
+    def expr(self, e, pre: list, value_used: bool = True):
+        if e is None or not self.has_call(e):
+            return e
+        if isinstance(e, A.Call):
+            t = self._target(e)
+            if t is not None and self.inlinable.get(id(t), False):
+                return self.inline(e, t, pre)
+            e.args = self.operands(e.args, pre, _lvalue_positions(e))
+            return e
+        if isinstance(e, A.Binary) and e.op in ("&&", "||"):
+            left = self.expr(e.left, pre)
+            if not self.has_call(e.right):
+                e.left = left
+                return e
+            name = self.names.fresh("cond")
+            pre.append(declare(name, A.FullType([], A.TypeSpecifier("bool")), left, loc=e.loc))
+            inner: list = []
+            right = self.expr(e.right, inner)
+            inner.append(assign(name, right, e.loc))
+            test = A.Ident(name, loc=e.loc)
+            if e.op == "||":
+                test = A.Unary("!", test, loc=e.loc)
+            pre.append(A.If(test, A.Compound(inner, loc=e.loc), loc=e.loc))
+            return A.Ident(name, loc=e.loc, type=e.type)
+        if isinstance(e, A.Ternary):
+            cond = self.expr(e.cond, pre)
+            if not (self.has_call(e.then) or self.has_call(e.else_)):
+                e.cond = cond
+                return e
+            name = self.names.fresh("sel")
+            pre.append(declare_typed(name, e.type, None, e.loc))
+            branches = []
+            for branch in (e.then, e.else_):
+                inner: list = []
+                v = self.expr(branch, inner)
+                inner.append(assign(name, v, e.loc))
+                branches.append(A.Compound(inner, loc=e.loc))
+            pre.append(A.If(cond, branches[0], branches[1], loc=e.loc))
+            return A.Ident(name, loc=e.loc, type=e.type)
+        if isinstance(e, A.Sequence):
+            for x in e.exprs[:-1]:
+                v = self.expr(x, pre, value_used=False)
+                if v is not None:
+                    pre.append(A.ExprStmt(v, loc=x.loc))
+            return self.expr(e.exprs[-1], pre, value_used)
+        if isinstance(e, A.Assign):
+            e.target = self.lvalue(e.target, pre)
+            e.value = self.expr(e.value, pre)
+            return e
+        if isinstance(e, A.Unary) and e.op in ("++", "--"):
+            e.operand = self.lvalue(e.operand, pre)
+            return e
+        names = [n for n in ("left", "right", "operand", "obj", "index") if hasattr(e, n)]
+        if names:
+            values = self.operands([getattr(e, n) for n in names], pre, set())
+            for n, v in zip(names, values):
+                setattr(e, n, v)
+            return e
+        if isinstance(e, A.InitList):
+            e.items = self.operands(e.items, pre, set())
+            return e
+        return e
+
+    def operands(self, items: list, pre: list, lvalues: set) -> list:
+        """Lower operands evaluated left to right, keeping the order of side effects."""
+        out: list = []
+        for j, item in enumerate(items):
+            if j in lvalues:
+                out.append(self.lvalue(item, pre))
+                continue
+            if self.has_call(item):
+                if self._effects_call(item) or any(
+                        self.has_effects(x) for k, x in enumerate(out) if k not in lvalues):
+                    out = [x if k in lvalues else self.hoist(x, pre) for k, x in enumerate(out)]
+                out.append(self.expr(item, pre))
+            else:
+                out.append(item)
+        return out
+
+    def _effects_call(self, e) -> bool:
+        for n in walk(e):
+            if isinstance(n, A.Call):
+                t = self._target(n)
+                if t is not None and self.effectful.get(id(t), True):
+                    return True
+        return False
+
+    def lvalue(self, e: A.Expr, pre: list) -> A.Expr:
+        """An l-value whose index expressions are evaluated once, now."""
+        if isinstance(e, A.Field):
+            e.obj = self.lvalue(e.obj, pre)
+        elif isinstance(e, A.Index):
+            e.obj = self.lvalue(e.obj, pre)
+            idx = self.expr(e.index, pre)
+            e.index = idx if is_literal(idx) else self.hoist(idx, pre)
+        return e
+
+    # ------------------------------------------------------------------ the call site
+    def inline(self, call: A.Call, fd: A.FunctionDecl, pre: list) -> Optional[A.Expr]:
+        quals = [param_qualifier(p) for p in fd.params]
+        args = self.operands(call.args, pre, {i for i, q in enumerate(quals) if q != "in"})
+        tpl = self.templates[id(fd)]
+        site = f"{fd.name} ({call.loc.line}:{call.loc.col})" if call.loc else fd.name
+        is_void = fd.return_type.spec.name == "void"
+        mapping: dict = {}
+        ret = None
+        if not is_void:
+            ret = self.names.fresh(fd.name)
+            rtype = A.FullType([q for q in fd.return_type.qualifiers
+                                if q in ("lowp", "mediump", "highp")], fd.return_type.spec,
+                               loc=fd.return_type.loc)
+            pre.append(declare(ret, rtype, None, None, call.loc))
+            mapping[_RET] = ret
+        block: list = []
+        writebacks: list = []
+        for p, arg, q in zip(fd.params, args, quals):
+            name = self.names.fresh(p.name or "arg")
+            if p.name:
+                mapping[p.name] = name
+            keep = [x for x in p.type.qualifiers
+                    if not (isinstance(x, str) and x in ("in", "out", "inout", "const"))]
+            ptype = A.FullType(keep, p.type.spec, loc=p.type.loc)
+            dims = clone(p.array_dims) if p.array_dims else None
+            block.append(declare(name, ptype, arg if q != "out" else None, dims, call.loc))
+            if q != "in":
+                writebacks.append(A.ExprStmt(
+                    A.Assign("=", clone(arg), A.Ident(name, loc=call.loc), loc=call.loc),
+                    loc=call.loc))
+        if tpl.needs_flag:
+            live = self.names.fresh("live")
+            mapping[_LIVE] = live
+            block.append(declare(live, A.FullType([], A.TypeSpecifier("bool")),
+                                 A.BoolLit(True, loc=call.loc), loc=call.loc))
+        body = clone(tpl.body, lambda loc: with_chain(loc, site))
+        rewrite_scoped(body, mapping, self.names.fresh)
+        block += body.stmts + writebacks
+        pre.append(A.Compound(block, loc=call.loc))
+        if ret is None:
+            return None
+        return A.Ident(ret, loc=call.loc, type=call.type)
+
+
+def _lvalue_positions(call: A.Call) -> set:
+    return {i for i, q in enumerate(out_qualifiers(call)) if q != "in"}

@@ -1,0 +1,36 @@
+"""The analysed program: inline → unroll → expand compound assignments, checked once.
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> s = parse_shader("float f(float x) { return x * 2.0; }\\nvoid main() {"
+...                  " float a = 0.0; for (int i = 0; i < 3; i++) a += f(float(i));"
+...                  " gl_FragColor = vec4(a); }")
+>>> from rrcache.glsl.printer import print_glsl
+>>> text = print_glsl(analyse(s).unit)
+>>> "for" in text, "f(" in text
+(False, False)
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from rrcache.glsl.semantic import check
+
+from rrcache.analysis.compound import expand_unit
+from rrcache.analysis.inline import inline_unit
+from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL, unroll_unit
+
+__all__ = ["analyse"]
+
+
+def analyse(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
+            max_total: int = DEFAULT_MAX_TOTAL):
+    """The analysed copy of ``shader``: every call inlined, constant loops unrolled (at most
+    ``max_iterations`` per loop, ``max_total`` body copies in all), compound assignments
+    expanded, type-checked again. A valid program equivalent to the input; node ids
+    (:func:`rrcache.analysis.find_node`) refer to it. The input is not modified.
+    """
+    unit = inline_unit(shader.unit)
+    unit = unroll_unit(unit, shader.info, max_iterations, max_total)
+    unit = expand_unit(unit)
+    info = check(unit, shader.path or "<string>")
+    return dataclasses.replace(shader, unit=unit, info=info)

@@ -1,0 +1,372 @@
+"""Pass: unroll ``for`` loops whose trip count is a compile-time constant.
+
+The nodes inside an unrolled loop become ordinary straight-line nodes, one per iteration, and so
+cacheable (the paper lists this as future work). A ``for`` loop is unrolled when
+
+- its init declares (``int i = 0``) or assigns (``i = 0``) one ``int``/``uint``/``float``
+  variable to a constant;
+- its condition compares that variable (``< <= > >= != ==``) with a constant;
+- its step is ``i++``, ``++i``, ``i--``, ``--i``, ``i += c``, ``i -= c``, ``i = i + c`` or
+  ``i = i - c``;
+- the body does not write the variable and has no ``break``/``continue`` of this loop;
+- the trip count, simulated in the variable's own precision (``float`` loops in single
+  precision), is at most ``max_iterations``, and the total number of body copies made in the
+  shader stays within ``max_total``.
+
+"Constant" means literals, ``const`` globals, and locals initialised with a constant and not
+written before the loop (so ``int n = 5; for (int i = 0; i < n; i++)`` and an inlined parameter
+``turbulence(p, 5)`` unroll). Each iteration becomes a block ``{ body }`` in which the loop
+variable is replaced by its value as a literal and the body's locals get fresh names
+(``_rr_<name>_<n>``); an assigned (not declared) loop variable gets its exit value after the
+copies. Nested loops unroll inside out once the outer variable is a literal. Other loops are
+left as they are (the cacheable-node analysis treats what is inside them as ``dynamic``).
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> from rrcache.glsl.printer import print_glsl
+>>> s = parse_shader("void main() { float a = 0.0; for (int i = 0; i < 2; i++) a += float(i);"
+...                  " gl_FragColor = vec4(a); }")
+>>> "for" in print_glsl(unroll_loops(s).unit)
+False
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+from typing import Optional
+
+import numpy as np
+
+from rrcache.glsl import ast as A
+from rrcache.glsl.semantic import check
+
+from rrcache.analysis._tree import (
+    InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped, walk, written_roots,
+)
+
+__all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL"]
+
+DEFAULT_MAX_ITERATIONS = 64
+DEFAULT_MAX_TOTAL = 4096
+_COMPARE = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
+            "!=": np.not_equal, "==": np.equal}
+_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!=", "==": "=="}
+_DTYPE = {"int": np.int32, "uint": np.uint32, "float": np.float32}
+
+
+def unroll_loops(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
+                 max_total: int = DEFAULT_MAX_TOTAL):
+    """Return a copy of ``shader`` with its constant-trip-count ``for`` loops unrolled (see the
+    module docstring). The input is not modified; the result is type-checked again.
+
+    >>> from rrcache.glsl.frontend import parse_shader
+    >>> s = parse_shader("void main() { float a = 0.0; for (int i = 0; i < 99; i++) a += 1.0;"
+    ...                  " gl_FragColor = vec4(a); }")
+    >>> from rrcache.glsl.printer import print_glsl
+    >>> "for" in print_glsl(unroll_loops(s, max_iterations=10).unit)
+    True
+    """
+    unit = unroll_unit(clone(shader.unit), shader.info, max_iterations, max_total)
+    info = check(unit, shader.path or "<string>")
+    return dataclasses.replace(shader, unit=unit, info=info)
+
+
+def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX_ITERATIONS,
+                max_total: int = DEFAULT_MAX_TOTAL) -> A.TranslationUnit:
+    """The unrolling pass, in place on ``unit`` (a copy the caller owns). ``info`` is the
+    :class:`SemanticInfo` of the input (for the values of ``const`` globals)."""
+    consts = {name: sym.const_value for name, sym in info.globals.items()
+              if sym.kind == "const" and isinstance(sym.const_value, (int, float, bool))
+              and not sym.type.dims}
+    u = _Unroller(unit, consts, max_iterations, max_total)
+    for d in unit.decls:
+        if isinstance(d, A.FunctionDecl) and d.body is not None:
+            u.scopes = [{}]
+            for p in d.params:
+                if p.name:
+                    u.scopes[-1][p.name] = None
+            d.body.stmts = u.block(d.body.stmts)
+    return unit
+
+
+class _Unroller:
+    def __init__(self, unit, consts, max_iterations, max_total):
+        self.consts = consts
+        self.max_iterations = max_iterations
+        self.budget = max_total
+        self.names = NameAllocator(unit)
+        self.scopes: list[dict[str, Optional[tuple[str, object]]]] = [{}]
+
+    # ------------------------------------------------------------------ constants
+    def lookup(self, name: str):
+        for scope in reversed(self.scopes):
+            if name in scope:
+                return scope[name]
+        v = self.consts.get(name)
+        if v is None:
+            return None
+        return ("float" if isinstance(v, float) else "bool" if isinstance(v, bool) else "int", v)
+
+    def invalidate(self, name: str) -> None:
+        for scope in reversed(self.scopes):
+            if name in scope:
+                scope[name] = None
+                return
+
+    def const(self, e) -> Optional[tuple[str, object]]:
+        """``(base, value)`` of a constant scalar expression, or None."""
+        if isinstance(e, A.IntLit):
+            return ("uint" if e.unsigned else "int", e.value)
+        if isinstance(e, A.FloatLit) and not e.double:
+            return ("float", float(np.float32(e.value)))
+        if isinstance(e, A.Ident):
+            return self.lookup(e.name)
+        if isinstance(e, A.Unary) and e.op in ("-", "+"):
+            v = self.const(e.operand)
+            if v is None or v[0] not in _DTYPE:
+                return None
+            return (v[0], -v[1] if e.op == "-" else v[1])
+        if isinstance(e, A.Binary) and e.op in ("+", "-", "*"):
+            a, b = self.const(e.left), self.const(e.right)
+            if a is None or b is None or a[0] != b[0] or a[0] not in _DTYPE:
+                return None
+            x, y = _DTYPE[a[0]](a[1]), _DTYPE[a[0]](b[1])
+            with np.errstate(all="ignore"):
+                r = x + y if e.op == "+" else x - y if e.op == "-" else x * y
+            return (a[0], r.item())
+        if isinstance(e, A.Call) and e.name in ("int", "float", "uint") and len(e.args) == 1:
+            v = self.const(e.args[0])
+            if v is None or v[0] not in _DTYPE:
+                return None
+            return (e.name, _DTYPE[e.name](v[1]).item())
+        return None
+
+    # ------------------------------------------------------------------ statements
+    def block(self, stmts: list) -> list:
+        out: list = []
+        for s in stmts:
+            out.extend(self.stmt(s))
+        return out
+
+    def sub(self, s):
+        if s is None:
+            return None
+        self.scopes.append({})
+        got = self.stmt(s)
+        self.scopes.pop()
+        return got[0] if len(got) == 1 else A.Compound(got, loc=s.loc)
+
+    def writes(self, node) -> None:
+        for root in written_roots(node):
+            self.invalidate(root.name)
+
+    def declare(self, decl) -> None:
+        if not isinstance(decl, A.VariableDecl):
+            return
+        for d in decl.declarators:
+            if d.init is not None:
+                self.writes(d.init)
+            value = None
+            if d.init is not None and not d.array_dims and not decl.type.spec.array_dims:
+                v = self.const(d.init)
+                base = decl.type.spec.name
+                if v is not None and base in _DTYPE and v[0] in _DTYPE:
+                    value = (base, _DTYPE[base](v[1]).item())
+                elif v is not None and base == v[0]:
+                    value = v
+            self.scopes[-1][d.name] = value
+
+    def stmt(self, s) -> list:
+        if isinstance(s, A.Compound):
+            self.scopes.append({})
+            s.stmts = self.block(s.stmts)
+            self.scopes.pop()
+            return [s]
+        if isinstance(s, A.DeclStmt):
+            self.declare(s.decl)
+            return [s]
+        if isinstance(s, A.ExprStmt):
+            if s.expr is not None:
+                self.writes(s.expr)
+            return [s]
+        if isinstance(s, A.If):
+            self.writes(s.cond)
+            s.then = self.sub(s.then)
+            s.else_ = self.sub(s.else_)
+            return [s]
+        if isinstance(s, A.Switch):
+            self.writes(s.expr)
+            self.scopes.append({})
+            s.body.stmts = self.block(s.body.stmts)
+            self.scopes.pop()
+            return [s]
+        if isinstance(s, A.For):
+            got = self.try_unroll(s)
+            if got is not None:
+                return got
+            return [self.keep_loop(s)]
+        if isinstance(s, (A.While, A.DoWhile)):
+            return [self.keep_loop(s)]
+        if isinstance(s, A.Return) and s.expr is not None:
+            self.writes(s.expr)
+        return [s]
+
+    def keep_loop(self, s):
+        """A loop left in place: what it writes is unknown from its start."""
+        for root in _stmt_writes(s):
+            self.invalidate(root.name)
+        self.scopes.append({})
+        if isinstance(s, A.For):
+            if s.init is not None:
+                self.stmt(s.init)
+            if isinstance(s.cond, A.VariableDecl):
+                self.declare(s.cond)
+            s.body = self.sub(s.body)
+        elif isinstance(s, A.While):
+            if isinstance(s.cond, A.VariableDecl):
+                self.declare(s.cond)
+            s.body = self.sub(s.body)
+        else:
+            s.body = self.sub(s.body)
+        self.scopes.pop()
+        for root in _stmt_writes(s):
+            self.invalidate(root.name)
+        return s
+
+    # ------------------------------------------------------------------ unrolling
+    def try_unroll(self, s: A.For) -> Optional[list]:
+        head = self.loop_header(s)
+        if head is None:
+            return None
+        name, base, start, declared = head
+        step = _step(s.step, name)
+        cond = s.cond
+        if step is None or not isinstance(cond, A.Binary) or cond.op not in _COMPARE:
+            return None
+        if isinstance(cond.left, A.Ident) and cond.left.name == name:
+            op, bound_expr = cond.op, cond.right
+        elif isinstance(cond.right, A.Ident) and cond.right.name == name:
+            op, bound_expr = _FLIP[cond.op], cond.left
+        else:
+            return None
+        bound = self.const(bound_expr)
+        delta = self.const(step) if isinstance(step, A.Expr) else ("int", step)
+        if bound is None or delta is None or bound[0] not in _DTYPE or delta[0] not in _DTYPE:
+            return None
+        if any(r.name == name for r in _stmt_writes(s.body)) or _breaks(s.body):
+            return None
+        dtype = _DTYPE[base]
+        values = []
+        try:
+            v, b, dv = dtype(start), dtype(bound[1]), dtype(delta[1])
+        except (OverflowError, ValueError):
+            return None
+        with np.errstate(all="ignore"):
+            while bool(_COMPARE[op](v, b)):
+                values.append(v.item())
+                if len(values) > min(self.max_iterations, self.budget):
+                    return None
+                v = dtype(v + dv)
+        self.budget -= len(values)
+        loc = s.loc
+        copies: list = []
+        for value in values:
+            body = clone(s.body, _iteration_loc(f"for {_display(name)}={value}", loc))
+            body = body if isinstance(body, A.Compound) else A.Compound([body], loc=body.loc)
+            rewrite_scoped(body, {name: _literal(base, value)}, self.names.fresh)
+            copies.extend(self.stmt(body))
+        if not declared:
+            exit_value = _literal(base, v.item())(A.Ident(name, loc=loc))
+            copies.append(A.ExprStmt(A.Assign("=", A.Ident(name, loc=loc), exit_value, loc=loc),
+                                     loc=loc))
+            self.invalidate(name)
+        return [A.Compound(copies, loc=loc)] if declared else copies
+
+    def loop_header(self, s: A.For):
+        """``(name, base, start, declared)`` of a loop variable with a constant start."""
+        init = s.init
+        if isinstance(init, A.DeclStmt) and isinstance(init.decl, A.VariableDecl):
+            decl = init.decl
+            base = decl.type.spec.name
+            if len(decl.declarators) != 1 or base not in _DTYPE or decl.declarators[0].array_dims:
+                return None
+            d = decl.declarators[0]
+            v = self.const(d.init) if d.init is not None else None
+            if v is None or v[0] not in _DTYPE:
+                return None
+            return d.name, base, v[1], True
+        if isinstance(init, A.ExprStmt) and isinstance(init.expr, A.Assign) \
+                and init.expr.op == "=" and isinstance(init.expr.target, A.Ident):
+            t = init.expr.target
+            base = getattr(getattr(t, "type", None), "base", None)
+            if base not in _DTYPE or t.type.size != 1 or t.type.dims:
+                return None
+            v = self.const(init.expr.value)
+            if v is None or v[0] not in _DTYPE:
+                return None
+            return t.name, base, v[1], False
+        return None
+
+
+def _literal(base: str, value):
+    def make(ident: A.Ident) -> A.Expr:
+        loc = ident.loc
+        if base == "float":
+            lit = A.FloatLit(abs(float(value)), loc=loc)
+        else:
+            lit = A.IntLit(abs(int(value)), base == "uint", loc=loc)
+        return A.Unary("-", lit, loc=loc) if value < 0 else lit
+    return make
+
+
+def _display(name: str) -> str:
+    """The source name of a (possibly renamed) variable: ``_rr_i_156`` -> ``i``."""
+    m = re.match(r"^_rr_(.+)_\d+$", name)
+    return m.group(1) if m else name
+
+
+def _iteration_loc(step: str, loop_loc):
+    """Insert the iteration into a body location's chain, right after the loop's own chain."""
+    where = f"{step} ({loop_loc.line}:{loop_loc.col})" if loop_loc else step
+    k = len(chain_of(loop_loc))
+
+    def fix(loc):
+        c = chain_of(loc)
+        return InlinedLoc(loc.file, loc.line, loc.col, c[:k] + (where,) + c[k:])
+    return fix
+
+
+def _step(step, name: str):
+    """The increment of a step expression: an int for ``++``/``--``, an expression for
+    ``+= c``/``-= c`` (negated for ``-``), None when the step has another form."""
+    if isinstance(step, A.Unary) and step.op in ("++", "--") and isinstance(step.operand, A.Ident) \
+            and step.operand.name == name:
+        return 1 if step.op == "++" else -1
+    if isinstance(step, A.Assign) and isinstance(step.target, A.Ident) and step.target.name == name:
+        if step.op in ("+=", "-="):
+            delta = step.value
+            return delta if step.op == "+=" else A.Unary("-", delta, loc=delta.loc)
+        if step.op == "=" and isinstance(step.value, A.Binary) and step.value.op in ("+", "-") \
+                and isinstance(step.value.left, A.Ident) and step.value.left.name == name:
+            delta = step.value.right
+            return delta if step.value.op == "+" else A.Unary("-", delta, loc=delta.loc)
+    return None
+
+
+def _stmt_writes(s):
+    return written_roots(s)
+
+
+def _breaks(s, depth: int = 0) -> bool:
+    """A ``break``/``continue`` that leaves (or restarts) the loop whose body is ``s``."""
+    if isinstance(s, (A.Break, A.Continue)):
+        return True
+    if isinstance(s, (A.For, A.While, A.DoWhile)):
+        return False
+    if isinstance(s, A.Switch):
+        return any(isinstance(n, A.Continue) for n in walk(s.body)
+                   if not isinstance(n, (A.For, A.While, A.DoWhile)))
+    if isinstance(s, A.Compound):
+        return any(_breaks(x) for x in s.stmts)
+    if isinstance(s, A.If):
+        return _breaks(s.then) or (s.else_ is not None and _breaks(s.else_))
+    return False

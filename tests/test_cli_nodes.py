@@ -1,0 +1,109 @@
+"""``rrcache nodes``: table, --json schema, --all, -D, errors."""
+from __future__ import annotations
+
+import json
+
+import jsonschema
+import pytest
+
+from rrcache.cli import main
+
+SHADER = """#version 330
+in vec3 v_n;
+out vec4 fragColor;
+uniform float u_k;
+void main() {
+#ifdef BRIGHT
+    vec3 c = exp(v_n) * sin(v_n) + 1.0;
+#else
+    vec3 c = exp(v_n) * sin(v_n);
+#endif
+    float s = 0.0;
+    for (int i = 0; i < int(u_k); i++) s += exp(v_n.x * float(i));
+    fragColor = vec4(c * s, 1.0);
+}
+"""
+
+NODE = {"type": "object", "required": ["id", "type", "line", "column", "text", "cost",
+                                       "call_chain"],
+        "properties": {"id": {"type": "string", "pattern": "^n[0-9]+$"},
+                       "type": {"enum": ["float", "vec2", "vec3", "vec4"]},
+                       "line": {"type": "integer", "minimum": 1},
+                       "column": {"type": "integer", "minimum": 1},
+                       "text": {"type": "string"}, "cost": {"type": "integer", "minimum": 0},
+                       "call_chain": {"type": "array", "items": {"type": "string"}}}}
+EXCLUDED = {"type": "object", "required": ["id", "reason", "line", "column", "text"],
+            "properties": {"reason": {"enum": ["type", "dynamic", "uniform", "derivative",
+                                               "duplicate", "cheap"]}}}
+SCHEMA = {"type": "object", "required": ["shader", "nodes", "excluded"],
+          "properties": {"shader": {"type": "string"},
+                         "nodes": {"type": "array", "items": NODE},
+                         "excluded": {"type": "array", "items": EXCLUDED}}}
+
+
+@pytest.fixture
+def shader_file(tmp_path):
+    path = tmp_path / "s.frag"
+    path.write_text(SHADER)
+    return str(path)
+
+
+def run(capsys, *args):
+    try:
+        main(list(args))
+        code = 0
+    except SystemExit as e:
+        code = e.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_json_output_follows_the_schema(capsys, shader_file):
+    code, out, _ = run(capsys, "nodes", shader_file, "--json", "--all")
+    assert code == 0
+    doc = json.loads(out)
+    jsonschema.validate(doc, SCHEMA)
+    assert doc["shader"] == shader_file
+    texts = {n["text"] for n in doc["nodes"]}
+    assert "exp(v_n) * sin(v_n)" in texts and "vec4(c * s, 1.0)" in texts
+    dynamic = {x["text"] for x in doc["excluded"] if x["reason"] == "dynamic"}
+    assert "exp(v_n.x * float(i))" in dynamic
+
+
+def test_json_without_all_has_no_excluded(capsys, shader_file):
+    code, out, _ = run(capsys, "nodes", shader_file, "--json")
+    assert code == 0 and json.loads(out)["excluded"] == []
+
+
+def test_defines_change_the_nodes(capsys, shader_file):
+    _, out, _ = run(capsys, "nodes", shader_file, "--json", "-D", "BRIGHT")
+    texts = {n["text"] for n in json.loads(out)["nodes"]}
+    assert "exp(v_n) * sin(v_n) + 1.0" in texts
+
+
+def test_text_table(capsys, shader_file):
+    code, out, _ = run(capsys, "nodes", shader_file)
+    assert code == 0
+    assert out.splitlines()[0].split()[:4] == ["id", "type", "line:col", "cost"]
+    assert "exp(v_n) * sin(v_n)" in out and "cacheable nodes" in out
+    code, out_all, _ = run(capsys, "nodes", shader_file, "--all")
+    assert "reason" in out_all.splitlines()[0] and " dynamic " in out_all
+    assert len(out_all.splitlines()) > len(out.splitlines())
+
+
+@pytest.mark.parametrize("content, message", [
+    (None, "cannot read shader file"),
+    ("#version 330\nout vec4 c;\nvoid main() { c = vec4(x); }\n", "s.frag:3:"),
+])
+def test_errors_exit_nonzero_without_traceback(capsys, tmp_path, content, message):
+    path = tmp_path / "s.frag"
+    if content is not None:
+        path.write_text(content)
+    code, out, err = run(capsys, "nodes", str(path))
+    assert code == 2
+    assert message in err and "Traceback" not in err and out == ""
+
+
+def test_bad_define_is_a_usage_error(capsys, shader_file):
+    code, _, err = run(capsys, "nodes", shader_file, "-D", "1BAD")
+    assert code == 2 and "NAME or NAME=VALUE" in err and "Traceback" not in err
