@@ -16,6 +16,7 @@ from rrcache.errors import RRCacheError
 # subcommand name -> module in rrcache.cli (each module defines a click command named `command`)
 _COMMANDS = {
     "nodes": "nodes",
+    "bench-frontend": "bench_frontend",
     "render": "render",
 }
 

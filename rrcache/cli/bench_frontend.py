@@ -1,0 +1,31 @@
+"""``rrcache bench-frontend``: front-end and analysis timings (issue 2 targets: 1 s and 3 s)."""
+from __future__ import annotations
+
+import json
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+
+@click.command("bench-frontend")
+@click.argument("shader", default="shaders/marble.glsl", type=click.Path(exists=True, dir_okay=False))
+@click.option("--lines", default=3000, show_default=True, help="Size of the synthetic large shader.")
+@click.option("--repeat", default=3, show_default=True, help="Runs per shader (the median is reported).")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
+def command(shader, lines, repeat, as_json):
+    """Time preprocessing+parsing+type checking and analysis of SHADER and of a large shader made
+    from it."""
+    from rrcache.bench.frontend import run
+
+    timings = run(shader, lines, repeat)
+    if as_json:
+        click.echo(json.dumps([dict(name=t.name, lines=t.lines, parse_s=t.parse_s, analyse_s=t.analyse_s,
+                                    total_s=t.total_s, nodes=t.nodes) for t in timings]))
+        return
+    table = Table(title="front-end + analysis (median of %d runs)" % repeat)
+    for col in ("shader", "lines", "parse s", "analyse s", "total s", "nodes"):
+        table.add_column(col, justify="right" if col != "shader" else "left")
+    for t in timings:
+        table.add_row(t.name, str(t.lines), f"{t.parse_s:.3f}", f"{t.analyse_s:.3f}", f"{t.total_s:.3f}", str(t.nodes))
+    Console().print(table)
