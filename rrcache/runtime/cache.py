@@ -17,8 +17,11 @@ three-pass (default; programs ``reproject``, ``payload``, ``shade``)
     2. ``payload`` — depth test ``<`` with depth writes: it runs only where pass 1 left no depth
        for this surface (misses and refreshes; at hits the stored depth equals the fragment's, so
        ``<`` fails and early-z culls the fragment). It computes the payload from scratch.
-    3. ``shade`` — depth test ``<=`` without writes against the now complete depth buffer: the
+    3. ``shade`` — depth test ``==`` without writes against the now complete depth buffer: the
        original shader with the cached value replaced by ``rr_current()``, into the colour target.
+       Equality (not ``<=``) matters when a pass discards a fragment after the cached value (an
+       alpha test on it): no depth was written for that fragment, so the final pass must not
+       shade it either, and the surface behind it, whose depth is there, is shaded instead.
 two-pass (programs ``hit``, ``miss``; Nehab 2007 §3.4)
     1. ``hit`` shades hit pixels completely (colour, payload, depth); misses discard.
     2. ``miss`` computes payload and colour at the remaining pixels (three render targets).
@@ -40,6 +43,7 @@ from typing import Callable, Optional
 import moderngl
 import numpy as np
 
+from rrcache.gl.context import bind_default_framebuffer
 from rrcache.runtime import glsl as G
 from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_offsets
 
@@ -204,6 +208,10 @@ class CacheRuntime:
         self._valid = False
 
     def _release_targets(self) -> None:
+        # moderngl re-binds the current framebuffer whenever it creates a new one: if the bound
+        # framebuffer was released (ours, or one of the application's) that raises
+        # GL_INVALID_OPERATION, so bind the default framebuffer before releasing or creating any
+        bind_default_framebuffer(self.ctx)
         for res in self._resources:
             res.release()
         self._resources = []
@@ -277,7 +285,7 @@ class CacheRuntime:
             self._color_only_fbo.clear(*self.clear_color)
             self._out_fbo.depth_mask = False
             self._out_fbo.use()
-            ctx.depth_func = "<="
+            ctx.depth_func = "=="
             covered = self._run("shade", draw, count)
             self._out_fbo.depth_mask = True
         elif self.algorithm == "two-pass":

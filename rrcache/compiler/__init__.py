@@ -1,0 +1,84 @@
+"""The instancing compiler: one cached node of an analysed shader → the shaders of every pass.
+
+Given the analysed shader (every call inlined into ``main``, constant loops unrolled; see
+:mod:`rrcache.analysis`) and the id of a cacheable node E, :func:`instance` emits the passes of
+the chosen algorithm (Sitthi-amorn et al. 2008a §3, DESIGN.md §3) as ``#version 330 core``
+fragment shaders with the runtime's GLSL (:mod:`rrcache.runtime.glsl`), each pruned to what the
+pass needs, and their generated vertex shaders:
+
+- ``three-pass``: ``reproject`` (hit: write the reprojected payload; miss: ``discard``),
+  ``payload`` (compute E where pass 1 left no depth), ``shade`` (the shader with E replaced by
+  this frame's payload);
+- ``two-pass``: ``hit`` (shade hits completely, cache included) and ``miss``;
+- ``one-pass``: ``single`` (a dynamic branch).
+
+One file per pass of the compiler: :mod:`~rrcache.compiler.locate` (find E and its statement S),
+:mod:`~rrcache.compiler.replace`, :mod:`~rrcache.compiler.hoist`,
+:mod:`~rrcache.compiler.feeders` (one-pass only), :mod:`~rrcache.compiler.outputs`,
+:mod:`~rrcache.compiler.prune` (dead-code elimination), :mod:`~rrcache.compiler.passes`
+(assembly per algorithm), :mod:`~rrcache.compiler.emit` (printing),
+:mod:`~rrcache.compiler.variant` (the result).
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> s = parse_shader("#version 330\\nin vec3 v_normal; uniform float u_k; out vec4 c;\\n"
+...                  "void main() { float d = dot(v_normal, v_normal); c = vec4(d * u_k); }")
+>>> node = [n for n in s.unit.walk() if isinstance(n, A.Call) and n.name == "dot"][0]
+>>> v = instance(s, node)
+>>> sorted(v.passes), v.node_type, v.uniforms["payload"]
+(['payload', 'reproject', 'shade'], 'float', ['u_modelMatrix', 'u_modelViewProjectionMatrix', 'u_normalMatrix'])
+"""
+from __future__ import annotations
+
+from typing import Any, Union
+
+from rrcache.glsl import ast as A
+from rrcache.compiler.emit import (
+    fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
+)
+from rrcache.compiler.locate import prepare
+from rrcache.compiler.passes import build_pass
+from rrcache.compiler.variant import PassSource, Variant
+from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.glsl import FILTERS
+
+__all__ = ["instance", "Variant", "PassSource"]
+
+
+def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
+             filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
+    """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
+
+    ``analysed`` is what the analysis returns (a checked, inlined and unrolled shader);
+    ``node_id`` an id of its node table (or the expression node itself). ``filter`` is the
+    payload reconstruction filter (``nearest``, ``bilinear``, ``catmull-rom``) and
+    ``payload_dtype`` the cache precision (``f4``, or ``f2`` for half floats), recorded for the
+    runtime. Raises :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a
+    node that cannot be cached.
+    """
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
+    if filter not in FILTERS:
+        raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
+    if payload_dtype not in PAYLOAD_DTYPES:
+        raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    loc = prepare(analysed, node_id)
+    passes: dict[str, PassSource] = {}
+    uniforms: dict[str, list[str]] = {}
+    samplers: dict[str, list[str]] = {}
+    runtime: dict[str, list[str]] = {}
+    forms: dict[str, str] = {}
+    for name in ALGORITHMS[algorithm]:
+        built = build_pass(loc, name, filter)
+        iface = interface(built.unit)
+        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit))
+        fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
+        passes[name] = PassSource(vertex, fragment, line_map)
+        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_uniforms(vertex)))
+        samplers[name] = list(iface["sampler"])
+        runtime[name] = runtime_uniforms(built.runtime_glsl)
+        forms[name] = built.form
+    return Variant(
+        algorithm=algorithm, node_id=node_id if not isinstance(node_id, A.Node) else None,
+        node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
+        payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
+        runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path)

@@ -1,0 +1,100 @@
+"""Pass: print an assembled pass as shader sources.
+
+The fragment shader is the pass's unit printed as ``#version 330 core`` (or the shader's own
+core version when higher) with the runtime's GLSL inserted verbatim after the ``#version`` and
+``#extension`` lines; its line map (printed line → original place, None for generated lines)
+maps driver errors back to the user's file.
+
+The vertex shader comes from the harness generator (:func:`rrcache.harness.vertex.
+vertex_source`), asked for exactly the varyings the fragment shader declares (plus
+``rr_prevClip`` when the pass reads the previous frame's cache), with ``gl_Position`` declared
+``invariant``: every pass must produce bit-identical depths, or the depth tests between passes
+(``<`` at hits, ``<=`` in the final pass) would fail at random pixels.
+
+>>> vs = vertex_shader({"v_normal": "vec3"}, prev_clip=True)
+>>> "invariant gl_Position;" in vs and "out vec4 rr_prevClip;" in vs
+True
+"""
+from __future__ import annotations
+
+import re
+from typing import Optional
+
+from rrcache.errors import SourceLoc
+from rrcache.glsl import ast as A
+from rrcache.glsl.printer import print_with_map
+from rrcache.glsl.types import OPAQUE_NAMES
+from rrcache.harness.vertex import vertex_source
+from rrcache.runtime import glsl as G
+
+_UNIFORM_LINE = re.compile(r"^\s*uniform\s+\w+\s+(\w+)\s*;", re.MULTILINE)
+
+
+def fragment_shader(unit: A.TranslationUnit, runtime_glsl: str) -> tuple[str, list[Optional[SourceLoc]]]:
+    """The fragment source and its line map."""
+    text, line_map = print_with_map(unit)
+    lines = text.split("\n")
+    head = 0
+    while head < len(lines) and lines[head].startswith("#"):
+        head += 1
+    extra = runtime_glsl.rstrip("\n").split("\n") if runtime_glsl else []
+    lines[head:head] = extra
+    line_map = list(line_map[:head]) + [None] * len(extra) + list(line_map[head:])
+    return "\n".join(lines), line_map
+
+
+def _qualifier_words(decl: A.VariableDecl) -> set[str]:
+    return {q for q in decl.type.qualifiers if isinstance(q, str)}
+
+
+def interface(unit: A.TranslationUnit) -> dict[str, dict[str, str]]:
+    """The shader's own globals by storage: ``{"in": {name: type}, "uniform": {...},
+    "sampler": {...}}`` (uniform blocks are listed under ``uniform`` by block name)."""
+    found: dict[str, dict[str, str]] = {"in": {}, "uniform": {}, "sampler": {}}
+    for d in unit.decls:
+        if isinstance(d, A.VariableDecl) and d.declarators:
+            quals = _qualifier_words(d)
+            type_name = d.type.spec.name or (d.type.spec.struct.name if d.type.spec.struct else "struct")
+            for x in d.declarators:
+                if "in" in quals or "varying" in quals:
+                    found["in"][x.name] = type_name
+                elif "uniform" in quals:
+                    kind = "sampler" if type_name in OPAQUE_NAMES else "uniform"
+                    found[kind][x.name] = type_name
+        elif isinstance(d, A.InterfaceBlock):
+            quals = {q for q in d.qualifiers if isinstance(q, str)}
+            if "uniform" in quals:
+                found["uniform"][d.block_name] = "block"
+    return found
+
+
+def input_locations(unit: A.TranslationUnit) -> dict[str, Optional[SourceLoc]]:
+    """Where each ``in`` variable is declared (for the harness' error messages)."""
+    out: dict[str, Optional[SourceLoc]] = {}
+    for d in unit.decls:
+        if isinstance(d, A.VariableDecl) and "in" in _qualifier_words(d):
+            for x in d.declarators:
+                out[x.name] = x.loc or d.loc
+    return out
+
+
+def vertex_shader(inputs: dict[str, str], prev_clip: bool,
+                  locs: Optional[dict[str, Optional[SourceLoc]]] = None) -> str:
+    """The generated vertex shader writing ``inputs`` (and ``rr_prevClip``), with an invariant
+    ``gl_Position``."""
+    wanted = dict(inputs)
+    if prev_clip:
+        wanted[G.PREV_CLIP] = "vec4"
+    text = vertex_source(wanted, locs)
+    first, _, rest = text.partition("\n")
+    return f"{first}\ninvariant gl_Position;\n{rest}"
+
+
+def vertex_uniforms(vertex_text: str) -> list[str]:
+    """The uniforms a generated vertex shader declares (the application sets them per object)."""
+    return _UNIFORM_LINE.findall(vertex_text)
+
+
+def runtime_uniforms(runtime_glsl: str) -> list[str]:
+    """The ``rr_`` uniforms and samplers the runtime sets, as declared in its snippets."""
+    return _UNIFORM_LINE.findall(runtime_glsl)

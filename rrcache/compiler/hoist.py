@@ -1,0 +1,116 @@
+"""Pass: bind the cached value to ``rr_node`` right before S.
+
+Two forms (the lead's transformation, see the package docstring):
+
+- hoist form (the usual one): ``T rr_node = E;`` (or ``T rr_node;`` followed by a statement that
+  sets it) is inserted right before S, then the statements of ``then`` (the cache writes), and E
+  in S becomes ``rr_node``;
+- inline form, when S has side effects evaluated before E inside the statement itself (an
+  assignment, ``++``, a call with ``out`` arguments or to a user function, an earlier declarator
+  of the same declaration that E may read): ``T rr_node;`` before S, E becomes ``(rr_node = E)``
+  in place and ``then`` goes right after S.
+
+>>> from rrcache.compiler.locate import PLACEHOLDER
+>>> from rrcache.glsl.printer import print_glsl
+>>> from rrcache.glsl.parser import parse_source
+>>> unit = parse_source("void main() { float y = 2.0 * rr_cachedNodePlaceholder; }")
+>>> block = unit.decls[0].body
+>>> hoist(Site(block, 0, block.stmts[0]), "float", A.Call("sin", [A.Ident("x")]))
+'hoist'
+>>> print(print_glsl(unit).strip().splitlines()[2:4])
+['    float rr_node = sin(x);', '    float y = 2.0 * rr_node;']
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+from rrcache.glsl import ast as A
+from rrcache.compiler._ast import post_order
+from rrcache.compiler.locate import PLACEHOLDER, Site
+from rrcache.compiler.replace import NODE_VAR, node_variable, replace_node
+
+
+def _own_roots(s: A.Stmt) -> list[A.Node]:
+    if isinstance(s, A.ExprStmt):
+        return [s.expr] if s.expr is not None else []
+    if isinstance(s, A.DeclStmt):
+        return [s.decl]
+    if isinstance(s, A.If):
+        return [s.cond]
+    if isinstance(s, A.For):
+        return [x for x in (s.init,) if x is not None]
+    if isinstance(s, A.Switch):
+        return [s.expr]
+    if isinstance(s, A.Return):
+        return [s.expr] if s.expr is not None else []
+    return []
+
+
+def _has_effect(n: A.Node) -> bool:
+    if isinstance(n, A.Assign):
+        return True
+    if isinstance(n, A.Unary) and n.op in ("++", "--"):
+        return True
+    if isinstance(n, A.Declarator):
+        return True
+    if isinstance(n, A.Call):
+        if n.kind == "function" or isinstance(n.target, A.FunctionDecl):
+            return True
+        target = n.target
+        if target is not None and (getattr(target, "side_effects", False)
+                                   or any(q != "in" for q in getattr(target, "qualifiers", ()))):
+            return True
+    return False
+
+
+def side_effect_before(stmt: A.Stmt) -> bool:
+    """Whether something with a side effect is evaluated before the placeholder in ``stmt``'s
+    own expressions (evaluation order: operands left to right, then the operator)."""
+    for root in _own_roots(stmt):
+        for n in post_order(root):
+            if isinstance(n, A.Ident) and n.name == PLACEHOLDER:
+                return False
+            if _has_effect(n):
+                return True
+    return False
+
+
+def declare(type_name: str, name: str, init: Optional[A.Expr] = None) -> A.DeclStmt:
+    """``T name [= init];``"""
+    return A.DeclStmt(A.VariableDecl(A.FullType([], A.TypeSpecifier(type_name)),
+                                     [A.Declarator(name, None, init)]))
+
+
+def insert_before(site: Site, stmts: list[A.Stmt]) -> None:
+    """Insert ``stmts`` right before S (``site.index`` follows S)."""
+    site.block.stmts[site.index:site.index] = stmts
+    site.index += len(stmts)
+
+
+def insert_after(site: Site, stmts: list[A.Stmt]) -> None:
+    """Insert ``stmts`` right after S."""
+    site.block.stmts[site.index + 1:site.index + 1] = stmts
+
+
+def hoist(site: Site, type_name: str, value: A.Expr, then: Optional[list[A.Stmt]] = None,
+          setter: Optional[A.Stmt] = None) -> str:
+    """Bind the node's value to ``rr_node`` before S (see the module docstring); returns the
+    form used, ``"hoist"`` or ``"inline"``.
+
+    ``value`` is the expression giving the value; ``setter``, when given, is the statement used
+    in the hoist form instead of the initialiser (the one-pass branch), ``value`` then being its
+    equivalent expression for the inline form.
+    """
+    then = list(then or [])
+    if side_effect_before(site.stmt):
+        insert_before(site, [declare(type_name, NODE_VAR)])
+        replace_node(site.stmt, lambda: A.Assign("=", node_variable(), value))
+        insert_after(site, then)
+        return "inline"
+    if setter is None:
+        before = [declare(type_name, NODE_VAR, value)]
+    else:
+        before = [declare(type_name, NODE_VAR), setter]
+    insert_before(site, before + then)
+    replace_node(site.stmt, node_variable)
+    return "hoist"

@@ -1,0 +1,151 @@
+"""The compiled variant: one cached node, every pass of one algorithm, ready to run.
+
+A :class:`Variant` holds, per pass, the vertex and fragment sources (and the fragment line map
+to the original shader), what the application must bind, and how the runtime must be set up
+(payload precision, reconstruction filter). :meth:`Variant.manifest` describes it as JSON,
+:meth:`Variant.write` writes ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json``, and
+:meth:`Variant.build_programs` links the programs for :class:`rrcache.runtime.CacheRuntime`::
+
+    variant = instance(analysed, node_id)            # rrcache.compiler.instance
+    programs = variant.build_programs(ctx)
+    rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h),
+                      payload_dtype=variant.payload_dtype)
+"""
+from __future__ import annotations
+
+import inspect
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import moderngl
+
+from rrcache.errors import GLError, SourceLoc
+from rrcache.gl.program import build_program
+from rrcache.runtime.cache import ALGORITHMS, CacheRuntime
+
+
+def default_period() -> int:
+    """The runtime's default refresh period Δn."""
+    return int(inspect.signature(CacheRuntime.__init__).parameters["period"].default)
+
+
+@dataclass
+class PassSource:
+    """The sources of one pass. ``fragment_line_map[i]`` is the original place of fragment line
+    ``i + 1`` (None for generated lines)."""
+
+    vertex: str
+    fragment: str
+    fragment_line_map: list[Optional[SourceLoc]] = field(default_factory=list)
+
+
+@dataclass
+class Variant:
+    """A node cached with one algorithm.
+
+    ``uniforms`` / ``samplers`` map each pass to the names the application binds (the vertex
+    shader's per-object matrices included; the ``rr_`` ones, set by the runtime, are in
+    ``runtime_uniforms``). ``forms`` records, per pass, how the value was bound (``hoist``,
+    ``inline`` or ``replace``; see :mod:`rrcache.compiler.hoist`).
+    """
+
+    algorithm: str
+    node_id: Any
+    node_type: str
+    node_text: str
+    components: int
+    filter: str
+    payload_dtype: str
+    passes: dict[str, PassSource]
+    uniforms: dict[str, list[str]] = field(default_factory=dict)
+    samplers: dict[str, list[str]] = field(default_factory=dict)
+    runtime_uniforms: dict[str, list[str]] = field(default_factory=dict)
+    forms: dict[str, str] = field(default_factory=dict)
+    node_loc: Optional[SourceLoc] = None
+    shader_path: Optional[str] = None
+
+    @property
+    def pass_names(self) -> tuple[str, ...]:
+        """The passes in the order the runtime runs them."""
+        return ALGORITHMS[self.algorithm]
+
+    def manifest(self) -> dict:
+        """A JSON-able description of the variant.
+
+        >>> v = Variant("one-pass", 3, "float", "sin(x)", 1, "bilinear", "f4",
+        ...             {"single": PassSource("vs", "fs")})
+        >>> m = v.manifest()
+        >>> m["passes"]["single"], m["node"]["type"], m["default_period"]
+        ({'vertex': 'single.vert', 'fragment': 'single.frag', 'uniforms': [], 'samplers': [], 'runtime_uniforms': []}, 'float', 8)
+        """
+        node_id = self.node_id if isinstance(self.node_id, (int, str)) else None
+        return {
+            "rrcache_variant": 1,
+            "node": {
+                "id": node_id, "type": self.node_type, "text": self.node_text,
+                "components": self.components,
+                "location": str(self.node_loc) if self.node_loc else None,
+            },
+            "shader": self.shader_path,
+            "algorithm": self.algorithm,
+            "filter": self.filter,
+            "payload_dtype": self.payload_dtype,
+            "default_period": default_period(),
+            "passes": {
+                name: {
+                    "vertex": f"{name}.vert", "fragment": f"{name}.frag",
+                    "uniforms": list(self.uniforms.get(name, [])),
+                    "samplers": list(self.samplers.get(name, [])),
+                    "runtime_uniforms": list(self.runtime_uniforms.get(name, [])),
+                }
+                for name in self.passes
+            },
+            "uniforms": sorted({u for names in self.uniforms.values() for u in names}),
+            "textures": sorted({s for names in self.samplers.values() for s in names}),
+        }
+
+    def write(self, out_dir: "str | os.PathLike[str]") -> list[str]:
+        """Write ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json`` into ``out_dir``
+        (created when missing); returns the paths written."""
+        out_dir = os.fspath(out_dir)
+        os.makedirs(out_dir, exist_ok=True)
+        written = []
+        for name, src in self.passes.items():
+            for ext, text in (("vert", src.vertex), ("frag", src.fragment)):
+                path = os.path.join(out_dir, f"{name}.{ext}")
+                with open(path, "w", encoding="utf-8") as f:
+                    f.write(text if text.endswith("\n") else text + "\n")
+                written.append(path)
+        path = os.path.join(out_dir, "manifest.json")
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(self.manifest(), f, indent=2)
+            f.write("\n")
+        written.append(path)
+        return written
+
+    def build_programs(self, ctx: moderngl.Context) -> dict[str, moderngl.Program]:
+        """Compile and link every pass. A pass the driver refuses raises :class:`GLError`
+        naming the node and the pass (at the original line where the log allows); programs
+        already linked are released first."""
+        programs: dict[str, moderngl.Program] = {}
+        for name, src in self.passes.items():
+            shader = self.shader_path or "<shader>"
+            try:
+                programs[name] = build_program(
+                    ctx, src.vertex, src.fragment, src.fragment_line_map,
+                    fragment_name=f"{shader} ({name} pass)",
+                    vertex_name=f"<generated vertex shader of the {name} pass>")
+            except GLError as err:
+                for prog in programs.values():
+                    prog.release()
+                new = GLError(
+                    f"the {name} pass of the {self.algorithm} variant caching node "
+                    f"{self.node_id} '{self.node_text}' was refused: {err.message}",
+                    err.where, err.hint or "this is a bug in rrcache's compiler; please report it")
+                new.loc = getattr(err, "loc", None)
+                new.diagnostics = getattr(err, "diagnostics", [])
+                new.pass_name = name
+                raise new from None
+        return programs
