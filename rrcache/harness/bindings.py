@@ -76,8 +76,12 @@ def active_uniforms(program: moderngl.Program) -> dict[str, moderngl.Uniform]:
     return {name: program[name] for name in program if isinstance(program[name], moderngl.Uniform)}
 
 
-def plan_bindings(program: moderngl.Program, prepared: PreparedShader, session) -> BindingPlan:
+def plan_bindings(program: moderngl.Program, prepared: PreparedShader, session,
+                  runtime_prefix: str = "rr_") -> BindingPlan:
     """Sort the program's active uniforms by source and check the session supplies the rest.
+
+    Uniforms whose name starts with ``runtime_prefix`` belong to the reprojection cache
+    (:mod:`rrcache.runtime` binds them) and are left out of the plan.
 
     Raises :class:`SessionError` for a uniform or sampler with no value, a value of the wrong
     shape or a texture of the wrong kind; :class:`UnsupportedShaderError` for a sampler type the
@@ -89,6 +93,8 @@ def plan_bindings(program: moderngl.Program, prepared: PreparedShader, session) 
     session_path = str(session.path)
     active = active_uniforms(program)
     for name, uniform in sorted(active.items()):
+        if runtime_prefix and name.startswith(runtime_prefix):
+            continue
         base = base_name(name)
         where = prepared.where(base)
         decl = prepared.declaration(base)

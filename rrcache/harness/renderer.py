@@ -25,22 +25,13 @@ from typing import Callable, Iterable, Optional
 import moderngl
 import numpy as np
 
-from rrcache.errors import SessionError, UnsupportedShaderError
+from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
-from rrcache.gl.textures import texture_from_asset
-from rrcache.gl.uniforms import write_uniform
-from rrcache.harness.bindings import BUILTINS, lookup, plan_bindings
+from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
-from rrcache.harness.vertex import ATTRIBUTES, vertex_source
-
-# value for a vertex attribute the mesh does not have
-_DEFAULTS = {"normal": (0.0, 0.0, 1.0), "texcoord": (0.0, 0.0), "color": (1.0, 1.0, 1.0, 1.0),
-             "tangent": (1.0, 0.0, 0.0, 1.0)}
-_FIELDS = {"position": "positions", "normal": "normals", "texcoord": "texcoords", "color": "colors",
-           "tangent": "tangents"}
-
+from rrcache.harness.vertex import vertex_source
 
 @dataclass
 class FrameResult:
@@ -82,14 +73,6 @@ def parse_resolution(text: str) -> tuple[int, int]:
     return w, h
 
 
-def _normal_matrix(model: np.ndarray) -> np.ndarray:
-    m3 = np.asarray(model, dtype=np.float64)[:3, :3]
-    try:
-        return np.linalg.inv(m3).T
-    except np.linalg.LinAlgError:  # a zero scale: no meaningful normals, keep the rotation part
-        return m3
-
-
 class Renderer:
     """Renders frames of ``session`` through ``prepared`` at ``resolution`` (default: the session's).
 
@@ -125,14 +108,9 @@ class Renderer:
         self.vertex_source = vertex_source(inputs, locs)
         self.program = self._scope.own(build_program(
             ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path))
-        self.plan = plan_bindings(self.program, prepared, self.session)
-        self.notes = list(self.plan.notes)
-        self._textures = []
-        for unit, (name, uniform, _kind) in enumerate(self.plan.samplers):
-            tex = self._scope.own(texture_from_asset(self.ctx, self.session.textures[name]))
-            uniform.value = unit
-            self._textures.append((unit, tex))
-        self._vaos = [self._object_vao(obj) for obj in self.session.objects]
+        self.drawer = SceneDrawer(ctx, self.session, prepared, self.size, self._scope, self.cull_back_faces)
+        self.plan = self.drawer.add_program(self.program)
+        self.notes = self.drawer.notes
         w, h = self.size
         self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
         self._depth = self._scope.own(ctx.depth_texture((w, h)))
@@ -140,99 +118,23 @@ class Renderer:
         # moderngl's Query has no release(); it goes with the Python object
         self._query = ctx.query(samples=True)
 
-    def _object_vao(self, obj):
-        mesh = obj.mesh
-        n = int(np.asarray(mesh.positions).shape[0])
-        content = []
-        for attr, (glsl_type, _define) in ATTRIBUTES.items():
-            name = f"a_{attr}"
-            if name not in self.program or not isinstance(self.program[name], moderngl.Attribute):
-                continue
-            data = getattr(mesh, _FIELDS[attr], None)
-            size = int(glsl_type[-1])
-            if data is None:
-                data = np.tile(np.asarray(_DEFAULTS[attr], np.float32), (n, 1))
-            data = np.ascontiguousarray(np.asarray(data, np.float32).reshape(n, size))
-            vbo = self._scope.own(self.ctx.buffer(data.tobytes()))
-            content.append((vbo, f"{size}f", name))
-        indices = np.ascontiguousarray(np.asarray(mesh.indices, np.uint32).reshape(-1))
-        ibo = self._scope.own(self.ctx.buffer(indices.tobytes()))
-        return obj, self._scope.own(self.ctx.vertex_array(self.program, content, ibo, index_element_size=4))
-
     # ------------------------------------------------------------------ per frame
     def _check_frame(self, index: int) -> int:
-        index = int(index)
-        if not 0 <= index < self.session.frames:
-            raise SessionError(f"frame {index} is outside the session's {self.session.frames} frames (0..{self.session.frames - 1})",
-                               str(self.session.path), "frames")
-        return index
-
-    def _set_builtin(self, name: str, value) -> None:
-        uniform = self.plan.builtins.get(name)
-        if uniform is None:
-            return
-        try:
-            write_uniform(uniform, value)
-        except ValueError:
-            decl = self.prepared.declaration(name)
-            raise UnsupportedShaderError(
-                f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
-                decl.loc if decl is not None else None,
-                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
-
-    def _frame_uniforms(self, index: int) -> list[tuple[object, np.ndarray, np.ndarray]]:
-        session = self.session
-        w, h = self.size
-        prev = max(index - 1, 0)
-        cam, cam_prev = session.camera_at(index), session.camera_at(prev)
-        view, proj = cam.view, cam.projection(w / h)
-        view_proj = proj @ view
-        prev_view_proj = cam_prev.projection(w / h) @ cam_prev.view
-        light = session.light_at(index)
-        self._set_builtin("u_camera", cam.eye)
-        self._set_builtin("u_light", light.position)
-        self._set_builtin("u_lightColor", light.color)
-        self._set_builtin("u_resolution", (float(w), float(h)))
-        self._set_builtin("u_time", index / session.fps)
-        self._set_builtin("u_frame", index)
-        self._set_builtin("u_viewMatrix", view)
-        self._set_builtin("u_projectionMatrix", proj)
-        values = session.uniform_values(index)
-        for name, uniform in self.plan.session:
-            write_uniform(uniform, lookup(values, name))
-        for unit, tex in self._textures:
-            tex.use(location=unit)
-        per_object = []
-        for obj, vao in self._vaos:
-            model = obj.model_matrix(index)
-            cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
-            per_object.append((vao, model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev), cull))
-        return per_object
+        return check_frame_index(self.session, index)
 
     def _draw(self, index: int) -> tuple[float, int]:
         ctx = self.ctx
-        per_object = self._frame_uniforms(index)
+        self.drawer.set_frame(index)
         ctx.enable(moderngl.DEPTH_TEST)
-        ctx.cull_face = "back"
         ctx.depth_func = "<"
         self.fbo.use()
         self.fbo.viewport = (0, 0, *self.size)
-        background = tuple(getattr(self.session, "background", None) or (0.0, 0.0, 0.0, 0.0))
-        background = (background + (1.0,))[:4] if len(background) == 3 else background
+        background = session_background(self.session)
         ctx.finish()
         start = time.perf_counter()
         self.fbo.clear(*background, depth=1.0)
         with self._query:
-            for vao, model, mvp, prev_mvp, cull in per_object:
-                if cull:
-                    ctx.enable(moderngl.CULL_FACE)
-                else:
-                    ctx.disable(moderngl.CULL_FACE)
-                self._set_builtin("u_modelMatrix", model)
-                self._set_builtin("u_modelViewProjectionMatrix", mvp)
-                self._set_builtin("u_normalMatrix", _normal_matrix(model))
-                self._set_builtin("u_prevModelViewProjectionMatrix", prev_mvp)
-                vao.render(moderngl.TRIANGLES)
+            self.drawer.draw(self.program)
         ctx.finish()
         ms = (time.perf_counter() - start) * 1000.0
         return ms, int(self._query.samples)
@@ -267,6 +169,21 @@ class Renderer:
 
     def __exit__(self, *exc) -> None:
         self.release()
+
+
+def check_frame_index(session, index: int) -> int:
+    """``index`` as an int, or a :class:`SessionError` when it is outside the session."""
+    index = int(index)
+    if not 0 <= index < session.frames:
+        raise SessionError(f"frame {index} is outside the session's {session.frames} frames (0..{session.frames - 1})",
+                           str(session.path), "frames")
+    return index
+
+
+def session_background(session) -> tuple[float, float, float, float]:
+    """The session's clear colour as RGBA (alpha 1 when only RGB is given; default transparent black)."""
+    background = tuple(getattr(session, "background", None) or (0.0, 0.0, 0.0, 0.0))
+    return (background + (1.0,))[:4] if len(background) == 3 else background
 
 
 def frame_indices(session, frames=None) -> list[int]:

@@ -81,6 +81,8 @@ class CacheRuntime:
     ``programs`` maps the pass names of ``algorithm`` (see :data:`ALGORITHMS`) to linked
     programs. ``size`` is (width, height). ``period`` (Δn), ``block`` (k), ``refresh`` and
     ``depth_epsilon`` can be changed between frames (they are uniforms or small textures).
+    ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
+    the application's culling state alone (the draw callback may set it per object).
 
     Example, inside a render loop (``draw`` renders the scene with the given program)::
 
@@ -104,7 +106,7 @@ class CacheRuntime:
         payload_dtype: str = "f4",
         depth_epsilon: float = 1e-3,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
-        cull_back_faces: bool = True,
+        cull_back_faces: Optional[bool] = None,
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -265,9 +267,9 @@ class CacheRuntime:
         """
         ctx = self.ctx
         ctx.enable(moderngl.DEPTH_TEST)
-        if self.cull_back_faces:
+        if self.cull_back_faces is True:
             ctx.enable(moderngl.CULL_FACE)
-        else:
+        elif self.cull_back_faces is False:
             ctx.disable(moderngl.CULL_FACE)
         cache_fbo = self._cache_fbos[self._index]
         cache_fbo.depth_mask = True
@@ -314,6 +316,11 @@ class CacheRuntime:
     def read_color(self) -> np.ndarray:
         """The last frame's colour, float32 (height, width, 4), row 0 = top of the image."""
         return self._read(self.color, 4)
+
+    def read_depth(self) -> np.ndarray:
+        """The last frame's window depth (1.0 where nothing was drawn), row 0 = top."""
+        w, h = self.size
+        return np.frombuffer(self.depth.read(), dtype=np.float32).reshape(h, w)[::-1].copy()
 
     def read_payload(self) -> np.ndarray:
         """The last frame's cache payload, float32 (height, width, 4), row 0 = top."""

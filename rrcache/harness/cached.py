@@ -1,0 +1,246 @@
+"""Replaying a session through a cached variant, and comparing it with the original side by side.
+
+:class:`CachedRenderer` draws the session's objects (:class:`~rrcache.harness.drawer.SceneDrawer`)
+with every pass program of a compiled :class:`~rrcache.compiler.Variant` through the public
+:class:`~rrcache.runtime.CacheRuntime`, so what is measured is what an application runs.
+
+:func:`compare` renders the original and the variant frame by frame in one run, alternating them
+so that machine noise touches both alike, and reports the paper's error (mean per-pixel RGB L2
+over covered pixels), PSNR, hit rate and the speed-up as a ratio of median frame times.
+
+Hits and misses come from occlusion queries while timing (misses = fragments the miss pass shaded,
+overdraw included; hits = covered − misses); ``hit_maps=True`` also reads the exact per-pixel hit
+map after the reprojection pass (that read-back stalls the pipeline: such frames are not timed
+fairly and the comparison says so).
+"""
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import moderngl
+import numpy as np
+
+from rrcache.gl.context import get_context
+from rrcache.gl.resources import GLScope
+from rrcache.harness.drawer import SceneDrawer
+from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
+from rrcache.harness.prepare import PreparedShader
+from rrcache.harness.renderer import Renderer, check_frame_index, session_background
+from rrcache.runtime import CacheRuntime
+
+
+@dataclass
+class CachedFrame:
+    """One frame of a cached variant: ``image`` H×W×4 (row 0 = top), ``mask`` covered pixels,
+    ``hits``/``misses`` (queries), ``ms`` wall time of the passes, ``hit_map`` (exact, only
+    with ``hit_maps=True``; row 0 = top)."""
+
+    index: int
+    image: np.ndarray
+    mask: np.ndarray
+    covered_pixels: int
+    hits: int
+    misses: int
+    ms: float
+    hit_map: Optional[np.ndarray] = None
+    payload: Optional[np.ndarray] = None
+
+
+class CachedRenderer:
+    """Renders frames of ``session`` with ``variant`` (a compiled :class:`Variant`).
+
+    ``prepared`` is the original shader prepared by the harness: its declarations name the places
+    in error messages when the session lacks a uniform a pass needs. Frames must be rendered in
+    order for the cache to mean anything (frame ``i`` reprojects from the last rendered frame);
+    a jump resets the cache (every pixel misses, as after a camera cut).
+    """
+
+    def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
+                 period: int = 8, block: int = 4, refresh: str = "random", depth_epsilon: float = 1e-3,
+                 seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
+                 ctx: Optional[moderngl.Context] = None):
+        self.ctx = ctx or get_context()
+        self.variant = variant
+        self.session = session
+        self.size = tuple(int(v) for v in (resolution or session.resolution))
+        self.hit_maps = hit_maps
+        self.keep_payload = keep_payload
+        self._scope = GLScope()
+        self._last: Optional[int] = None
+        self._warm = False
+        try:
+            self.programs = {name: self._scope.own(p) for name, p in variant.build_programs(self.ctx).items()}
+            self.drawer = SceneDrawer(self.ctx, session, prepared, self.size, self._scope)
+            for program in self.programs.values():
+                self.drawer.add_program(program)
+            self.notes = self.drawer.notes
+            self.runtime = CacheRuntime(
+                self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
+                refresh=refresh, seed=seed, payload_dtype=variant.payload_dtype, depth_epsilon=depth_epsilon,
+                clear_color=session_background(session))
+        except BaseException:
+            self._scope.release()
+            raise
+
+    @property
+    def period(self) -> int:
+        return self.runtime.period
+
+    @period.setter
+    def period(self, value: int) -> None:
+        self.runtime.period = value
+
+    def reset(self) -> None:
+        """Empty the cache: the next frame misses everywhere."""
+        self.runtime.reset()
+        self._last = None
+
+    def _frame(self, index: int, hit_box: Optional[dict]):
+        after = None
+        if hit_box is not None:
+            def after():
+                hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
+        return self.runtime.frame(self.drawer.draw, after_first_pass=after)
+
+    def render_frame(self, index: int) -> CachedFrame:
+        """Render frame ``index`` with the cache. The first call renders it once untimed to warm
+        up llvmpipe's shader compilation, then resets the cache."""
+        index = check_frame_index(self.session, index)
+        ctx = self.ctx
+        if self._last is not None and index != self._last + 1:
+            self.runtime.reset()
+        self.drawer.set_frame(index)
+        if not self._warm:
+            self._frame(index, None)
+            self.runtime.reset()
+            self._warm = True
+        hit_box = {} if self.hit_maps else None
+        ctx.finish()
+        start = time.perf_counter()
+        stats = self._frame(index, hit_box)
+        ctx.finish()
+        ms = (time.perf_counter() - start) * 1000.0
+        self._last = index
+        image = self.runtime.read_color()
+        mask = self.runtime.read_depth() < 1.0
+        covered = int(mask.sum())
+        misses = min(int(stats.misses or 0), covered) if stats.misses is not None else covered
+        hit_map = hit_box.get("map") if hit_box is not None else None
+        if hit_map is not None:
+            hits = int((hit_map & mask).sum())
+            misses = covered - hits
+        else:
+            hits = covered - misses
+        payload = self.runtime.read_payload() if self.keep_payload else None
+        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
+
+    def release(self) -> None:
+        """Release every GL object (safe to call twice)."""
+        runtime = getattr(self, "runtime", None)
+        if runtime is not None:
+            runtime.release()
+            self.runtime = None
+        self._scope.release()
+
+    def __enter__(self) -> "CachedRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+@dataclass
+class FrameComparison:
+    index: int
+    mean_error: float
+    psnr: float
+    hits: int
+    misses: int
+    covered: int
+    ms: float
+    original_ms: float
+    nonfinite: int = 0
+    left_out: int = 0
+
+
+@dataclass
+class Comparison:
+    """The variant against the original over the frames of one run (timed side by side)."""
+
+    frames: list[FrameComparison] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    resolution: tuple[int, int] = (0, 0)
+    skip_first: int = 1  # frames left out of the summary: the first one has no cache
+
+    def _steady(self) -> list[FrameComparison]:
+        steady = self.frames[self.skip_first:]
+        return steady or self.frames
+
+    @property
+    def mean_error(self) -> float:
+        return float(np.mean([f.mean_error for f in self._steady()]))
+
+    @property
+    def psnr(self) -> float:
+        return float(np.mean([min(f.psnr, 100.0) for f in self._steady()]))
+
+    @property
+    def hits(self) -> int:
+        return sum(f.hits for f in self._steady())
+
+    @property
+    def misses(self) -> int:
+        return sum(f.misses for f in self._steady())
+
+    @property
+    def hit_rate(self) -> float:
+        total = self.hits + self.misses
+        return self.hits / total if total else 0.0
+
+    @property
+    def ms_per_frame(self) -> float:
+        return statistics.median(f.ms for f in self._steady())
+
+    @property
+    def original_ms_per_frame(self) -> float:
+        return statistics.median(f.original_ms for f in self._steady())
+
+    @property
+    def speedup(self) -> float:
+        return self.original_ms_per_frame / self.ms_per_frame if self.ms_per_frame > 0 else float("nan")
+
+    def summary(self) -> dict:
+        """The figures ``rrcache render --node ... --json`` prints."""
+        return {
+            "mean_error": self.mean_error, "psnr": self.psnr, "hit_rate": self.hit_rate,
+            "hits": self.hits, "misses": self.misses, "ms_per_frame": self.ms_per_frame,
+            "original_ms_per_frame": self.original_ms_per_frame, "speedup": self.speedup,
+        }
+
+
+def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
+            resolution: Optional[tuple[int, int]] = None, block: int = 4, refresh: str = "random",
+            depth_epsilon: float = 1e-3, hit_maps: bool = False,
+            on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None) -> Comparison:
+    """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
+    frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
+    is called per frame (for progress bars and writing images)."""
+    result = Comparison()
+    with Renderer(prepared, session, resolution) as original, \
+            CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
+                           depth_epsilon=depth_epsilon, hit_maps=hit_maps) as cached:
+        result.resolution = original.size
+        result.notes = list(original.notes)
+        for index in frames:
+            ref = original.render_frame(index)
+            got = cached.render_frame(index)
+            err, left_out = mean_l2(got.image, ref.image, ref.mask)
+            row = FrameComparison(index, float(err), float(psnr(got.image, ref.image)), got.hits, got.misses,
+                                  got.covered_pixels, got.ms, ref.ms, nonfinite_count(got.image), int(left_out))
+            result.frames.append(row)
+            if on_frame is not None:
+                on_frame(row, got, ref)
+    return result

@@ -1,0 +1,179 @@
+"""Drawing a session's objects with any program: the part of the harness shared by the plain
+renderer and the cached one (one program per pass).
+
+:class:`SceneDrawer` uploads meshes and textures once, checks each program it is given against
+the session (:func:`rrcache.harness.bindings.plan_bindings`), and per frame sets the built-in
+uniforms of DESIGN.md §4 (camera, light, time, matrices, the previous frame's
+model-view-projection for reprojection), the session's uniforms and samplers, and renders every
+object, culling back faces unless the object is ``double_sided``.
+
+>>> drawer = SceneDrawer(ctx, session, prepared, (640, 480), scope)    # doctest: +SKIP
+>>> drawer.add_program(program)                                         # doctest: +SKIP
+>>> drawer.set_frame(10); drawer.draw(program)                          # doctest: +SKIP
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import moderngl
+import numpy as np
+
+from rrcache.errors import UnsupportedShaderError
+from rrcache.gl.resources import GLScope
+from rrcache.gl.textures import texture_from_asset
+from rrcache.gl.uniforms import write_uniform
+from rrcache.harness.bindings import BUILTINS, BindingPlan, lookup, plan_bindings
+from rrcache.harness.prepare import PreparedShader
+from rrcache.harness.vertex import ATTRIBUTES
+
+# value for a vertex attribute the mesh does not have
+_DEFAULTS = {"normal": (0.0, 0.0, 1.0), "texcoord": (0.0, 0.0), "color": (1.0, 1.0, 1.0, 1.0),
+             "tangent": (1.0, 0.0, 0.0, 1.0)}
+_FIELDS = {"position": "positions", "normal": "normals", "texcoord": "texcoords", "color": "colors",
+           "tangent": "tangents"}
+
+
+def normal_matrix(model: np.ndarray) -> np.ndarray:
+    """The world-space normal matrix (inverse transpose of the model matrix's 3×3 part)."""
+    m3 = np.asarray(model, dtype=np.float64)[:3, :3]
+    try:
+        return np.linalg.inv(m3).T
+    except np.linalg.LinAlgError:  # a zero scale: no meaningful normals, keep the rotation part
+        return m3
+
+
+class SceneDrawer:
+    """Draws the objects of ``session`` at ``size`` with programs registered by
+    :meth:`add_program`. GL objects are owned by ``scope``."""
+
+    def __init__(self, ctx: moderngl.Context, session, prepared: PreparedShader, size: tuple[int, int],
+                 scope: GLScope, cull_back_faces: Optional[bool] = None):
+        self.ctx = ctx
+        self.session = session
+        self.prepared = prepared
+        self.size = size
+        self.scope = scope
+        self.cull_back_faces = cull_back_faces
+        self.notes: list[str] = []
+        self._plans: dict[int, BindingPlan] = {}
+        self._vaos: dict[int, list] = {}
+        self._buffers: dict[tuple[int, str], moderngl.Buffer] = {}
+        self._indices: dict[int, moderngl.Buffer] = {}
+        self._textures: dict[str, tuple[int, moderngl.Texture]] = {}
+        self._frame: Optional[int] = None
+        self._per_object: list = []
+
+    # ------------------------------------------------------------------ programs
+    def add_program(self, program: moderngl.Program) -> BindingPlan:
+        """Check ``program`` against the session, upload what it needs, and remember it."""
+        plan = plan_bindings(program, self.prepared, self.session)
+        for name, uniform, _kind in plan.samplers:
+            unit, _tex = self._texture(name)
+            uniform.value = unit
+        self._plans[id(program)] = plan
+        self._vaos[id(program)] = [self._object_vao(program, i, obj) for i, obj in enumerate(self.session.objects)]
+        for note in plan.notes:
+            if note not in self.notes:
+                self.notes.append(note)
+        return plan
+
+    def _texture(self, name: str):
+        if name not in self._textures:
+            tex = self.scope.own(texture_from_asset(self.ctx, self.session.textures[name]))
+            self._textures[name] = (len(self._textures), tex)
+        return self._textures[name]
+
+    def _buffer(self, index: int, obj, attr: str, size: int) -> moderngl.Buffer:
+        key = (index, attr)
+        if key not in self._buffers:
+            mesh = obj.mesh
+            n = int(np.asarray(mesh.positions).shape[0])
+            data = getattr(mesh, _FIELDS[attr], None)
+            if data is None:
+                data = np.tile(np.asarray(_DEFAULTS[attr], np.float32), (n, 1))
+            data = np.ascontiguousarray(np.asarray(data, np.float32).reshape(n, size))
+            self._buffers[key] = self.scope.own(self.ctx.buffer(data.tobytes()))
+        return self._buffers[key]
+
+    def _object_vao(self, program: moderngl.Program, index: int, obj):
+        content = []
+        for attr, (glsl_type, _define) in ATTRIBUTES.items():
+            name = f"a_{attr}"
+            if name not in program or not isinstance(program[name], moderngl.Attribute):
+                continue
+            size = int(glsl_type[-1])
+            content.append((self._buffer(index, obj, attr, size), f"{size}f", name))
+        if index not in self._indices:
+            indices = np.ascontiguousarray(np.asarray(obj.mesh.indices, np.uint32).reshape(-1))
+            self._indices[index] = self.scope.own(self.ctx.buffer(indices.tobytes()))
+        return self.scope.own(self.ctx.vertex_array(program, content, self._indices[index], index_element_size=4))
+
+    # ------------------------------------------------------------------ frames
+    def set_frame(self, index: int) -> None:
+        """Compute the camera, light and per-object matrices of frame ``index`` (and ``index - 1``
+        for reprojection; frame 0 uses itself)."""
+        session = self.session
+        w, h = self.size
+        prev = max(index - 1, 0)
+        cam, cam_prev = session.camera_at(index), session.camera_at(prev)
+        self._view, self._proj = cam.view, cam.projection(w / h)
+        view_proj = self._proj @ self._view
+        prev_view_proj = cam_prev.projection(w / h) @ cam_prev.view
+        self._camera = cam
+        self._light = session.light_at(index)
+        self._values = session.uniform_values(index)
+        self._frame = index
+        self._per_object = []
+        for obj in session.objects:
+            model = obj.model_matrix(index)
+            cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
+            self._per_object.append((model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev),
+                                     normal_matrix(model), cull))
+
+    def _set_builtin(self, plan: BindingPlan, name: str, value) -> None:
+        uniform = plan.builtins.get(name)
+        if uniform is None:
+            return
+        try:
+            write_uniform(uniform, value)
+        except ValueError:
+            decl = self.prepared.declaration(name)
+            raise UnsupportedShaderError(
+                f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
+                decl.loc if decl is not None else None,
+                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
+
+    def draw(self, program: moderngl.Program, _pass_name: str = "") -> None:
+        """Draw every object of the current frame with ``program`` into the bound framebuffer
+        (depth testing is the caller's; back-face culling is set per object)."""
+        if self._frame is None:
+            raise RuntimeError("SceneDrawer.draw before set_frame")
+        ctx = self.ctx
+        plan = self._plans[id(program)]
+        w, h = self.size
+        index = self._frame
+        set_builtin = self._set_builtin
+        set_builtin(plan, "u_camera", self._camera.eye)
+        set_builtin(plan, "u_light", self._light.position)
+        set_builtin(plan, "u_lightColor", self._light.color)
+        set_builtin(plan, "u_resolution", (float(w), float(h)))
+        set_builtin(plan, "u_time", index / self.session.fps)
+        set_builtin(plan, "u_frame", index)
+        set_builtin(plan, "u_viewMatrix", self._view)
+        set_builtin(plan, "u_projectionMatrix", self._proj)
+        for name, uniform in plan.session:
+            write_uniform(uniform, lookup(self._values, name))
+        for name, _uniform, _kind in plan.samplers:
+            unit, tex = self._textures[name]
+            tex.use(location=unit)
+        ctx.cull_face = "back"
+        for vao, (model, mvp, prev_mvp, nmat, cull) in zip(self._vaos[id(program)], self._per_object):
+            if cull:
+                ctx.enable(moderngl.CULL_FACE)
+            else:
+                ctx.disable(moderngl.CULL_FACE)
+            set_builtin(plan, "u_modelMatrix", model)
+            set_builtin(plan, "u_modelViewProjectionMatrix", mvp)
+            set_builtin(plan, "u_normalMatrix", nmat)
+            set_builtin(plan, "u_prevModelViewProjectionMatrix", prev_mvp)
+            vao.render(moderngl.TRIANGLES)
