@@ -129,3 +129,44 @@ def test_back_faces_are_culled_unless_the_object_is_double_sided(tmp_path, doubl
     result = render(str(shader), load_session(path), frames=1)
     covered = result.frames[0].covered_pixels
     assert (covered > 100) if double_sided else (covered == 0)
+
+
+def _final_node(shader, session, capsys):
+    main(["nodes", str(shader), "--session", str(session), "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    return doc["nodes"][-1]["id"]
+
+
+def test_render_node_compares_with_the_original(files, capsys):
+    shader, session = files
+    node = _final_node(shader, session, capsys)
+    main(["render", str(shader), str(session), "--node", node, "--period", "1", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    keys = {"mean_error", "psnr", "hit_rate", "hits", "misses", "ms_per_frame", "original_ms_per_frame", "speedup"}
+    assert keys <= set(doc)
+    assert doc["mean_error"] <= 1e-6 and doc["hit_rate"] == 0.0 and doc["hits"] == 0
+    main(["render", str(shader), str(session), "--node", node, "--period", "2", "--json", "--algorithm", "two-pass"])
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["hits"] > 0 and doc["speedup"] > 0
+
+
+def test_render_unknown_node_is_a_clear_error(files, capsys):
+    shader, session = files
+    with pytest.raises(SystemExit) as info:
+        main(["render", str(shader), str(session), "--node", "n999999"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert "n999999" in err and "rrcache nodes" in err and "Traceback" not in err
+
+
+def test_instance_writes_every_pass_and_a_manifest(files, tmp_path, capsys):
+    shader, session = files
+    node = _final_node(shader, session, capsys)
+    out = tmp_path / "variant"
+    main(["instance", str(shader), "--node", node, "--period", "12", "--session", str(session), "--out", str(out)])
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["period"] == 12 and manifest["node"]["id"] == node
+    for name in ("reproject", "payload", "shade"):
+        assert (out / f"{name}.frag").read_text().startswith("#version 330")
+        assert (out / f"{name}.vert").exists()
+    assert "u_gain" in manifest["uniforms"]

@@ -17,6 +17,7 @@ from rrcache.errors import RRCacheError
 _COMMANDS = {
     "nodes": "nodes",
     "bench-frontend": "bench_frontend",
+    "instance": "instance",
     "render": "render",
 }
 

@@ -87,9 +87,18 @@ def format_table(table, show_all: bool) -> str:
               help="Define a preprocessor macro (repeatable).")
 @click.option("--max-unroll", type=click.IntRange(min=0), default=64, show_default=True,
               help="Unroll constant loops of at most this many iterations.")
-def command(shader, as_json, show_all, define, max_unroll):
+@click.option("--session", type=click.Path(dir_okay=False), default=None,
+              help="Apply the MODEL_VERTEX_* defines of this session's meshes, as `rrcache render` "
+                   "and `rrcache profile` do (node ids depend on the defines).")
+def command(shader, as_json, show_all, define, max_unroll, session):
     """List the nodes of SHADER that a reprojection cache can hold."""
-    loaded = load_shader(shader, parse_defines(define))
+    defines = parse_defines(define)
+    if session is not None:
+        from rrcache.harness.vertex import mesh_defines, session_attributes
+        from rrcache.session import load_session
+
+        defines = {**mesh_defines(session_attributes(load_session(session))), **defines}
+    loaded = load_shader(shader, defines)
     table = cacheable_nodes(loaded, max_iterations=max_unroll)
     if as_json:
         doc = table.to_json(shader)

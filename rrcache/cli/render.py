@@ -2,6 +2,11 @@
 
     rrcache render marble.frag session.json --frames 10 --out frames/ -D OCTAVES=5
     rrcache render marble.frag session.json --resolution 64x48 --json
+    rrcache render marble.frag session.json --node n2575 --period 16 --json
+
+With ``--node`` the variant caching that node is rendered beside the original, frame by frame in
+one run, and compared: error, PSNR, hit rate, and the speed-up as a ratio of median frame times
+(the first frame, which has no cache, is left out of the summary).
 
 With ``--out`` each frame is written as ``frame_NNNN.exr`` (float, exact) and ``frame_NNNN.png``.
 The summary is a table (or, with ``--json``, an object with ``frames``, ``resolution``,
@@ -21,6 +26,7 @@ from rich.table import Table
 from rrcache.harness.images import write_image
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, parse_resolution, render
+from rrcache.runtime import ALGORITHMS, FILTERS, REFRESH_MODES
 from rrcache.session import load_session
 
 
@@ -60,10 +66,29 @@ def _resolution(ctx, param, value):
               help="Render at this size instead of the session's.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
-def command(shader, session, out_dir, frame_count, resolution, as_json, defines):
-    """Render SESSION through the fragment shader SHADER and report time and coverage per frame."""
+@click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
+@click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
+@click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
+@click.option("--block", type=click.Choice(["1", "2", "4", "8"]), default="4", show_default=True,
+              help="Refresh block size k (pixels).")
+@click.option("--refresh", type=click.Choice(REFRESH_MODES), default="random", show_default=True)
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
+              help="Payload reconstruction filter.")
+@click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
+              help="Cache precision: 32- or 16-bit float.")
+@click.option("--depth-epsilon", type=float, default=1e-3, show_default=True,
+              help="Relative tolerance of the reprojected depth test.")
+def command(shader, session, out_dir, frame_count, resolution, as_json, defines, node, period, algorithm,
+            block, refresh, filter_, payload, depth_epsilon):
+    """Render SESSION through the fragment shader SHADER and report time and coverage per frame;
+    with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
     loaded = load_session(session)
+    if node is not None:
+        _render_cached(shader, loaded, parse_defines(defines), node, out_dir, frame_count, resolution, as_json,
+                       dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
+                            filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console)
+        return
     prepared = prepare_file(shader, loaded, parse_defines(defines))
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
@@ -105,3 +130,55 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines)
     console.print(table)
     console.print(f"median {result.ms_per_frame:.2f} ms per frame over {len(result.frames)} frames"
                   + (f"; images in {out}" if out is not None else ""), highlight=False)
+
+
+def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resolution, as_json, opts, err_console):
+    from rrcache.harness.cached import compare
+    from rrcache.pipeline import load_for_session, variant_for
+
+    work = load_for_session(shader, loaded, defines)
+    entry = work.node(node)
+    variant = variant_for(work, node, opts["period"], opts["algorithm"], opts["filter"], opts["payload"])
+    indices = frame_indices(loaded, frame_count)
+    out = Path(out_dir) if out_dir else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    show_progress = len(indices) > 1 and err_console.is_terminal
+    progress = Progress(TextColumn(f"caching {node} at Δn={opts['period']}"), BarColumn(), MofNCompleteColumn(),
+                        TimeElapsedColumn(), console=err_console, transient=True, disable=not show_progress)
+    with progress:
+        task = progress.add_task("render", total=len(indices))
+
+        def done(row, got, ref):
+            if out is not None:
+                stem = out / f"frame_{row.index:04d}"
+                write_image(stem.with_suffix(".exr"), got.image)
+                write_image(stem.with_suffix(".png"), got.image)
+                write_image(out / f"original_{row.index:04d}.png", ref.image)
+            progress.advance(task)
+
+        result = compare(variant, loaded, work.prepared, indices, period=opts["period"], resolution=resolution,
+                         block=opts["block"], refresh=opts["refresh"], depth_epsilon=opts["depth_epsilon"],
+                         on_frame=done)
+    for note in result.notes:
+        err_console.print(f"note: {note}", highlight=False, markup=False)
+    summary = result.summary()
+    if as_json:
+        click.echo(json.dumps(dict(
+            frames=len(result.frames), resolution=list(result.resolution), node=node, period=opts["period"],
+            algorithm=opts["algorithm"], covered_pixels=[f.covered for f in result.frames], **summary)))
+        return
+    console = Console()
+    table = Table(title=f"{work.prepared.path} caching {node} ({entry.type}, line {entry.line}) "
+                        f"at Δn={opts['period']}, {opts['algorithm']}")
+    for col in ("frame", "covered", "hit rate", "mean error", "PSNR dB", "ms", "original ms"):
+        table.add_column(col, justify="right")
+    for f in result.frames:
+        rate = f.hits / f.covered if f.covered else 0.0
+        table.add_row(str(f.index), str(f.covered), f"{rate:.3f}", f"{f.mean_error:.5f}",
+                      f"{min(f.psnr, 999):.1f}", f"{f.ms:.2f}", f"{f.original_ms:.2f}")
+    console.print(table)
+    console.print(f"node {node}: {entry.text}", highlight=False, markup=False)
+    console.print(f"speed-up {summary['speedup']:.2f}× ({summary['ms_per_frame']:.2f} ms vs "
+                  f"{summary['original_ms_per_frame']:.2f} ms, medians), hit rate {summary['hit_rate']:.3f}, "
+                  f"mean error {summary['mean_error']:.5f}, PSNR {summary['psnr']:.1f} dB", highlight=False)

@@ -65,6 +65,7 @@ class Variant:
     forms: dict[str, str] = field(default_factory=dict)
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
+    period: Optional[int] = None  # the refresh period Δn chosen for this variant (None: runtime default)
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -93,6 +94,7 @@ class Variant:
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
             "default_period": default_period(),
+            "period": self.period if self.period is not None else default_period(),
             "passes": {
                 name: {
                     "vertex": f"{name}.vert", "fragment": f"{name}.frag",
