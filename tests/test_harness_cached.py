@@ -85,7 +85,10 @@ def test_period_one_matches_the_original(gl_ctx, orbit, algorithm):
     table, prepared, node = _setup(shader, session, "vec3(b, b * b, 1.0 - b)")
     result = compare(instance(table, node.id, algorithm), session, prepared, range(4), period=1)
     assert all(f.mean_error <= 1e-6 for f in result.frames)
-    assert result.hit_rate == 0.0
+    if algorithm == "one-pass":  # a dynamic branch: no pass boundary for a query to count at
+        assert result.hits is None and np.isnan(result.hit_rate)
+    else:
+        assert result.hit_rate == 0.0
     assert result.frames[-1].covered > 500
 
 

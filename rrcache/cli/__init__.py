@@ -18,6 +18,7 @@ _COMMANDS = {
     "nodes": "nodes",
     "bench-frontend": "bench_frontend",
     "instance": "instance",
+    "bench-cache": "bench_cache",
     "render": "render",
 }
 

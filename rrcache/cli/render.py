@@ -174,8 +174,8 @@ def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resoluti
     for col in ("frame", "covered", "hit rate", "mean error", "PSNR dB", "ms", "original ms"):
         table.add_column(col, justify="right")
     for f in result.frames:
-        rate = f.hits / f.covered if f.covered else 0.0
-        table.add_row(str(f.index), str(f.covered), f"{rate:.3f}", f"{f.mean_error:.5f}",
+        rate = "n/a" if f.hits is None else f"{f.hits / f.covered if f.covered else 0.0:.3f}"
+        table.add_row(str(f.index), str(f.covered), rate, f"{f.mean_error:.5f}",
                       f"{min(f.psnr, 999):.1f}", f"{f.ms:.2f}", f"{f.original_ms:.2f}")
     console.print(table)
     console.print(f"node {node}: {entry.text}", highlight=False, markup=False)

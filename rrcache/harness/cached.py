@@ -42,8 +42,8 @@ class CachedFrame:
     image: np.ndarray
     mask: np.ndarray
     covered_pixels: int
-    hits: int
-    misses: int
+    hits: Optional[int]
+    misses: Optional[int]
     ms: float
     hit_map: Optional[np.ndarray] = None
     payload: Optional[np.ndarray] = None
@@ -127,15 +127,43 @@ class CachedRenderer:
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0
         covered = int(mask.sum())
-        misses = min(int(stats.misses or 0), covered) if stats.misses is not None else covered
         hit_map = hit_box.get("map") if hit_box is not None else None
         if hit_map is not None:
             hits = int((hit_map & mask).sum())
             misses = covered - hits
-        else:
+        elif stats.misses is not None:
+            misses = min(int(stats.misses), covered)
             hits = covered - misses
+        else:  # one-pass: a dynamic branch, nothing for a query to count
+            hits = misses = None
         payload = self.runtime.read_payload() if self.keep_payload else None
         return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
+
+    def render_static(self, index: int, repeats: int = 5) -> float:
+        """The cached pipeline's best case: frame ``index`` shown again and again with nothing
+        moving and no refresh, so every covered pixel hits after the first showing. Returns the
+        median ms of the ``repeats`` hitting frames (the speed-up limit's denominator). The cache
+        is reset afterwards and the period restored."""
+        index = check_frame_index(self.session, index)
+        saved = self.runtime.period
+        self.runtime.period = 2 ** 30
+        self.runtime.reset()
+        self.drawer.set_frame(index, static=True)
+        times = []
+        try:
+            for i in range(repeats + 2):
+                self.ctx.finish()
+                start = time.perf_counter()
+                stats = self.runtime.frame(self.drawer.draw)
+                self.ctx.finish()
+                if i >= 2:
+                    times.append((time.perf_counter() - start) * 1000.0)
+            self.last_static_stats = stats
+        finally:
+            self.runtime.period = saved
+            self.runtime.reset()
+            self._last = None
+        return statistics.median(times)
 
     def release(self) -> None:
         """Release every GL object (safe to call twice)."""
@@ -157,8 +185,8 @@ class FrameComparison:
     index: int
     mean_error: float
     psnr: float
-    hits: int
-    misses: int
+    hits: Optional[int]
+    misses: Optional[int]
     covered: int
     ms: float
     original_ms: float
@@ -188,15 +216,21 @@ class Comparison:
         return float(np.mean([min(f.psnr, 100.0) for f in self._steady()]))
 
     @property
-    def hits(self) -> int:
-        return sum(f.hits for f in self._steady())
+    def hits(self) -> Optional[int]:
+        """Hits summed over the steady frames (None when the algorithm cannot count them:
+        one-pass without ``hit_maps``)."""
+        counted = [f.hits for f in self._steady() if f.hits is not None]
+        return sum(counted) if counted else None
 
     @property
-    def misses(self) -> int:
-        return sum(f.misses for f in self._steady())
+    def misses(self) -> Optional[int]:
+        counted = [f.misses for f in self._steady() if f.misses is not None]
+        return sum(counted) if counted else None
 
     @property
     def hit_rate(self) -> float:
+        if self.hits is None:
+            return float("nan")
         total = self.hits + self.misses
         return self.hits / total if total else 0.0
 

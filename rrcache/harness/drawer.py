@@ -109,12 +109,13 @@ class SceneDrawer:
         return self.scope.own(self.ctx.vertex_array(program, content, self._indices[index], index_element_size=4))
 
     # ------------------------------------------------------------------ frames
-    def set_frame(self, index: int) -> None:
+    def set_frame(self, index: int, static: bool = False) -> None:
         """Compute the camera, light and per-object matrices of frame ``index`` (and ``index - 1``
-        for reprojection; frame 0 uses itself)."""
+        for reprojection; frame 0 uses itself). ``static``: the previous frame is this frame too
+        (a frame shown again, as when measuring the cache with every pixel hitting)."""
         session = self.session
         w, h = self.size
-        prev = max(index - 1, 0)
+        prev = index if static else max(index - 1, 0)
         cam, cam_prev = session.camera_at(index), session.camera_at(prev)
         self._view, self._proj = cam.view, cam.projection(w / h)
         view_proj = self._proj @ self._view

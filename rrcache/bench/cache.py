@@ -1,0 +1,126 @@
+"""The cache benchmark (`rrcache bench-cache`): one node of one scene, side by side with the
+original in one run (issue 4; Sitthi-amorn 2008a Figs. 8–9).
+
+- the node cached at several refresh periods (three-pass, k = 4): speed-up, hit rate, mean error,
+  PSNR;
+- the three algorithms at one period;
+- refresh block sizes k = 1, 2, 4 at that period;
+- the limit: the cached pipeline's frame time when every pixel hits (the frame shown again with
+  nothing moving and no refresh), as a fraction of the original's, and the speed-up that bounds.
+
+Every speed-up is a ratio of median frame times measured in the same run, the original and the
+variant rendered alternately frame by frame (:func:`rrcache.harness.cached.compare`).
+"""
+from __future__ import annotations
+
+import statistics
+from dataclasses import asdict, dataclass, field
+from typing import Callable, Optional
+
+from rrcache.harness.cached import CachedRenderer, compare
+from rrcache.harness.renderer import Renderer
+from rrcache.pipeline import load_for_session, variant_for
+from rrcache.session import load_session
+
+
+@dataclass
+class BenchRow:
+    label: str
+    algorithm: str
+    period: int
+    block: int
+    speedup: float
+    hit_rate: float
+    mean_error: float
+    psnr: float
+    ms_per_frame: float
+    original_ms_per_frame: float
+
+
+@dataclass
+class CacheBench:
+    shader: str
+    session: str
+    node: str
+    node_text: str
+    resolution: tuple[int, int]
+    frames: int
+    periods: list[BenchRow] = field(default_factory=list)
+    algorithms: list[BenchRow] = field(default_factory=list)
+    blocks: list[BenchRow] = field(default_factory=list)
+    limit_ms: float = float("nan")
+    limit_original_ms: float = float("nan")
+
+    @property
+    def limit_fraction(self) -> float:
+        """The all-hit cached frame time as a fraction of the original's."""
+        return self.limit_ms / self.limit_original_ms
+
+    @property
+    def limit_speedup(self) -> float:
+        return self.limit_original_ms / self.limit_ms
+
+    def to_json(self) -> dict:
+        doc = asdict(self)
+        doc["limit_fraction"] = self.limit_fraction
+        doc["limit_speedup"] = self.limit_speedup
+        return doc
+
+    def markdown(self) -> str:
+        """The tables as Markdown (for the README)."""
+        lines = [f"`{self.shader}` × `{self.session}`, caching `{self.node}` (`{self.node_text}`), "
+                 f"{self.resolution[0]}×{self.resolution[1]}, {self.frames} frames", ""]
+        header = "| | algorithm | Δn | k | speed-up | hit rate | mean error | PSNR dB | ms | original ms |"
+        rule = "|---|---|---|---|---|---|---|---|---|---|"
+        for title, rows in (("refresh period", self.periods), ("algorithm", self.algorithms),
+                            ("refresh block", self.blocks)):
+            lines += [f"**{title}**", "", header, rule]
+            for r in rows:
+                lines.append(f"| {r.label} | {r.algorithm} | {r.period} | {r.block} | {r.speedup:.2f}× | "
+                             f"{'n/a' if r.hit_rate != r.hit_rate else format(r.hit_rate, '.3f')} | {r.mean_error:.4f} | {r.psnr:.1f} | {r.ms_per_frame:.1f} | "
+                             f"{r.original_ms_per_frame:.1f} |")
+            lines.append("")
+        lines.append(f"Limit (every pixel hits): {self.limit_ms:.1f} ms against {self.limit_original_ms:.1f} ms, "
+                     f"{100 * self.limit_fraction:.0f}% of the original: at most {self.limit_speedup:.2f}×.")
+        return "\n".join(lines)
+
+
+def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
+        frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
+        progress: Optional[Callable[[str], None]] = None) -> CacheBench:
+    """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration."""
+    say = progress or (lambda _msg: None)
+    session = load_session(session_path)
+    work = load_for_session(shader_path, session)
+    entry = work.node(node_id)
+    indices = range(start, min(start + frames, session.frames))
+    size = resolution or session.resolution
+    bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices))
+
+    def row(label, algorithm, period, block):
+        say(f"{label}: {algorithm}, Δn={period}, k={block}")
+        variant = variant_for(work, node_id, period, algorithm)
+        c = compare(variant, session, work.prepared, indices, period=period, resolution=resolution, block=block)
+        return BenchRow(label, algorithm, period, block, c.speedup, c.hit_rate, c.mean_error, c.psnr,
+                        c.ms_per_frame, c.original_ms_per_frame)
+
+    for period in periods:
+        bench.periods.append(row(f"Δn={period}", "three-pass", period, 4))
+    for algorithm in ("three-pass", "two-pass", "one-pass"):
+        bench.algorithms.append(row(algorithm, algorithm, compare_period, 4))
+    for block in (1, 2, 4):
+        bench.blocks.append(row(f"k={block}", "three-pass", compare_period, block))
+
+    say("limit: every pixel hits")
+    probe = list(indices)[:: max(1, len(indices) // 5)][:5]
+    variant = variant_for(work, node_id, compare_period)
+    cached_ms, original_ms = [], []
+    with Renderer(work.prepared, session, resolution) as original, \
+            CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:
+        for index in probe:
+            original.render_frame(index)
+            original_ms.append(statistics.median(original.render_frame(index).ms for _ in range(5)))
+            cached_ms.append(cached.render_static(index, repeats=5))
+    bench.limit_ms = statistics.median(cached_ms)
+    bench.limit_original_ms = statistics.median(original_ms)
+    return bench
