@@ -140,8 +140,8 @@ def test_discard_before_and_after_the_node(gl_ctx):
         for algorithm in ALGORITHMS:
             variant = instance(table, t_node[0].id, algorithm)
             assert "discard" in variant.passes[variant.pass_names[0]].fragment
-            if algorithm == "three-pass":  # pass 3 skips pixels that pass 2 discarded
-                assert "if (rr_current().w == 0.0)" in variant.passes["shade"].fragment
+            # pass 2 discards where the value says so; the final pass's == depth test then
+            # shades the surface behind, not this fragment from an empty payload
             images, _ = render_variant(scene, variant, 3, period=1)
             for img, want in zip(images, ref):
                 assert np.abs(img - want).max() <= 1e-5, algorithm

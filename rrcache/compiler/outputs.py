@@ -30,15 +30,11 @@ def float_lit(value: float) -> A.FloatLit:
     return A.FloatLit(float(value), text=repr(float(value)))
 
 
-def pack(value: A.Expr, components: int, marker: bool = False) -> A.Expr:
-    """``value`` (float or vec2-4) padded with zeros to the vec4 payload; with ``marker`` (1 to
-    3 components only) the last channel is 1.0 instead: "this pixel holds a payload"."""
+def pack(value: A.Expr, components: int) -> A.Expr:
+    """``value`` (float or vec2-4) padded with zeros to the vec4 payload."""
     if components == 4:
         return value
-    pad = [float_lit(0.0) for _ in range(4 - components)]
-    if marker:
-        pad[-1] = float_lit(1.0)
-    return A.Call("vec4", [value] + pad)
+    return A.Call("vec4", [value] + [float_lit(0.0) for _ in range(4 - components)])
 
 
 def unpack(payload: A.Expr, components: int) -> A.Expr:

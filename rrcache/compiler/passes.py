@@ -18,11 +18,9 @@ al. 2008a §3; DESIGN.md §3):
                writes; colour and cache outputs
 =============  ==========================================================================
 
-Marker: in the three-pass algorithm, a ``discard`` after S that depends on E may fire in pass 2
-(payload) at a pixel; no depth is written there, so pass 3 shades it with an empty payload. When
-main has a ``discard`` after S and E has fewer than 4 components, the payload's last channel
-is set to 1.0 (:func:`~rrcache.compiler.outputs.pack` with ``marker``) and pass 3 starts S with
-``if (rr_current().w == 0.0) discard;``. (A vec4 node has no spare channel: see the report.)
+A ``discard`` after S that depends on E (an alpha test on the cached value) is kept in every
+pass. Where it fires in pass 1 or 2 no depth is written, and the runtime's final pass tests depth
+with ``==``, so that fragment is not shaded from an empty payload and the surface behind it is.
 
 Every pass that writes the cache starts ``main`` with ``rr_outInvDepth = 0.0; rr_outPayload =
 vec4(0.0);``. Then the runtime's GLSL (:mod:`rrcache.runtime.glsl`) is parsed and put in front
@@ -53,11 +51,11 @@ from rrcache.glsl import ast as A
 from rrcache.glsl.parser import parse_source
 from rrcache.glsl.semantic import check
 from rrcache.analysis._tree import clone
-from rrcache.compiler._ast import main_function, walk
+from rrcache.compiler._ast import main_function
 from rrcache.compiler.feeders import move_feeders
 from rrcache.compiler.hoist import declare, hoist, insert_before
-from rrcache.compiler.locate import PLACEHOLDER, Located, find_site
-from rrcache.compiler.outputs import cache_init, cache_writes, float_lit, pack, set_color_output
+from rrcache.compiler.locate import Located, find_site
+from rrcache.compiler.outputs import cache_init, cache_writes, pack, set_color_output
 from rrcache.compiler.prune import prune
 from rrcache.compiler.replace import (
     NODE_VAR, current_value, node_variable, previous_payload, previous_value, replace_node,
@@ -132,17 +130,6 @@ def _set(name: str, value: A.Expr) -> A.ExprStmt:
     return A.ExprStmt(A.Assign("=", A.Ident(name), value))
 
 
-def discard_after(unit: A.TranslationUnit) -> bool:
-    """Whether ``main`` has a ``discard`` after the placeholder (in source order)."""
-    seen = False
-    for n in walk(main_function(unit).body):
-        if isinstance(n, A.Ident) and n.name == PLACEHOLDER:
-            seen = True
-        elif seen and isinstance(n, A.Discard):
-            return True
-    return False
-
-
 def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
     """The transformed (not yet checked or pruned) unit of pass ``name``, and the binding form."""
     if name not in PASS_SPECS:
@@ -151,7 +138,6 @@ def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
     unit = clone(loc.unit)
     site = find_site(unit)
     n, t = loc.components, loc.type_name
-    marker = name in ("payload", "shade") and n < 4 and discard_after(unit)
     if name in ("reproject", "hit"):
         insert_before(site, [
             A.If(_miss_condition(), A.Discard()),
@@ -162,11 +148,8 @@ def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
         form = "replace"
     elif name in ("payload", "miss"):
         form = hoist(site, t, clone(loc.expr),
-                     then=cache_writes(pack(node_variable(), n, marker=marker)))
+                     then=cache_writes(pack(node_variable(), n)))
     elif name == "shade":
-        if marker:
-            empty = A.Binary("==", A.Field(A.Call("rr_current", []), "w"), float_lit(0.0))
-            insert_before(site, [A.If(empty, A.Discard())])
         replace_node(site.stmt, lambda: current_value(n))
         form = "replace"
     else:  # single

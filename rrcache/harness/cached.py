@@ -79,7 +79,8 @@ class CachedRenderer:
             self.notes = self.drawer.notes
             self.runtime = CacheRuntime(
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
-                refresh=refresh, seed=seed, payload_dtype=variant.payload_dtype, depth_epsilon=depth_epsilon,
+                refresh=refresh, seed=seed, payload_dtype=variant.payload_dtype,
+                payload_components=variant.components, depth_epsilon=depth_epsilon,
                 clear_color=session_background(session))
         except BaseException:
             self._scope.release()
@@ -99,11 +100,9 @@ class CachedRenderer:
         self._last = None
 
     def _frame(self, index: int, hit_box: Optional[dict]):
-        after = None
-        if hit_box is not None:
-            def after():
-                hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
-        return self.runtime.frame(self.drawer.draw, after_first_pass=after)
+        def read_hits():
+            hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
+        return self.runtime.frame(self.drawer.draw, after_first_pass=read_hits if hit_box is not None else None)
 
     def render_frame(self, index: int) -> CachedFrame:
         """Render frame ``index`` with the cache. The first call renders it once untimed to warm

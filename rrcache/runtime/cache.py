@@ -104,6 +104,7 @@ class CacheRuntime:
         refresh: str = "random",
         seed: int = 0,
         payload_dtype: str = "f4",
+        payload_components: int = 4,
         depth_epsilon: float = 1e-3,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
         cull_back_faces: Optional[bool] = None,
@@ -123,6 +124,9 @@ class CacheRuntime:
         self.programs = programs
         self.algorithm = algorithm
         self.payload_dtype = payload_dtype
+        if payload_components not in (1, 2, 3, 4):
+            raise ValueError(f"payload_components must be 1 to 4, not {payload_components}")
+        self.payload_components = int(payload_components)
         self.clear_color = clear_color
         self.cull_back_faces = cull_back_faces
         self.depth_epsilon = float(depth_epsilon)
@@ -179,7 +183,7 @@ class CacheRuntime:
         self.size = (w, h)
         self.depth = ctx.depth_texture((w, h))
         self.color = ctx.texture((w, h), 4, dtype="f4")
-        self._payload = [ctx.texture((w, h), 4, dtype=self.payload_dtype) for _ in range(2)]
+        self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
         self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
         for tex in self._payload + self._invdepth:
             tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
@@ -190,10 +194,14 @@ class CacheRuntime:
             self._cache_fbos = [
                 ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
             ]
+        # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
+        # the colour to the background; the payload needs no clear (it is read only where the
+        # inverse depth says a surface was cached)
+        self._clear_fbos = [ctx.framebuffer([self._invdepth[i]], self.depth) for i in range(2)]
         self._out_fbo = ctx.framebuffer([self.color], self.depth)
         self._color_only_fbo = ctx.framebuffer([self.color])
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
-                           self._out_fbo, self._color_only_fbo]
+                           *self._clear_fbos, self._out_fbo, self._color_only_fbo]
         self._make_refresh_texture()
         self.reset()
 
@@ -271,10 +279,15 @@ class CacheRuntime:
             ctx.enable(moderngl.CULL_FACE)
         elif self.cull_back_faces is False:
             ctx.disable(moderngl.CULL_FACE)
+        self._color_only_fbo.use()
+        self._color_only_fbo.clear(*self.clear_color)
+        clear_fbo = self._clear_fbos[self._index]
+        clear_fbo.depth_mask = True
+        clear_fbo.use()
+        clear_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         cache_fbo = self._cache_fbos[self._index]
         cache_fbo.depth_mask = True
         cache_fbo.use()
-        cache_fbo.clear(*self.clear_color, depth=1.0)
         ctx.depth_func = "<"
         covered = misses = None
         if self.algorithm == "three-pass":
@@ -283,8 +296,6 @@ class CacheRuntime:
                 after_first_pass()
                 cache_fbo.use()
             misses = self._run("payload", draw, count)
-            self._color_only_fbo.use()
-            self._color_only_fbo.clear(*self.clear_color)
             self._out_fbo.depth_mask = False
             self._out_fbo.use()
             ctx.depth_func = "=="
@@ -323,8 +334,13 @@ class CacheRuntime:
         return np.frombuffer(self.depth.read(), dtype=np.float32).reshape(h, w)[::-1].copy()
 
     def read_payload(self) -> np.ndarray:
-        """The last frame's cache payload, float32 (height, width, 4), row 0 = top."""
-        return self._read(self._payload[1 - self._index], 4)
+        """The last frame's cache payload, float32 (height, width, 4; unused channels 0), row 0
+        = top. Pixels where nothing was cached hold stale values: mask them with
+        :meth:`read_inverse_depth` > 0."""
+        payload = self._read(self._payload[1 - self._index], self.payload_components)
+        if self.payload_components < 4:
+            payload = np.concatenate([payload, np.zeros(payload.shape[:2] + (4 - self.payload_components,), np.float32)], axis=-1)
+        return payload
 
     def read_inverse_depth(self, current: bool = False) -> np.ndarray:
         """1/w of the visible surface per pixel (0 where nothing is cached), row 0 = top.
