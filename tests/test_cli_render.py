@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rrcache.cli import main
-from rrcache.cli.render import parse_defines
+from rrcache.cli.options import parse_defines
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import render
 from rrcache.session import load_session

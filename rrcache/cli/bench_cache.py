@@ -8,7 +8,7 @@ import json
 import click
 from rich.console import Console
 
-from rrcache.cli.render import _resolution
+from rrcache.cli.options import resolution_option as _resolution
 
 
 @click.command("bench-cache")

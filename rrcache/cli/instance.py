@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.render import parse_defines
+from rrcache.cli.options import parse_defines
 from rrcache.runtime import ALGORITHMS, FILTERS
 
 

@@ -17,25 +17,10 @@ import json
 import click
 
 from rrcache.analysis.cacheable import cacheable_nodes
+from rrcache.cli.options import parse_defines
 from rrcache.glsl.frontend import load_shader
 
 _TEXT_WIDTH = 70
-
-
-def parse_defines(items) -> dict[str, str]:
-    """``("A=1", "B")`` → ``{"A": "1", "B": "1"}``; a bad name is a ``click.BadParameter``.
-
-    >>> parse_defines(["OCTAVES=5", "FAST"])
-    {'OCTAVES': '5', 'FAST': '1'}
-    """
-    defines = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        name = name.strip()
-        if not name.isidentifier():
-            raise click.BadParameter(f"{item!r} is not NAME or NAME=VALUE", param_hint="-D")
-        defines[name] = value if sep else "1"
-    return defines
 
 
 def _short(text: str, width: int = _TEXT_WIDTH) -> str:

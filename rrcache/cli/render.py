@@ -23,36 +23,12 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
+from rrcache.cli.options import parse_defines, resolution_option
 from rrcache.harness.images import write_image
 from rrcache.harness.prepare import prepare_file
-from rrcache.harness.renderer import frame_indices, parse_resolution, render
+from rrcache.harness.renderer import frame_indices, render
 from rrcache.runtime import ALGORITHMS, FILTERS, REFRESH_MODES
 from rrcache.session import load_session
-
-
-def parse_defines(items) -> dict[str, str]:
-    """``("A=1", "B")`` → ``{"A": "1", "B": "1"}``; a bad name is a ``click.BadParameter``.
-
-    >>> parse_defines(["OCTAVES=5", "FAST"])
-    {'OCTAVES': '5', 'FAST': '1'}
-    """
-    defines = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        name = name.strip()
-        if not name.isidentifier():
-            raise click.BadParameter(f"{item!r} is not NAME or NAME=VALUE", param_hint="-D")
-        defines[name] = value if sep else "1"
-    return defines
-
-
-def _resolution(ctx, param, value):
-    if value is None:
-        return None
-    try:
-        return parse_resolution(value)
-    except ValueError as err:
-        raise click.BadParameter(str(err)) from None
 
 
 @click.command("render")
@@ -62,7 +38,7 @@ def _resolution(ctx, param, value):
               help="Write every frame here as EXR and PNG.")
 @click.option("--frames", "frame_count", type=click.IntRange(min=1), default=None,
               help="Render only the first N frames (default: all).")
-@click.option("--resolution", callback=_resolution, default=None, metavar="WxH",
+@click.option("--resolution", callback=resolution_option, default=None, metavar="WxH",
               help="Render at this size instead of the session's.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")

@@ -1,0 +1,32 @@
+"""Option parsing shared by the commands (``-D`` defines, ``--resolution``)."""
+from __future__ import annotations
+
+import click
+
+from rrcache.harness.renderer import parse_resolution
+
+
+def parse_defines(items) -> dict[str, str]:
+    """``("A=1", "B")`` → ``{"A": "1", "B": "1"}``; a bad name is a ``click.BadParameter``.
+
+    >>> parse_defines(["OCTAVES=5", "FAST"])
+    {'OCTAVES': '5', 'FAST': '1'}
+    """
+    defines = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not name.isidentifier():
+            raise click.BadParameter(f"{item!r} is not NAME or NAME=VALUE", param_hint="-D")
+        defines[name] = value if sep else "1"
+    return defines
+
+
+def resolution_option(ctx, param, value):
+    """click callback: ``WxH`` → ``(w, h)`` (None stays None)."""
+    if value is None:
+        return None
+    try:
+        return parse_resolution(value)
+    except ValueError as err:
+        raise click.BadParameter(str(err)) from None
