@@ -45,7 +45,7 @@ def test_print_with_map_example():
                         "        c = vec4(1.0);\n}\n", "m.frag")
     text, line_map = print_with_map(unit)
     lines = text.splitlines()
-    assert lines[0] == "#version 330 core" and line_map[0] is None
+    assert lines[0] == "#version 330 core" and (line_map[0].file, line_map[0].line) == ("m.frag", 1)
     idx = lines.index("        c = vec4(1.0);")
     assert (line_map[idx].line, line_map[idx].col) == (6, 9)
     idx = lines.index("    if (true)")

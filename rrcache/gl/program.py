@@ -67,6 +67,8 @@ def map_location(diag: Diagnostic, line_map: Optional[Sequence[Optional[SourceLo
         loc = line_map[diag.line - 1]
         if loc is not None:  # the driver's column counts in the printed text: keep the map's
             return SourceLoc(loc.file, loc.line, loc.col)
+        # a line rrcache generated (no original place): do not pass it off as the user's line
+        return SourceLoc(f"{name} (generated line)", diag.line, max(diag.col, 1))
     return SourceLoc(name, diag.line, max(diag.col, 1) if diag.line else 0)
 
 

@@ -168,6 +168,9 @@ class TranslationUnit(Node):
     version: Optional[int] = None
     profile: Optional[str] = None
     extensions: list[tuple[str, str]] = field(default_factory=list)
+    # where the #version and each #extension directive stand (for error messages)
+    version_loc: Optional[SourceLoc] = field(default=None, compare=False, repr=False)
+    extension_locs: list[SourceLoc] = field(default_factory=list, compare=False, repr=False)
 
 
 # ----------------------------------------------------------------------------- statements

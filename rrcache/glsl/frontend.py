@@ -19,8 +19,7 @@ from typing import Iterable, Mapping, Optional
 from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import NON_FRAGMENT_VARIABLES
-from rrcache.glsl.lexer import lex
-from rrcache.glsl.parser import parse
+from rrcache.glsl.parser import parse_preprocessed
 from rrcache.glsl.preprocessor import preprocess
 from rrcache.glsl.semantic import SemanticInfo, check
 from rrcache.glsl.types import Type
@@ -93,9 +92,7 @@ def parse_shader(source: str, filename: str = "<string>",
     """
     defines = dict(defines or {})
     pp = preprocess(source, filename, defines, tuple(include_dirs))
-    tokens = lex(pp.tokens, pp.version, pp.profile, filename=filename)
-    unit = parse(tokens, pp.version, pp.profile)
-    unit.extensions = list(pp.extensions)
+    unit = parse_preprocessed(pp, filename)
     frag_data = _reject_other_stages(unit, filename)
     info = check(unit, filename)
     _reject_multiple_outputs(frag_data, info)

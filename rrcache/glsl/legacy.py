@@ -277,7 +277,10 @@ def to_core(unit: A.TranslationUnit) -> A.TranslationUnit:
             A.FullType(["out"], A.TypeSpecifier("vec4")), [A.Declarator(FRAG_COLOR)])
         u.decls.insert(0, decl)
     u.version, u.profile = version, profile
-    u.extensions = [(name, behavior) for name, behavior in u.extensions
-                    if not (was_es and (name in _ES_ONLY_EXTENSIONS or name.startswith("GL_OES_")))
-                    and name not in _ES_ONLY_EXTENSIONS]
+    locs = list(u.extension_locs) + [None] * (len(u.extensions) - len(u.extension_locs))
+    kept = [(ext, loc) for ext, loc in zip(u.extensions, locs)
+            if not (was_es and (ext[0] in _ES_ONLY_EXTENSIONS or ext[0].startswith("GL_OES_")))
+            and ext[0] not in _ES_ONLY_EXTENSIONS]
+    u.extensions = [ext for ext, _ in kept]
+    u.extension_locs = [loc for _, loc in kept]
     return u

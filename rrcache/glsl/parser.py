@@ -690,11 +690,18 @@ def parse_source(source: str, filename: str = "<string>",
     >>> unit.version, [type(d).__name__ for d in unit.decls]
     (330, ['VariableDecl', 'FunctionDecl'])
     """
-    pp = preprocess(source, filename, defines)
+    return parse_preprocessed(preprocess(source, filename, defines), filename)
+
+
+def parse_preprocessed(pp, filename: str = "<string>") -> A.TranslationUnit:
+    """Lex and parse a :class:`~rrcache.glsl.preprocessor.Preprocessed` result, carrying its
+    ``#version`` and ``#extension`` directives (and where they stand) into the unit."""
     # Without #version the language is GLSL 1.10 (or ES 1.00): late keywords are identifiers.
     lex_version = pp.version if pp.version is not None else 110
     tokens = lex(pp.tokens, lex_version, pp.profile, filename=filename)
     unit = parse(tokens, pp.version, pp.profile)
     unit.extensions = list(pp.extensions)
+    unit.extension_locs = list(pp.extension_locs)
+    unit.version_loc = pp.version_loc
     return unit
 

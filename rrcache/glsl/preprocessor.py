@@ -54,6 +54,7 @@ class Preprocessed:
     profile: str | None = None
     version_loc: SourceLoc | None = None
     extensions: list[tuple[str, str]] = field(default_factory=list)
+    extension_locs: list[SourceLoc] = field(default_factory=list)  # where each #extension stands
     pragmas: list[tuple[str, SourceLoc]] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
 
@@ -749,6 +750,7 @@ class _Preprocessor:
             raise _err(f"#extension all : {behavior} is not allowed", rest[2].loc,
                        "'all' takes only warn or disable")
         self.result.extensions.append((ext, behavior))
+        self.result.extension_locs.append(hash_tok.loc)
 
     def _d_include(self, hash_tok, name_tok, rest, src, next_line) -> None:
         toks = rest

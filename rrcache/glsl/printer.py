@@ -332,7 +332,7 @@ def _dangles(s: A.Stmt) -> bool:
             return False
 
 
-def _header(unit: A.TranslationUnit) -> list[str]:
+def _header(unit: A.TranslationUnit) -> list[tuple[str, Optional[SourceLoc]]]:
     lines = []
     if unit.version is not None:
         profile = unit.profile
@@ -340,9 +340,10 @@ def _header(unit: A.TranslationUnit) -> list[str]:
             profile = None
         if profile in ("core", "compatibility") and unit.version < 150:
             profile = None
-        lines.append(_join(f"#version {unit.version}", profile or ""))
-    for name, behavior in unit.extensions:
-        lines.append(f"#extension {name} : {behavior}")
+        lines.append((_join(f"#version {unit.version}", profile or ""), unit.version_loc))
+    locs = list(unit.extension_locs) + [None] * (len(unit.extensions) - len(unit.extension_locs))
+    for (name, behavior), loc in zip(unit.extensions, locs):
+        lines.append((f"#extension {name} : {behavior}", loc))
     return lines
 
 
@@ -350,7 +351,8 @@ def print_with_map(unit: A.TranslationUnit) -> tuple[str, list[Optional[SourceLo
     """Print a unit and map each printed line to the place it came from.
 
     ``line_map[i]`` is the SourceLoc of the statement or declaration on printed line ``i + 1``,
-    or None (blank lines, closing braces, the ``#version`` line).
+    or None (blank lines, closing braces, lines rrcache generated); the ``#version`` and
+    ``#extension`` lines map to their directives.
 
     >>> from rrcache.glsl.parser import parse_source
     >>> text, line_map = print_with_map(parse_source("void main()\\n{ gl_FragColor = vec4(1.0); }", "a.frag"))
@@ -358,8 +360,8 @@ def print_with_map(unit: A.TranslationUnit) -> tuple[str, list[Optional[SourceLo
     ('    gl_FragColor = vec4(1.0);', 'a.frag:2:3')
     """
     p = _Printer()
-    for line in _header(unit):
-        p.emit(line, None)
+    for line, loc in _header(unit):
+        p.emit(line, loc)
     prev = None
     for d in unit.decls:
         spacious = isinstance(d, (A.FunctionDecl, A.InterfaceBlock)) or (
