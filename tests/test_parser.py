@@ -290,3 +290,16 @@ def test_large_shader_parses_quickly():
     elapsed = time.perf_counter() - start
     assert len(unit.decls) > 100
     assert elapsed < 1.0, f"parsing 3000 lines took {elapsed:.2f}s"
+
+
+def test_layout_keyword_before_140_with_extension():
+    # GL_ARB_shading_language_420pack (and the other layout extensions) make 'layout' a keyword
+    # in #version 130 shaders (glslang's spv.130.frag); without one it stays an identifier.
+    src = ("#version 130\n#extension GL_ARB_shading_language_420pack : enable\n"
+           "uniform layout(binding=0) sampler2D bounds;\nvoid main() {}\n")
+    unit = parse_source(src)
+    assert isinstance(unit.decls[0], A.VariableDecl)
+    assert any(isinstance(q, A.Layout) for q in unit.decls[0].type.qualifiers)
+    kinds = [t.kind for t in lex(preprocess("#version 130\nfloat layout;\n", "a.frag").tokens,
+                                 130)]
+    assert kinds[1] == "ident"

@@ -630,3 +630,26 @@ void main() {
 }
 """)
     assert ty(unit, "sv") == VEC3 and ty(unit, "back") == VEC2
+
+
+# ---------------------------------------------------------------- glslang-suite regressions
+def test_unsized_local_array_redeclared_with_size():
+    # GLSL allows 'float u[][7]; ... float u[5][7];' in one scope (found via glslang's tests).
+    unit, _ = checked("#version 430\nout vec4 c;\nvoid main() {\n float u[][7];\n"
+                      " u[2][2] = 3.0;\n float u[5][7];\n c = vec4(u[2][2]);\n}\n")
+    decls = [n for n in nodes(unit) if isinstance(n, A.Ident) and n.name == "u"]
+    assert all(d.symbol.type.dims == (5, 7) for d in decls)
+    with pytest.raises(SemanticError, match="redefinition of 'u'"):
+        checked("#version 430\nvoid main() { float u[3]; float u[5]; }\n")
+    with pytest.raises(SemanticError, match="redefinition of 'u'"):
+        checked("#version 430\nvoid main() { float u[][7]; int u[5][7]; }\n")
+
+
+def test_compatibility_input_redeclared_twice():
+    # 'in vec4 gl_Color; flat in vec4 gl_Color;' is accepted (glslang's spv.130.frag).
+    checked("#version 130\nin vec4 gl_Color;\nflat in vec4 gl_Color;\n"
+            "void main() { gl_FragColor = gl_Color; }\n")
+    with pytest.raises(SemanticError, match="redefinition of 'gl_FragCoord'"):
+        checked("#version 150\nin vec4 gl_FragCoord;\n"
+                "layout(origin_upper_left) in vec4 gl_FragCoord;\nout vec4 c;\n"
+                "void main() { c = gl_FragCoord; }\n")

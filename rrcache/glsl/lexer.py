@@ -112,6 +112,16 @@ _PUNCTUATORS = frozenset(
 )
 
 
+# Extensions that bring the ``layout`` keyword to desktop GLSL before 1.40.
+LAYOUT_EXTENSIONS = frozenset({
+    "GL_ARB_explicit_attrib_location", "GL_ARB_separate_shader_objects",
+    "GL_ARB_shading_language_420pack", "GL_ARB_uniform_buffer_object",
+    "GL_ARB_explicit_uniform_location", "GL_ARB_fragment_coord_conventions",
+    "GL_ARB_conservative_depth", "GL_AMD_conservative_depth", "GL_ARB_enhanced_layouts",
+    "GL_EXT_blend_func_extended", "GL_ARB_shader_image_load_store",
+})
+
+
 def is_keyword(word: str, version: Optional[int] = None, profile: Optional[str] = None) -> bool:
     """Whether ``word`` is a keyword (or reserved word) in the given GLSL version.
 
@@ -162,18 +172,23 @@ def _number(tok: Any) -> Token:
 
 
 def lex(pp_tokens: Iterable[Any], version: Optional[int] = None,
-        profile: Optional[str] = None, filename: str = "<string>") -> list[Token]:
+        profile: Optional[str] = None, filename: str = "<string>",
+        extensions: Iterable[Any] = ()) -> list[Token]:
     """Classify preprocessing tokens; the result ends with an ``eof`` token.
 
     ``version``/``profile`` (from ``#version``) decide whether late keywords such as ``sample``
     are keywords; ``None`` means the newest language. ``filename`` names the place of the
-    ``eof`` token when there are no tokens at all.
+    ``eof`` token when there are no tokens at all. ``extensions`` (``(name, behavior)`` pairs
+    from ``#extension``) can make ``layout`` a keyword before GLSL 1.40
+    (``GL_ARB_explicit_attrib_location`` and the like).
 
     >>> from rrcache.glsl.preprocessor import preprocess
     >>> [t.kind for t in lex(preprocess("vec3 a = 1.0;", "a.frag").tokens)]
     ['keyword', 'ident', 'punct', 'float', 'punct', 'eof']
     """
     out: list[Token] = []
+    layout_ext = any(name in LAYOUT_EXTENSIONS and behavior != "disable"
+                     for name, behavior in extensions)
     last_loc: Optional[SourceLoc] = None
     last_len = 0
     for tok in pp_tokens:
@@ -181,7 +196,7 @@ def lex(pp_tokens: Iterable[Any], version: Optional[int] = None,
         if kind == "ident":
             if text in ("true", "false"):
                 out.append(Token("bool", text, text == "true", loc))
-            elif is_keyword(text, version, profile):
+            elif is_keyword(text, version, profile) or (text == "layout" and layout_ext):
                 if text in RESERVED_WORDS:
                     raise ParseError(
                         f"'{text}' is a reserved word", loc, "rename it; GLSL reserves this name"

@@ -698,7 +698,8 @@ def parse_preprocessed(pp, filename: str = "<string>") -> A.TranslationUnit:
     ``#version`` and ``#extension`` directives (and where they stand) into the unit."""
     # Without #version the language is GLSL 1.10 (or ES 1.00): late keywords are identifiers.
     lex_version = pp.version if pp.version is not None else 110
-    tokens = lex(pp.tokens, lex_version, pp.profile, filename=filename)
+    tokens = lex(pp.tokens, lex_version, pp.profile, filename=filename,
+                 extensions=pp.extensions)
     unit = parse(tokens, pp.version, pp.profile)
     unit.extensions = list(pp.extensions)
     unit.extension_locs = list(pp.extension_locs)

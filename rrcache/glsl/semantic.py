@@ -236,11 +236,31 @@ class _Checker:
         if Type.is_type_name(name):
             raise _err(f"'{name}' is a type name and cannot be declared as a {what}", node)
 
+    def _sizes_unsized_array(self, sym: Symbol) -> bool:
+        """Whether ``sym`` redeclares an unsized array of this scope with an explicit size."""
+        prev = self.scope.vars.get(sym.name)
+        if prev is None or prev.kind != sym.kind or prev.loc is None:
+            return False
+        a, b = prev.type, sym.type
+        return bool(a.dims and b.dims and a.dims[0] is None and b.dims[0] is not None
+                    and a.dims[1:] == b.dims[1:] and a.base == b.base and a.size == b.size
+                    and a.cols == b.cols and a.rows == b.rows
+                    and a.struct_name == b.struct_name)
+
     def declare(self, sym: Symbol, node: Any) -> None:
         builtin = BUILTIN_VARIABLES.get(sym.name)
-        if builtin is not None and self.scope.is_global and sym.name not in self.scope.vars:
-            # Redeclaring a built-in (layout(origin_upper_left) in vec4 gl_FragCoord;)
+        prev = self.scope.vars.get(sym.name) if builtin is not None else None
+        if builtin is not None and self.scope.is_global and (
+                prev is None or (prev.kind == "builtin" and prev.type == sym.type
+                                 and sym.name not in ("gl_FragCoord", "gl_FragDepth"))):
+            # Redeclaring a built-in (layout(origin_upper_left) in vec4 gl_FragCoord;); a
+            # compatibility input may be redeclared again to add an interpolation qualifier
+            # (in vec4 gl_Color; flat in vec4 gl_Color;), gl_FragCoord/gl_FragDepth only once.
             sym.kind, sym.read_only = "builtin", builtin.read_only
+        elif self._sizes_unsized_array(sym):
+            # float u[][7]; ... float u[5][7];  -- an unsized array redeclared with its size:
+            # the earlier symbol (and every use of it so far) takes the size.
+            self.scope.vars[sym.name].type = sym.type
         else:
             self._check_new_name(sym.name, node, "variable")
         self.scope.vars[sym.name] = sym
