@@ -44,6 +44,10 @@ _LAZY = {
     "mean_l2": "rrcache.harness",
     "psnr": "rrcache.harness",
     "CacheRuntime": "rrcache.runtime",
+    "profile": "rrcache.profile",
+    "load_profile": "rrcache.profile",
+    "select": "rrcache.profile",
+    "TrainingSettings": "rrcache.profile",
     "get_context": "rrcache.gl",
 }
 

@@ -19,6 +19,8 @@ _COMMANDS = {
     "bench-frontend": "bench_frontend",
     "instance": "instance",
     "bench-cache": "bench_cache",
+    "profile": "profile",
+    "select": "select",
     "render": "render",
 }
 

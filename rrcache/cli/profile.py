@@ -1,0 +1,151 @@
+"""``rrcache profile SHADER SESSION``: train the models and write the profile folder.
+
+    rrcache profile marble.frag marble.json
+    rrcache profile marble.frag marble.json --out marble.rrprofile --budget 900 -D OCTAVES=5
+    rrcache profile noise.frag orbit.json --resolution 32x24 --periods 2,4,8 --timing-frames 6
+
+A progress bar with an ETA runs on stderr while training (when stderr is a terminal). Rerunning
+the same command resumes: every stored run is skipped (the summary says how many). Ctrl-C stops
+after the run in flight is dropped: what is stored stays, it is listed, and the exit code is 130.
+The closing summary gives the nodes trained, μ, the overhead, the original's frame time and the
+four selections (node, Δn, predicted/measured speed-up and error, PSNR).
+"""
+from __future__ import annotations
+
+import sys
+import warnings
+
+import click
+from rich.console import Console
+from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
+                           TimeRemainingColumn)
+from rich.table import Table
+
+from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.errors import RRCacheError
+from rrcache.profile.profile import STORE_NAME, default_out_dir, profile
+from rrcache.profile.settings import DEFAULT_PERIODS, TrainingSettings, parse_periods
+from rrcache.runtime import ALGORITHMS
+
+
+def _periods(ctx, param, value):
+    if value is None:
+        return None
+    return parse_periods(value, "--periods")
+
+
+def _fmt(value, spec=".3g", none="–"):
+    if value is None:
+        return none
+    try:
+        return format(value, spec)
+    except (TypeError, ValueError):
+        return str(value)
+
+
+@click.command("profile")
+@click.argument("shader", type=click.Path(dir_okay=False))
+@click.argument("session", type=click.Path(dir_okay=False))
+@click.option("--out", "out_dir", type=click.Path(), default=None,
+              help="Profile folder (default: <shader>-<session>.rrprofile here).")
+@click.option("--resolution", callback=_resolution, default=None, metavar="WxH",
+              help="Resolution of the error runs: the error is measured at this size (default: the session's divided by 4).")
+@click.option("--frames", type=click.IntRange(min=2), default=None,
+              help="Train the error on the first N frames (default: all).")
+@click.option("--periods", callback=_periods, default=None, metavar="LIST",
+              help=f"Training refresh periods (default: {','.join(map(str, DEFAULT_PERIODS))}).")
+@click.option("--timing-frames", type=click.IntRange(min=1), default=12, show_default=True,
+              help="Frames L timed per node and timing period, at full resolution.")
+@click.option("--timing-periods", callback=_periods, default=None, metavar="LIST",
+              help="Refresh periods at which each node is timed (default: 2,8,50).")
+@click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=480.0, show_default=True,
+              help="Seconds of node training; no new node is started once spent.")
+@click.option("--validation-frames", type=click.IntRange(min=2), default=None,
+              help="Render each selection over the first N frames (default: all).")
+@click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
+@click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
+@click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+def command(shader, session, out_dir, resolution, frames, periods, timing_frames, timing_periods, algorithm,
+            budget, validation_frames, no_validate, fresh, defines):
+    """Train error and performance models of every cacheable node of SHADER over SESSION, select
+    what to cache at four error levels, and write the profile folder."""
+    err_console = Console(stderr=True)
+    kwargs = dict(resolution=resolution, frames=frames, timing_frames=timing_frames, algorithm=algorithm,
+                  budget_s=budget, validate=not no_validate,
+                  validation_frames=validation_frames)
+    if periods is not None:
+        kwargs["periods"] = periods
+    if timing_periods is not None:
+        kwargs["timing_periods"] = timing_periods
+    settings = TrainingSettings(**kwargs)
+    out = out_dir if out_dir is not None else default_out_dir(shader, session)
+
+    bar = Progress(TextColumn("{task.description:<32}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                   TextColumn("ETA"), TimeRemainingColumn(), console=err_console, transient=True,
+                   disable=not err_console.is_terminal)
+    task = bar.add_task("starting", total=None)
+
+    def progress(event):
+        bar.update(task, completed=event.done, total=event.total, description=f"{event.stage} {event.detail}"[:32])
+
+    try:
+        with bar, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh)
+            finally:
+                for w in caught:
+                    err_console.print(f"warning: {w.message}", highlight=False, markup=False)
+    except KeyboardInterrupt:
+        _interrupted(out, err_console)
+        sys.exit(130)
+    console = Console()
+    if not console.is_terminal:
+        console = Console(width=120)
+    _summary(prof, console)
+
+
+def _interrupted(out, err_console) -> None:
+    from pathlib import Path
+
+    from rrcache.profile.store import read_store
+
+    err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
+    path = Path(out) / STORE_NAME
+    try:
+        with read_store(path) as store:
+            c = store.counts()
+        err_console.print(f"stored in {path}: {c['error_runs']} error runs over {c['nodes']} nodes, "
+                          f"{c['timing_runs']} timing runs, {c['validations']} validations; "
+                          "run the same command again to resume", highlight=False)
+    except RRCacheError as err:
+        err_console.print(f"nothing readable is stored ({err})", highlight=False, markup=False)
+
+
+def _summary(prof, console: Console) -> None:
+    c = prof.counts
+    trained = len(prof.trained_nodes)
+    console.print(f"profile: {prof.path}", highlight=False)
+    console.print(f"nodes trained: {trained} of {len(prof.nodes)}"
+                  + (" (budget spent: the rest are untrained)" if prof.data.get("budget_stopped") else ""),
+                  highlight=False)
+    console.print(f"runs: {c.get('error_runs_computed', 0)} error and {c.get('timing_runs_computed', 0)} timing runs "
+                  f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
+                  "runs were stored and skipped", highlight=False)
+    console.print(f"μ = {_fmt(prof.mu)} ({prof.mu_quality}); overhead {_fmt(prof.overhead_ms, '.3f')} ms; "
+                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
+                  f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
+    table = Table(title="selections")
+    for name in ("level", "max error", "node", "Δn", "speed-up pred.", "speed-up meas.", "error pred.",
+                 "error meas.", "PSNR"):
+        if name == "node":
+            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=40)
+        else:
+            table.add_column(name, justify="right")
+    for s in prof.selections:
+        node = "(original)" if s.node is None else f"{s.node}: {s.text}"
+        table.add_row(s.label, _fmt(s.max_error), node, _fmt(s.period, "d"), _fmt(s.predicted_speedup, ".2f"),
+                      _fmt(s.measured_speedup, ".2f"), _fmt(s.predicted_error), _fmt(s.measured_error),
+                      _fmt(s.measured_psnr, ".1f"))
+    console.print(table)

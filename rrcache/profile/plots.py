@@ -1,0 +1,160 @@
+"""The profile's figures (matplotlib, Agg backend; nothing opens a window).
+
+- ``tradeoff.png`` / ``tradeoff.svg`` (main paper Fig. 7): error against ms per frame, one path
+  per trained node over Δn = 1..50 from the models, the trained periods marked at their measured
+  error, the original's frame time as a dashed vertical line, the Pareto front, and the four
+  selections marked and labelled (e1..e4). Points left of the line are faster than the original.
+- ``hitrate.png`` (Fig. 5): the measured hit rate per training period, every trained node, with
+  the fitted γ(Δn) = μ(1 − 1/Δn).
+- ``validation.png`` (Fig. 6): predicted against measured error and frame time for the four
+  selections (the diagonal is a perfect prediction).
+
+>>> write_plots(load_profile("marble-marble.rrprofile"), "out/")    # doctest: +SKIP
+['out/tradeoff.png', 'out/tradeoff.svg', 'out/hitrate.png', 'out/validation.png']
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+PERIODS = np.arange(1, 51)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _curves(prof):
+    """Per trained node: (node, errors over Δn = 1..50, ms over Δn = 1..50)."""
+    from rrcache.model import predict_ms
+
+    errors, perfs, hit = prof.fits()
+    out = []
+    for node, ef, pf in zip(prof.trained_nodes, errors, perfs):
+        out.append((node, np.asarray(ef.predict(PERIODS), float),
+                    np.asarray(predict_ms(pf, hit.mu, prof.pixels, PERIODS), float)))
+    return out, hit
+
+
+def _front_points(prof):
+    from rrcache.model import pareto_front
+
+    points = [(float(p.predicted_error), float(p.predicted_ms)) for p in pareto_front(prof.table)]
+    return sorted(points, key=lambda p: p[1])
+
+
+def plot_tradeoff(prof, out_dir) -> list[str]:
+    """Write ``tradeoff.png`` and ``tradeoff.svg``; returns their paths."""
+    plt = _pyplot()
+    curves, _ = _curves(prof)
+    fig, ax = plt.subplots(figsize=(8, 5.5), dpi=110)
+    cmap = plt.get_cmap("viridis")
+    for k, (node, err, ms) in enumerate(curves):
+        color = cmap(k / max(1, len(curves) - 1))
+        ax.plot(ms, err, "-", color=color, lw=1.0, alpha=0.75)
+        trained = np.asarray(node.periods, float)
+        if len(trained):
+            from rrcache.model import predict_ms
+
+            _, perfs, hit = prof.fits()
+            idx = [n.id for n in prof.trained_nodes].index(node.id)
+            tms = np.asarray(predict_ms(perfs[idx], hit.mu, prof.pixels, trained), float)
+            ax.plot(tms, node.errors, "o", color=color, ms=3)
+    front = _front_points(prof)
+    if front:
+        ax.plot([p[1] for p in front], [p[0] for p in front], "-", color="black", lw=2.2, alpha=0.55,
+                label="Pareto front")
+    if prof.original_ms:
+        ax.axvline(prof.original_ms, ls="--", color="gray", label=f"original ({prof.original_ms:.2f} ms)")
+    groups: dict = {}
+    for sel in prof.selections:  # selections that coincide share one mark and one label
+        groups.setdefault((sel.node, sel.period), []).append(sel)
+    for k, ((node_id, period), sels) in enumerate(sorted(groups.items(), key=lambda g: g[1][0].label)):
+        first = sels[0]
+        ax.plot([first.predicted_ms], [first.predicted_error], "s", color="crimson", ms=7, mfc="none", mew=1.8)
+        labels = ",".join(s.label for s in sels)
+        text = f"{labels}: " + (f"{node_id} Δn={period}" if node_id else "original")
+        ax.annotate(text, (first.predicted_ms, first.predicted_error), textcoords="offset points",
+                    xytext=(8, 4 + 11 * (k % 4)), fontsize=8, color="crimson")
+    ax.plot([], [], "o-", color="gray", ms=3, lw=1.0, label="node over Δn = 1..50 (dots: trained Δn)")
+    ax.plot([], [], "s", color="crimson", mfc="none", label="selections e1..e4")
+    ax.set_xlabel("ms per frame (predicted, full resolution)")
+    ax.set_ylabel("mean RGB L2 error per pixel")
+    ax.set_title(f"{Path(prof.shader).name}: error against run time ({len(curves)} nodes)")
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
+    fig.tight_layout()
+    paths = [str(Path(out_dir) / "tradeoff.png"), str(Path(out_dir) / "tradeoff.svg")]
+    for path in paths:
+        fig.savefig(path)
+    plt.close(fig)
+    return paths
+
+
+def plot_hitrate(prof, out_dir) -> list[str]:
+    """Write ``hitrate.png``; returns its path."""
+    plt = _pyplot()
+    _, hit = _curves(prof)
+    fig, ax = plt.subplots(figsize=(6, 4), dpi=110)
+    for node in prof.trained_nodes:
+        ax.plot(node.periods, node.hit_rates, "o", ms=3, alpha=0.5, color="tab:blue")
+    ax.plot([], [], "o", ms=3, color="tab:blue", label="measured (each node)")
+    ax.plot(PERIODS, np.asarray(hit.predict(PERIODS), float), "-", color="black",
+            label=f"γ(Δn) = μ(1 − 1/Δn), μ = {hit.mu:.3f}")
+    ax.set_xlabel("refresh period Δn")
+    ax.set_ylabel("hit rate")
+    ax.set_ylim(0, 1.02)
+    ax.set_title("hit rate against refresh period")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    fig.tight_layout()
+    path = str(Path(out_dir) / "hitrate.png")
+    fig.savefig(path)
+    plt.close(fig)
+    return [path]
+
+
+def plot_validation(prof, out_dir) -> list[str]:
+    """Write ``validation.png`` (nothing when no selection was measured); returns its paths."""
+    rows = [s for s in prof.selections if s.measured_error is not None]
+    if not rows:
+        return []
+    plt = _pyplot()
+    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4), dpi=110)
+    for ax, pred, meas, name in ((a, "predicted_error", "measured_error", "mean RGB L2 error"),
+                                 (b, "predicted_ms", "measured_ms", "ms per frame")):
+        xs = [getattr(s, pred) for s in rows]
+        ys = [getattr(s, meas) for s in rows]
+        top = max(xs + ys + [1e-9]) * 1.15
+        ax.plot([0, top], [0, top], "--", color="gray", lw=1)
+        ax.plot(xs, ys, "o", color="tab:red")
+        for s, x, y in zip(rows, xs, ys):
+            ax.annotate(s.label, (x, y), textcoords="offset points", xytext=(5, 4), fontsize=8)
+        ax.set_xlim(0, top)
+        ax.set_ylim(0, top)
+        ax.set_xlabel(f"predicted {name}")
+        ax.set_ylabel(f"measured {name}")
+        ax.grid(alpha=0.3)
+    a.set_title("error: model against render")
+    b.set_title("time: model against render")
+    fig.tight_layout()
+    path = str(Path(out_dir) / "validation.png")
+    fig.savefig(path)
+    plt.close(fig)
+    return [path]
+
+
+def write_plots(prof, out_dir) -> list[str]:
+    """Every figure of a profile with trained nodes into ``out_dir``; returns the paths written."""
+    if not prof.trained_nodes:
+        return []
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    return plot_tradeoff(prof, out_dir) + plot_hitrate(prof, out_dir) + plot_validation(prof, out_dir)

@@ -1,0 +1,203 @@
+"""Training settings of a profile: what is measured, at which resolution, for how long.
+
+:class:`TrainingSettings` is a frozen, JSON-able dataclass. The fields that change what is
+*measured* (periods, resolution, frames, timing frames and periods, algorithm, refresh block,
+refresh pattern, depth epsilon, validation frames) are hashed into the key of the profile store
+(:mod:`rrcache.profile.store`): a store trained with other settings is refused rather than mixed.
+``budget_s`` and ``validate`` only decide how much is done, so they are left out of the key and
+may change between a run and its resumption.
+
+The error is measured at the *training* resolution (default: the session's divided by 4, at
+least 8×8), over consecutive frames; the times are measured at the session's full resolution.
+
+>>> s = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), frames=12)
+>>> s.periods, s.to_json()["resolution"]
+((2, 4, 8), [32, 24])
+>>> TrainingSettings.from_json(s.to_json()) == s
+True
+>>> TrainingSettings(periods=(0, 4))
+Traceback (most recent call last):
+    ...
+rrcache.errors.RRCacheError: settings: periods: 0 is not a refresh period (hint: give whole numbers from 1 to 1000, e.g. 2,10,18,26,34,42,50)
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import warnings
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Optional
+
+from rrcache.errors import RRCacheError
+from rrcache.runtime import ALGORITHMS, REFRESH_MODES
+
+#: the paper's training periods (main paper §4.2)
+DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
+#: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
+DEFAULT_TIMING_PERIODS = (2, 8, 50)
+BLOCK_SIZES = (1, 2, 4, 8)
+#: the fields that do not change a measurement (left out of the store key)
+UNKEYED = ("budget_s", "validate")
+
+
+def _fail(field_name: str, message: str, hint: str) -> RRCacheError:
+    return RRCacheError(f"{field_name}: {message}", "settings", hint=hint)
+
+
+def _periods(value, name: str, hint: str) -> tuple[int, ...]:
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise _fail(name, f"{value!r} is not a list of periods", hint) from None
+    if not items:
+        raise _fail(name, "no periods given", hint)
+    out = []
+    for item in items:
+        if isinstance(item, bool) or not isinstance(item, int) or not 1 <= item <= 1000:
+            raise _fail(name, f"{item!r} is not a refresh period", hint)
+        out.append(int(item))
+    if len(set(out)) != len(out):
+        raise _fail(name, f"{list(out)} repeats a period", hint)
+    return tuple(sorted(out))
+
+
+@dataclass(frozen=True)
+class TrainingSettings:
+    """What a profile measures (see the module docstring).
+
+    - ``periods``: the refresh periods Δn of the error runs.
+    - ``resolution``: (w, h) of the error runs; None: the session's divided by 4.
+    - ``frames``: the first N consecutive session frames of the error runs; None: all.
+    - ``timing_frames``: L, the frames timed per node and timing period (spread evenly).
+    - ``timing_periods``: the periods at which each node is timed.
+    - ``algorithm``, ``block``, ``refresh``, ``depth_epsilon``: the cache's own settings.
+    - ``validation_frames``: consecutive frames of each validation render; None: all.
+    - ``budget_s``: node training starts no new node once this many seconds are spent.
+    - ``validate``: render the four selections against the original after training.
+    """
+
+    periods: tuple[int, ...] = DEFAULT_PERIODS
+    resolution: Optional[tuple[int, int]] = None
+    frames: Optional[int] = None
+    timing_frames: int = 12
+    timing_periods: tuple[int, ...] = DEFAULT_TIMING_PERIODS
+    algorithm: str = "three-pass"
+    block: int = 4
+    refresh: str = "random"
+    depth_epsilon: float = 1e-3
+    validation_frames: Optional[int] = None
+    budget_s: float = 480.0
+    validate: bool = True
+
+    def __post_init__(self):
+        hint = "give whole numbers from 1 to 1000, e.g. 2,10,18,26,34,42,50"
+        object.__setattr__(self, "periods", _periods(self.periods, "periods", hint))
+        object.__setattr__(self, "timing_periods", _periods(self.timing_periods, "timing_periods", "e.g. 2,8,50"))
+        if self.resolution is not None:
+            try:
+                w, h = (int(v) for v in self.resolution)
+            except (TypeError, ValueError):
+                raise _fail("resolution", f"{self.resolution!r} is not (width, height)", "e.g. 160x120") from None
+            if w < 1 or h < 1 or w > 16384 or h > 16384:
+                raise _fail("resolution", f"{w}x{h} is not a usable size", "e.g. 160x120")
+            object.__setattr__(self, "resolution", (w, h))
+        for name, low in (("frames", 2), ("timing_frames", 1), ("validation_frames", 2)):
+            value = getattr(self, name)
+            if value is None and name != "timing_frames":
+                continue
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise _fail(name, f"{value!r} is not a frame count", f"give a whole number >= {low}")
+        if self.algorithm not in ALGORITHMS:
+            raise _fail("algorithm", f"unknown algorithm {self.algorithm!r}", f"one of {', '.join(ALGORITHMS)}")
+        if self.block not in BLOCK_SIZES:
+            raise _fail("block", f"{self.block!r} is not a refresh block size", "one of 1, 2, 4, 8")
+        if self.refresh not in REFRESH_MODES:
+            raise _fail("refresh", f"unknown refresh pattern {self.refresh!r}", f"one of {', '.join(REFRESH_MODES)}")
+        if not (isinstance(self.depth_epsilon, (int, float)) and 0 < self.depth_epsilon < 1):
+            raise _fail("depth_epsilon", f"{self.depth_epsilon!r} is not in (0, 1)", "the default is 0.001")
+        object.__setattr__(self, "depth_epsilon", float(self.depth_epsilon))
+        if not isinstance(self.budget_s, (int, float)) or not self.budget_s > 0:
+            raise _fail("budget_s", f"{self.budget_s!r} is not a positive number of seconds", "e.g. 480")
+        object.__setattr__(self, "budget_s", float(self.budget_s))
+
+    # ------------------------------------------------------------------ JSON
+    def to_json(self) -> dict:
+        """A JSON-able dict (tuples become lists)."""
+        out = asdict(self)
+        for key, value in out.items():
+            if isinstance(value, tuple):
+                out[key] = list(value)
+        return out
+
+    @classmethod
+    def from_json(cls, data: dict, where: str = "settings") -> "TrainingSettings":
+        """The settings from :meth:`to_json`'s dict; unknown keys are an error."""
+        if not isinstance(data, dict):
+            raise RRCacheError("the training settings are not a JSON object", where,
+                               hint="the profile file is damaged; run the profile again")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise RRCacheError(f"unknown training settings {unknown}", where,
+                               hint="this profile was written by another rrcache version")
+        kwargs = dict(data)
+        for key in ("periods", "timing_periods", "resolution"):
+            if isinstance(kwargs.get(key), list):
+                kwargs[key] = tuple(kwargs[key])
+        return cls(**kwargs)
+
+    # ------------------------------------------------------------------ resolved against a session
+    def resolved(self, session) -> "TrainingSettings":
+        """These settings with the session's defaults filled in (resolution, frames, validation
+        frames), so that leaving a default and writing it out give the same store key. Warns
+        (``UserWarning``) when the error runs have fewer frames than the largest period: the
+        cache then never reaches its steady state and the largest periods' errors are low.
+
+        >>> from types import SimpleNamespace
+        >>> s = TrainingSettings(periods=(2, 4)).resolved(SimpleNamespace(resolution=(640, 480), frames=30, path="s.json"))
+        >>> s.resolution, s.frames, s.validation_frames
+        ((160, 120), 30, 30)
+        """
+        where = str(getattr(session, "path", "session"))
+        resolution = self.resolution
+        if resolution is None:
+            w, h = session.resolution
+            resolution = (max(8, int(w) // 4), max(8, int(h) // 4))
+        frames = self.frames if self.frames is not None else int(session.frames)
+        if frames > session.frames:
+            raise RRCacheError(f"asked for {frames} training frames; the session has {session.frames}", where,
+                               hint=f"use --frames {session.frames} or fewer")
+        validation = self.validation_frames if self.validation_frames is not None else int(session.frames)
+        validation = min(validation, int(session.frames))
+        if int(session.frames) < 2:
+            raise RRCacheError("a session of one frame cannot train a cache", where,
+                               hint="give the session at least as many frames as the largest period")
+        if frames <= max(self.periods):
+            warnings.warn(f"{frames} training frames do not reach the steady state of period {max(self.periods)}: "
+                          "the cache needs at least as many consecutive frames as the largest period",
+                          UserWarning, stacklevel=2)
+        return replace(self, resolution=resolution, frames=frames, validation_frames=max(2, validation),
+                       timing_frames=min(self.timing_frames, int(session.frames) - 1))
+
+    def key_json(self) -> str:
+        """The canonical JSON of the keyed fields (everything but :data:`UNKEYED`)."""
+        data = {k: v for k, v in self.to_json().items() if k not in UNKEYED}
+        return json.dumps(data, sort_keys=True, separators=(",", ":"))
+
+    def key_hash(self) -> str:
+        """sha256 of :meth:`key_json` (use on :meth:`resolved` settings)."""
+        return hashlib.sha256(self.key_json().encode()).hexdigest()
+
+
+def parse_periods(text: str, option: str = "--periods") -> tuple[int, ...]:
+    """``"2,10,18"`` → ``(2, 10, 18)``; anything else raises :class:`RRCacheError`.
+
+    >>> parse_periods("2, 4,8")
+    (2, 4, 8)
+    """
+    try:
+        values = tuple(int(part) for part in text.split(",") if part.strip())
+    except ValueError:
+        raise RRCacheError(f"{text!r} is not a comma-separated list of whole numbers", option,
+                           hint="e.g. 2,10,18,26,34,42,50") from None
+    return _periods(values, option, "e.g. 2,10,18,26,34,42,50")

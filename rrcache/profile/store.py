@@ -1,0 +1,559 @@
+"""The profile store: a versioned SQLite file of every training measurement.
+
+In the manner of coverage.py's data file: the schema is one commented string (:data:`SCHEMA`), a
+``meta`` table names what the file belongs to, and nothing in a file is trusted before it is
+checked. A store is keyed by (shader hash, session hash, settings hash, rrcache version); opening
+it with another key is refused with the differences named (use another ``--out``, or ``--fresh``,
+which moves the old file aside as ``profile.sqlite.bak``). A damaged file (``PRAGMA
+integrity_check``) or a foreign SQLite file (no ``meta`` table, or another schema) is refused too.
+
+Each measurement is committed as soon as it is made, one transaction per (node, period) run, in
+WAL journal mode: a run that is killed loses at most the run in flight, and the next run resumes.
+
+>>> store = ProfileStore.open("out/profile.sqlite", key)           # doctest: +SKIP
+>>> store.has_error_run("n7", 10)                                  # doctest: +SKIP
+False
+"""
+from __future__ import annotations
+
+import json
+import os
+import sqlite3
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable, Optional
+
+from rrcache.errors import RRCacheError
+
+SCHEMA_VERSION = 1
+
+SCHEMA = """\
+-- rrcache profile store; the schema version is in meta('schema_version').
+--
+-- meta: what the file belongs to. Keys: schema_version, rrcache_version, shader_hash,
+--   session_hash, settings_json, settings_hash, created, updated (unix seconds).
+CREATE TABLE meta (
+    key TEXT PRIMARY KEY,
+    value TEXT NOT NULL
+);
+
+-- run_log: one row per `profile` invocation; the counters say what it computed and what it
+--   found already stored (a resumed run skips every stored run). status: running, done,
+--   interrupted, failed.
+CREATE TABLE run_log (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    started REAL NOT NULL,
+    finished REAL,
+    status TEXT NOT NULL,
+    error_runs_computed INTEGER NOT NULL DEFAULT 0,
+    error_runs_skipped INTEGER NOT NULL DEFAULT 0,
+    timing_runs_computed INTEGER NOT NULL DEFAULT 0,
+    timing_runs_skipped INTEGER NOT NULL DEFAULT 0
+);
+
+-- reference: the original shader over the training frames at the training resolution
+--   (covered pixels per frame); its images are kept in memory only.
+CREATE TABLE reference_frame (
+    frame INTEGER PRIMARY KEY,
+    covered INTEGER NOT NULL
+);
+
+-- error_run: one node cached at one refresh period, rendered over the training frames in order
+--   from an empty cache. mean_error is the mean over the frames after the first (which has no
+--   cache) of each frame's mean RGB L2 error over covered pixels; hit_rate = hits / (hits +
+--   misses) over the same frames. wall_s: seconds the run took (counts against the budget).
+CREATE TABLE error_run (
+    node TEXT NOT NULL,
+    period INTEGER NOT NULL,
+    mean_error REAL NOT NULL,
+    psnr REAL NOT NULL,
+    hit_rate REAL NOT NULL,
+    hits INTEGER NOT NULL,
+    misses INTEGER NOT NULL,
+    covered INTEGER NOT NULL,
+    frames INTEGER NOT NULL,
+    wall_s REAL NOT NULL,
+    run_id INTEGER NOT NULL REFERENCES run_log(id),
+    PRIMARY KEY (node, period)
+);
+
+-- error_frame: the frames of an error run (psnr is capped at 100 dB for identical frames).
+CREATE TABLE error_frame (
+    node TEXT NOT NULL,
+    period INTEGER NOT NULL,
+    frame INTEGER NOT NULL,
+    mean_error REAL NOT NULL,
+    psnr REAL NOT NULL,
+    hits INTEGER NOT NULL,
+    misses INTEGER NOT NULL,
+    covered INTEGER NOT NULL,
+    left_out INTEGER NOT NULL,
+    PRIMARY KEY (node, period, frame)
+);
+
+-- timing_run / timing_frame: one node at one timing period over the L timing frames at the
+--   session's full resolution. Each timed frame follows one untimed warm-up frame (the one
+--   before it) and is timed right after the original on the same frame (original_ms), so that
+--   machine noise touches both alike.
+CREATE TABLE timing_run (
+    node TEXT NOT NULL,
+    period INTEGER NOT NULL,
+    wall_s REAL NOT NULL,
+    run_id INTEGER NOT NULL REFERENCES run_log(id),
+    PRIMARY KEY (node, period)
+);
+CREATE TABLE timing_frame (
+    node TEXT NOT NULL,
+    period INTEGER NOT NULL,
+    frame INTEGER NOT NULL,
+    hits INTEGER NOT NULL,
+    misses INTEGER NOT NULL,
+    ms REAL NOT NULL,
+    original_ms REAL NOT NULL,
+    PRIMARY KEY (node, period, frame)
+);
+
+-- reference_timing: the original's ms per frame on the timing frames (full resolution),
+--   measured once before any node, with the covered pixels M.
+CREATE TABLE reference_timing (
+    frame INTEGER PRIMARY KEY,
+    ms REAL NOT NULL,
+    covered INTEGER NOT NULL
+);
+
+-- overhead: the cached pipeline's frame time with almost nothing covered (the variant of
+--   `node` rendered at a tiny resolution; geometry still processed): median ms over `frames`.
+CREATE TABLE overhead (
+    id INTEGER PRIMARY KEY CHECK (id = 1),
+    node TEXT NOT NULL,
+    width INTEGER NOT NULL,
+    height INTEGER NOT NULL,
+    frames INTEGER NOT NULL,
+    ms REAL NOT NULL
+);
+
+-- validation: a selection (label e1..e4 at max_error) rendered beside the original at full
+--   resolution; predicted figures from the models, measured ones from the render. node NULL =
+--   the original shader (nothing rendered: error 0, speed-up 1).
+CREATE TABLE validation (
+    label TEXT PRIMARY KEY,
+    max_error REAL NOT NULL,
+    node TEXT,
+    period INTEGER,
+    predicted_error REAL NOT NULL,
+    predicted_ms REAL NOT NULL,
+    predicted_speedup REAL NOT NULL,
+    measured_error REAL NOT NULL,
+    measured_psnr REAL NOT NULL,
+    measured_ms REAL NOT NULL,
+    measured_original_ms REAL NOT NULL,
+    measured_speedup REAL NOT NULL,
+    hit_rate REAL NOT NULL,
+    frames INTEGER NOT NULL
+);
+"""
+
+_TABLES = ("meta", "run_log", "reference_frame", "error_run", "error_frame", "timing_run", "timing_frame",
+           "reference_timing", "overhead", "validation")
+
+
+@dataclass(frozen=True)
+class StoreKey:
+    """What a store belongs to; two stores with different keys never mix measurements."""
+
+    shader_hash: str
+    session_hash: str
+    settings_hash: str
+    rrcache_version: str
+    settings_json: str = "{}"
+
+    def compare(self, meta: dict) -> list[str]:
+        """The differences against a store's ``meta`` rows, in words (empty: the same key)."""
+        names = (("shader_hash", "shader"), ("session_hash", "session"), ("settings_hash", "training settings"),
+                 ("rrcache_version", "rrcache version"))
+        out = []
+        for field_name, words in names:
+            mine, theirs = getattr(self, field_name), meta.get(field_name)
+            if mine != theirs:
+                if field_name == "settings_hash":
+                    out.append(f"the {words} differ ({_settings_diff(self.settings_json, meta.get('settings_json'))})")
+                elif field_name == "rrcache_version":
+                    out.append(f"the {words} differs (stored {theirs}, running {mine})")
+                else:
+                    out.append(f"the {words} differs (hash stored {str(theirs)[:12]}, now {mine[:12]})")
+        return out
+
+
+def _settings_diff(mine: str, theirs: Optional[str]) -> str:
+    try:
+        a, b = json.loads(mine), json.loads(theirs or "{}")
+    except ValueError:
+        return "unreadable stored settings"
+    keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+    return ", ".join(f"{k}: stored {b.get(k)!r}, now {a.get(k)!r}" for k in keys) or "same values, other hash"
+
+
+@dataclass
+class ErrorRun:
+    node: str
+    period: int
+    mean_error: float
+    psnr: float
+    hit_rate: float
+    hits: int
+    misses: int
+    covered: int
+    frames: int
+    wall_s: float
+
+
+@dataclass
+class ErrorFrame:
+    frame: int
+    mean_error: float
+    psnr: float
+    hits: int
+    misses: int
+    covered: int
+    left_out: int = 0
+
+
+@dataclass
+class TimingFrame:
+    frame: int
+    hits: int
+    misses: int
+    ms: float
+    original_ms: float
+
+
+@dataclass
+class ValidationRow:
+    label: str
+    max_error: float
+    node: Optional[str]
+    period: Optional[int]
+    predicted_error: float
+    predicted_ms: float
+    predicted_speedup: float
+    measured_error: float
+    measured_psnr: float
+    measured_ms: float
+    measured_original_ms: float
+    measured_speedup: float
+    hit_rate: float
+    frames: int
+
+
+def _refuse(path: Path, message: str, hint: str) -> RRCacheError:
+    return RRCacheError(message, str(path), hint=hint)
+
+
+_FRESH_HINT = "use another --out folder, or --fresh to move this file aside as profile.sqlite.bak"
+
+
+class ProfileStore:
+    """An open profile store. Use :meth:`open` (checks or creates), then the ``add_*`` methods
+    (each one transaction) and the readers. Close with :meth:`close` or a ``with`` block."""
+
+    def __init__(self, path: Path, conn: sqlite3.Connection):
+        self.path = path
+        self.conn = conn
+        self.run_id: Optional[int] = None
+
+    # ------------------------------------------------------------------ opening
+    @classmethod
+    def open(cls, path: "str | os.PathLike[str]", key: StoreKey, fresh: bool = False) -> "ProfileStore":
+        """Open (or create) the store at ``path`` for ``key``.
+
+        ``fresh=True`` moves an existing file aside as ``<name>.bak`` (replacing an older
+        ``.bak``) and starts empty. A file with another key, a damaged file and a foreign SQLite
+        file raise :class:`RRCacheError` naming the file and the problem.
+        """
+        path = Path(path)
+        if fresh and path.exists():
+            backup = path.with_name(path.name + ".bak")
+            os.replace(path, backup)
+            for suffix in ("-wal", "-shm"):
+                side = path.with_name(path.name + suffix)
+                if side.exists():
+                    os.replace(side, backup.with_name(backup.name + suffix))
+        exists = path.exists() and path.stat().st_size > 0
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if exists:
+            conn = cls._connect_existing(path)
+            store = cls(path, conn)
+            try:
+                store._check(key)
+            except BaseException:
+                conn.close()
+                raise
+            return store
+        try:
+            conn = sqlite3.connect(str(path), isolation_level=None)
+        except sqlite3.Error as err:
+            raise _refuse(path, f"cannot create the profile store: {err}", "check that the folder is writable") from None
+        store = cls(path, conn)
+        store._create(key)
+        return store
+
+    @staticmethod
+    def _connect_existing(path: Path) -> sqlite3.Connection:
+        with open(path, "rb") as f:
+            header = f.read(16)
+        if header != b"SQLite format 3\x00":
+            raise _refuse(path, "not a profile store (not an SQLite file)",
+                          "it is damaged or another program's file; " + _FRESH_HINT)
+        try:
+            conn = sqlite3.connect(str(path), isolation_level=None)
+            rows = conn.execute("PRAGMA integrity_check").fetchall()
+        except sqlite3.DatabaseError as err:
+            raise _refuse(path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+        if rows != [("ok",)]:
+            conn.close()
+            detail = "; ".join(str(r[0]) for r in rows[:3])
+            raise _refuse(path, f"the profile store is damaged (integrity check: {detail})", _FRESH_HINT)
+        return conn
+
+    def _create(self, key: StoreKey) -> None:
+        conn = self.conn
+        try:
+            conn.execute("PRAGMA journal_mode=WAL")
+            conn.execute("BEGIN")
+            for statement in _statements(SCHEMA):
+                conn.execute(statement)
+            now = repr(time.time())
+            meta = {"schema_version": str(SCHEMA_VERSION), "rrcache_version": key.rrcache_version,
+                    "shader_hash": key.shader_hash, "session_hash": key.session_hash,
+                    "settings_json": key.settings_json, "settings_hash": key.settings_hash,
+                    "created": now, "updated": now}
+            conn.executemany("INSERT INTO meta(key, value) VALUES (?, ?)", sorted(meta.items()))
+            conn.execute("COMMIT")
+        except sqlite3.Error as err:
+            if conn.in_transaction:
+                conn.execute("ROLLBACK")
+            raise _refuse(self.path, f"cannot create the profile store: {err}", "check that the folder is writable") from None
+
+    def _check(self, key: StoreKey) -> None:
+        path = self.path
+        try:
+            tables = {r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        except sqlite3.DatabaseError as err:
+            raise _refuse(path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+        if "meta" not in tables:
+            raise _refuse(path, "an SQLite file that is not a profile store (no meta table)", _FRESH_HINT)
+        try:
+            meta = dict(self.conn.execute("SELECT key, value FROM meta"))
+        except sqlite3.DatabaseError as err:
+            raise _refuse(path, f"an SQLite file that is not a profile store ({err})", _FRESH_HINT) from None
+        version = meta.get("schema_version")
+        if version != str(SCHEMA_VERSION):
+            raise _refuse(path, f"profile store schema {version!r}, this rrcache reads schema {SCHEMA_VERSION}"
+                          if version else "an SQLite file that is not a profile store (no schema version)", _FRESH_HINT)
+        missing = [t for t in _TABLES if t not in tables]
+        if missing:
+            raise _refuse(path, f"the profile store lacks the tables {missing}", _FRESH_HINT)
+        differences = key.compare(meta)
+        if differences:
+            raise _refuse(path, "the profile store was made for other inputs: " + "; ".join(differences), _FRESH_HINT)
+        self.conn.execute("PRAGMA journal_mode=WAL")
+
+    # ------------------------------------------------------------------ transactions
+    def _write(self, statements: Iterable[tuple[str, tuple]]) -> None:
+        conn = self.conn
+        conn.execute("BEGIN IMMEDIATE")
+        try:
+            for sql, args in statements:
+                conn.execute(sql, args)
+            conn.execute("UPDATE meta SET value = ? WHERE key = 'updated'", (repr(time.time()),))
+            conn.execute("COMMIT")
+        except BaseException:
+            if conn.in_transaction:
+                conn.execute("ROLLBACK")
+            raise
+
+    def begin_run(self) -> int:
+        """Log the start of a ``profile`` invocation; its id tags what it computes."""
+        conn = self.conn
+        conn.execute("BEGIN IMMEDIATE")
+        try:
+            cur = conn.execute("INSERT INTO run_log(started, status) VALUES (?, 'running')", (time.time(),))
+            conn.execute("COMMIT")
+        except BaseException:
+            if conn.in_transaction:
+                conn.execute("ROLLBACK")
+            raise
+        self.run_id = int(cur.lastrowid)
+        return self.run_id
+
+    def end_run(self, status: str) -> None:
+        """Mark this invocation ``done``, ``interrupted`` or ``failed``."""
+        if self.run_id is not None:
+            self._write([("UPDATE run_log SET finished = ?, status = ? WHERE id = ?",
+                          (time.time(), status, self.run_id))])
+
+    def count_skipped(self, error_runs: int, timing_runs: int) -> None:
+        """Record how many stored runs this invocation found and skipped."""
+        self._write([("UPDATE run_log SET error_runs_skipped = error_runs_skipped + ?, "
+                      "timing_runs_skipped = timing_runs_skipped + ? WHERE id = ?",
+                      (error_runs, timing_runs, self._rid()))])
+
+    def _rid(self) -> int:
+        if self.run_id is None:
+            self.begin_run()
+        return self.run_id
+
+    # ------------------------------------------------------------------ writers
+    def add_reference(self, covered: dict[int, int]) -> None:
+        """The training frames' covered pixels (replaces earlier rows: they are the same)."""
+        self._write([("INSERT OR REPLACE INTO reference_frame(frame, covered) VALUES (?, ?)", (int(f), int(c)))
+                     for f, c in sorted(covered.items())])
+
+    def add_error_run(self, run: ErrorRun, frames: list[ErrorFrame]) -> None:
+        """One error run and its frames, in one transaction."""
+        rid = self._rid()
+        statements = [("INSERT INTO error_run VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                       (run.node, run.period, run.mean_error, run.psnr, run.hit_rate, run.hits, run.misses,
+                        run.covered, run.frames, run.wall_s, rid))]
+        statements += [("INSERT INTO error_frame VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                        (run.node, run.period, f.frame, f.mean_error, f.psnr, f.hits, f.misses, f.covered, f.left_out))
+                       for f in frames]
+        statements.append(("UPDATE run_log SET error_runs_computed = error_runs_computed + 1 WHERE id = ?", (rid,)))
+        self._write(statements)
+
+    def add_reference_timing(self, rows: list[tuple[int, float, int]]) -> None:
+        """``(frame, ms, covered)`` of the original at full resolution."""
+        self._write([("INSERT OR REPLACE INTO reference_timing VALUES (?, ?, ?)", (int(f), float(ms), int(c)))
+                     for f, ms, c in rows])
+
+    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float) -> None:
+        """One timing run and its frames, in one transaction."""
+        rid = self._rid()
+        statements = [("INSERT INTO timing_run VALUES (?, ?, ?, ?)", (node, int(period), float(wall_s), rid))]
+        statements += [("INSERT INTO timing_frame VALUES (?, ?, ?, ?, ?, ?, ?)",
+                        (node, int(period), f.frame, f.hits, f.misses, f.ms, f.original_ms)) for f in frames]
+        statements.append(("UPDATE run_log SET timing_runs_computed = timing_runs_computed + 1 WHERE id = ?", (rid,)))
+        self._write(statements)
+
+    def set_overhead(self, node: str, size: tuple[int, int], frames: int, ms: float) -> None:
+        self._write([("INSERT OR REPLACE INTO overhead VALUES (1, ?, ?, ?, ?, ?)",
+                      (node, int(size[0]), int(size[1]), int(frames), float(ms)))])
+
+    def add_validation(self, row: ValidationRow) -> None:
+        self._write([("INSERT OR REPLACE INTO validation VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                      (row.label, row.max_error, row.node, row.period, row.predicted_error, row.predicted_ms,
+                       row.predicted_speedup, row.measured_error, row.measured_psnr, row.measured_ms,
+                       row.measured_original_ms, row.measured_speedup, row.hit_rate, row.frames))])
+
+    # ------------------------------------------------------------------ readers
+    def meta(self) -> dict:
+        return dict(self.conn.execute("SELECT key, value FROM meta"))
+
+    def has_error_run(self, node: str, period: int) -> bool:
+        return self.conn.execute("SELECT 1 FROM error_run WHERE node = ? AND period = ?",
+                                 (node, int(period))).fetchone() is not None
+
+    def has_timing_run(self, node: str, period: int) -> bool:
+        return self.conn.execute("SELECT 1 FROM timing_run WHERE node = ? AND period = ?",
+                                 (node, int(period))).fetchone() is not None
+
+    def error_runs(self, node: Optional[str] = None) -> list[ErrorRun]:
+        sql = "SELECT node, period, mean_error, psnr, hit_rate, hits, misses, covered, frames, wall_s FROM error_run"
+        rows = self.conn.execute(sql + (" WHERE node = ?" if node else "") + " ORDER BY node, period",
+                                 (node,) if node else ())
+        return [ErrorRun(*r) for r in rows]
+
+    def error_frames(self, node: str, period: int) -> list[ErrorFrame]:
+        rows = self.conn.execute("SELECT frame, mean_error, psnr, hits, misses, covered, left_out FROM error_frame "
+                                 "WHERE node = ? AND period = ? ORDER BY frame", (node, int(period)))
+        return [ErrorFrame(*r) for r in rows]
+
+    def timing_frames(self, node: str) -> dict[int, list[TimingFrame]]:
+        """Per timing period, the timed frames of ``node``."""
+        out: dict[int, list[TimingFrame]] = {}
+        rows = self.conn.execute("SELECT period, frame, hits, misses, ms, original_ms FROM timing_frame "
+                                 "WHERE node = ? ORDER BY period, frame", (node,))
+        for period, *rest in rows:
+            out.setdefault(int(period), []).append(TimingFrame(*rest))
+        return out
+
+    def timed_nodes(self) -> set[str]:
+        return {r[0] for r in self.conn.execute("SELECT DISTINCT node FROM timing_run")}
+
+    def reference_timing(self) -> list[tuple[int, float, int]]:
+        return [tuple(r) for r in self.conn.execute("SELECT frame, ms, covered FROM reference_timing ORDER BY frame")]
+
+    def overhead(self) -> Optional[dict]:
+        row = self.conn.execute("SELECT node, width, height, frames, ms FROM overhead WHERE id = 1").fetchone()
+        if row is None:
+            return None
+        return dict(zip(("node", "width", "height", "frames", "ms"), row))
+
+    def validations(self) -> list[ValidationRow]:
+        rows = self.conn.execute("SELECT * FROM validation ORDER BY label")
+        return [ValidationRow(*r) for r in rows]
+
+    def spent_s(self) -> float:
+        """Training seconds stored so far (error and timing runs): what the budget has spent."""
+        a = self.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM error_run").fetchone()[0]
+        b = self.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM timing_run").fetchone()[0]
+        return float(a) + float(b)
+
+    def counts(self) -> dict:
+        """How much is stored: error runs, timing runs, validations, and this invocation's counters."""
+        q = lambda sql: int(self.conn.execute(sql).fetchone()[0])  # noqa: E731
+        out = {"error_runs": q("SELECT COUNT(*) FROM error_run"),
+               "timing_runs": q("SELECT COUNT(*) FROM timing_run"),
+               "nodes": q("SELECT COUNT(DISTINCT node) FROM error_run"),
+               "validations": q("SELECT COUNT(*) FROM validation")}
+        if self.run_id is not None:
+            row = self.conn.execute("SELECT error_runs_computed, error_runs_skipped, timing_runs_computed, "
+                                    "timing_runs_skipped FROM run_log WHERE id = ?", (self.run_id,)).fetchone()
+            out.update(zip(("error_runs_computed", "error_runs_skipped", "timing_runs_computed",
+                            "timing_runs_skipped"), row))
+        return out
+
+    def run_log(self) -> list[dict]:
+        cols = ("id", "started", "finished", "status", "error_runs_computed", "error_runs_skipped",
+                "timing_runs_computed", "timing_runs_skipped")
+        return [dict(zip(cols, r)) for r in self.conn.execute(f"SELECT {', '.join(cols)} FROM run_log ORDER BY id")]
+
+    def close(self) -> None:
+        try:
+            self.conn.close()
+        except sqlite3.Error:
+            pass
+
+    def __enter__(self) -> "ProfileStore":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _statements(script: str) -> list[str]:
+    """The statements of :data:`SCHEMA` (comments dropped)."""
+    lines = [line for line in script.splitlines() if not line.lstrip().startswith("--")]
+    return [s.strip() for s in "\n".join(lines).split(";") if s.strip()]
+
+
+def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
+    """Open an existing store read-only-ish, without a key check (for reports and tests); a file
+    that is not a store raises :class:`RRCacheError`."""
+    path = Path(path)
+    if not path.exists():
+        raise _refuse(path, "no profile store here", "run 'rrcache profile' first")
+    conn = ProfileStore._connect_existing(path)
+    store = ProfileStore(path, conn)
+    try:
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        if "meta" not in tables or dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") != str(SCHEMA_VERSION):
+            raise _refuse(path, "an SQLite file that is not a profile store", _FRESH_HINT)
+    except sqlite3.DatabaseError as err:
+        conn.close()
+        raise _refuse(path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+    except BaseException:
+        conn.close()
+        raise
+    return store

@@ -1,0 +1,322 @@
+"""Training: the measurements behind the error and performance models (main paper §4.2–4.3).
+
+:func:`train` fills a :class:`~rrcache.profile.store.ProfileStore`, skipping whatever it already
+holds, and fits the models from what is stored:
+
+1. **Reference frames.** The original shader over the training frames at the training
+   resolution, rendered once and kept in memory for the run.
+2. **Error runs.** Nodes are trained costliest first (static cost: the "smart order"). Per node
+   one :class:`~rrcache.harness.cached.CachedRenderer` at the training resolution serves every
+   period (``.period = Δn; .reset()``): the training frames are rendered in order from an empty
+   cache and each frame's mean RGB L2 error over covered pixels, PSNR, hits and misses recorded.
+   A run's error is the mean over the frames after the first (which has no cache); so the error
+   is measured at the *training* resolution.
+3. **Timing.** At the session's full resolution the original is timed once on the L timing frames
+   (spread evenly over the session), then every node at each timing period: per timing frame f
+   the original renders f, then the variant renders f − 1 untimed (an empty cache filled once)
+   and f timed. The refresh schedule makes a frame's hit/miss mix independent of how long the
+   cache has run, so one warm-up frame gives the steady-state mix at two renders per sample,
+   and alternating with the original per frame lets machine noise touch both alike.
+4. **Overhead.** The cached pipeline's frame time with almost nothing covered: the costliest
+   trained node's variant rendered at 8×8 (geometry still processed, every pass issued), median
+   over the timing frames. DESIGN §3: with constant coverage h + m is nearly constant and the
+   hit/miss/overhead system is rank-deficient, so the overhead is measured, not solved for.
+5. **Fits** through :mod:`rrcache.model`: α, λ per node, μ over every node's hit rates, t_hit
+   and t_miss per node given the overhead.
+
+The budget (``settings.budget_s``) counts the seconds of every stored run, earlier invocations
+included: once spent, no new node is started (a started node is finished); the nodes never
+started are reported as untrained. Every run is committed as it completes, so an interruption
+(SIGINT, a kill) loses at most the run in flight; ``KeyboardInterrupt`` propagates after the
+store is left consistent.
+
+>>> result = train(work, session, settings.resolved(session), store)       # doctest: +SKIP
+>>> result.trained[:2], result.hit_fit.mu                                    # doctest: +SKIP
+(['n102', 'n115'], 0.93)
+"""
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+from rrcache.errors import RRCacheError
+from rrcache.harness.cached import CachedRenderer
+from rrcache.harness.metrics import mean_l2, psnr
+from rrcache.harness.renderer import Renderer
+from rrcache.pipeline import ShaderWork, variant_for
+from rrcache.profile.settings import TrainingSettings
+from rrcache.profile.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
+
+#: the resolution of the overhead measurement
+OVERHEAD_SIZE = (8, 8)
+PSNR_CAP = 100.0
+
+
+@dataclass
+class ProgressEvent:
+    """Sent to the ``progress`` callback: ``stage`` (``reference``, ``error``, ``timing``,
+    ``overhead``, ``validate``), frames rendered ``done`` of ``total`` planned (the plan shrinks
+    when the budget stops the training), and a short ``detail`` (node and period)."""
+
+    stage: str
+    done: int
+    total: int
+    detail: str = ""
+
+
+ProgressFn = Callable[[ProgressEvent], None]
+
+
+class _Meter:
+    def __init__(self, progress: Optional[ProgressFn], total: int):
+        self.progress, self.total, self.done = progress, max(0, total), 0
+
+    def step(self, stage: str, detail: str = "", n: int = 1) -> None:
+        self.done += n
+        self.total = max(self.total, self.done)
+        if self.progress is not None:
+            self.progress(ProgressEvent(stage, self.done, self.total, detail))
+
+    def shrink(self, by: int) -> None:
+        self.total = max(self.done, self.total - by)
+        if self.progress is not None:
+            self.progress(ProgressEvent("train", self.done, self.total, "budget spent"))
+
+    def grow(self, by: int) -> None:
+        self.total += by
+
+
+@dataclass
+class TrainingResult:
+    """What training produced: ``order`` (every node id, costliest first), ``trained`` (ids with
+    every error and timing run stored), ``untrained`` (the rest), the fits (``error_fits`` and
+    ``perf_fits`` by node id, ``hit_fit``), ``overhead_ms``, ``original_ms`` (median original
+    frame time at full resolution), ``pixels`` (mean covered pixels M at full resolution),
+    ``counts`` (runs computed and skipped by this invocation), ``wall_s`` (this invocation) and
+    ``spent_s`` (every stored run's seconds)."""
+
+    order: list[str]
+    trained: list[str]
+    untrained: list[str]
+    error_fits: dict = field(default_factory=dict)
+    perf_fits: dict = field(default_factory=dict)
+    hit_fit: object = None
+    overhead_ms: float = float("nan")
+    original_ms: float = float("nan")
+    pixels: float = 0.0
+    counts: dict = field(default_factory=dict)
+    wall_s: float = 0.0
+    spent_s: float = 0.0
+    budget_stopped: bool = False
+
+
+def training_order(work: ShaderWork) -> list:
+    """The cacheable nodes, costliest first (ties: in the table's order)."""
+    nodes = list(work.table.nodes)
+    return [n for _, n in sorted(enumerate(nodes), key=lambda item: (-item[1].cost, item[0]))]
+
+
+def timing_frame_indices(session_frames: int, count: int) -> list[int]:
+    """``count`` frames spread evenly over ``1 .. session_frames − 1`` (each timed frame needs the
+    one before it to warm the cache).
+
+    >>> timing_frame_indices(150, 4)
+    [1, 50, 100, 149]
+    >>> timing_frame_indices(5, 12)
+    [1, 2, 3, 4]
+    """
+    if session_frames < 2:
+        return []
+    count = max(1, min(count, session_frames - 1))
+    return sorted({int(round(x)) for x in np.linspace(1, session_frames - 1, count)})
+
+
+def _error_run(cached: CachedRenderer, node_id: str, period: int, refs: list, meter: _Meter) -> tuple[ErrorRun, list]:
+    start = time.perf_counter()
+    cached.period = period
+    cached.reset()
+    frames: list[ErrorFrame] = []
+    for ref in refs:
+        got = cached.render_frame(ref.index)
+        err, left_out = mean_l2(got.image, ref.image, ref.mask)
+        frames.append(ErrorFrame(ref.index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP),
+                                 int(got.hits), int(got.misses), int(got.covered_pixels), int(left_out)))
+        meter.step("error", f"{node_id} Δn={period}")
+    steady = frames[1:] or frames
+    hits, misses = sum(f.hits for f in steady), sum(f.misses for f in steady)
+    run = ErrorRun(node_id, int(period), float(np.mean([f.mean_error for f in steady])),
+                   float(np.mean([f.psnr for f in steady])), hits / (hits + misses) if hits + misses else 0.0,
+                   hits, misses, sum(f.covered for f in steady), len(frames), time.perf_counter() - start)
+    return run, frames
+
+
+def _timing_run(cached: CachedRenderer, original: Renderer, node_id: str, period: int, indices: list[int],
+                meter: _Meter) -> list[TimingFrame]:
+    cached.period = period
+    out = []
+    for index in indices:
+        ref = original.render_frame(index)
+        cached.reset()
+        cached.render_frame(index - 1)
+        got = cached.render_frame(index)
+        out.append(TimingFrame(index, int(got.hits), int(got.misses), float(got.ms), float(ref.ms)))
+        meter.step("timing", f"{node_id} Δn={period}", 3)
+    return out
+
+
+def _node_complete(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
+    return (all(store.has_error_run(node_id, p) for p in settings.periods)
+            and all(store.has_timing_run(node_id, p) for p in settings.timing_periods))
+
+
+def _node_started(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
+    return (any(store.has_error_run(node_id, p) for p in settings.periods)
+            or any(store.has_timing_run(node_id, p) for p in settings.timing_periods))
+
+
+def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore,
+          progress: Optional[ProgressFn] = None, clock: Callable[[], float] = time.perf_counter) -> TrainingResult:
+    """Measure what ``store`` lacks for ``work`` over ``session`` with the *resolved*
+    ``settings`` (:meth:`TrainingSettings.resolved`), then fit the models (see the module
+    docstring). Returns a :class:`TrainingResult`."""
+    start = clock()
+    order = training_order(work)
+    if not order:
+        raise RRCacheError("the shader has no cacheable node to train", str(work.shader.path or "<shader>"),
+                           hint="'rrcache nodes SHADER --all' lists the values left out and why")
+    ids = [n.id for n in order]
+    train_frames = list(range(settings.frames))
+    timing = timing_frame_indices(session.frames, settings.timing_frames)
+    full = tuple(int(v) for v in session.resolution)
+
+    todo_error = {i: [p for p in settings.periods if not store.has_error_run(i, p)] for i in ids}
+    todo_timing = {i: [p for p in settings.timing_periods if not store.has_timing_run(i, p)] for i in ids}
+    skipped_error = sum(len(settings.periods) - len(v) for v in todo_error.values())
+    skipped_timing = sum(len(settings.timing_periods) - len(v) for v in todo_timing.values())
+    store.count_skipped(skipped_error, skipped_timing)
+
+    need_refs = any(todo_error.values())
+    need_ref_timing = not store.reference_timing()
+    need_overhead = store.overhead() is None
+    plan = ((len(train_frames) if need_refs else 0) + (len(timing) if need_ref_timing else 0)
+            + sum(len(v) * len(train_frames) for v in todo_error.values())
+            + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
+            + (len(timing) if need_overhead else 0))
+    meter = _Meter(progress, plan)
+    budget_stopped = False
+
+    refs = []
+    if need_refs:
+        with Renderer(work.prepared, session, settings.resolution) as renderer:
+            for index in train_frames:
+                refs.append(renderer.render_frame(index))
+                meter.step("reference", f"frame {index}")
+        store.add_reference({r.index: r.covered_pixels for r in refs})
+
+    original: Optional[Renderer] = None
+    try:
+        original = Renderer(work.prepared, session, full)
+        if need_ref_timing:
+            rows = []
+            for index in timing:
+                got = original.render_frame(index)
+                rows.append((index, got.ms, got.covered_pixels))
+                meter.step("reference", f"timing frame {index}")
+            store.add_reference_timing(rows)
+
+        for node in order:
+            nid = node.id
+            if not todo_error[nid] and not todo_timing[nid]:
+                continue
+            if not _node_started(store, nid, settings) and store.spent_s() >= settings.budget_s:
+                budget_stopped = True
+                meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
+                continue
+            variant = variant_for(work, nid, settings.timing_periods[0], settings.algorithm)
+            if todo_error[nid]:
+                built = clock()
+                with CachedRenderer(variant, session, work.prepared, settings.resolution, period=settings.periods[0],
+                                    block=settings.block, refresh=settings.refresh,
+                                    depth_epsilon=settings.depth_epsilon) as cached:
+                    compile_s = clock() - built
+                    for period in todo_error[nid]:
+                        run, frames = _error_run(cached, nid, period, refs, meter)
+                        run.wall_s += compile_s
+                        compile_s = 0.0
+                        store.add_error_run(run, frames)
+            if todo_timing[nid]:
+                built = clock()
+                with CachedRenderer(variant, session, work.prepared, full, period=settings.timing_periods[0],
+                                    block=settings.block, refresh=settings.refresh,
+                                    depth_epsilon=settings.depth_epsilon) as cached:
+                    compile_s = clock() - built
+                    for period in todo_timing[nid]:
+                        t0 = clock()
+                        frames = _timing_run(cached, original, nid, period, timing, meter)
+                        store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
+                        compile_s = 0.0
+    finally:
+        if original is not None:
+            original.release()
+
+    trained = [i for i in ids if _node_complete(store, i, settings)]
+    if trained and need_overhead:
+        _measure_overhead(work, session, settings, store, trained[0], timing, meter)
+
+    result = TrainingResult(order=ids, trained=trained, untrained=[i for i in ids if i not in trained],
+                            budget_stopped=budget_stopped)
+    fit_models(store, settings, result)
+    result.counts = store.counts()
+    result.wall_s = clock() - start
+    result.spent_s = store.spent_s()
+    return result
+
+
+def _measure_overhead(work, session, settings, store, node_id, timing, meter) -> None:
+    variant = variant_for(work, node_id, settings.timing_periods[-1], settings.algorithm)
+    times = []
+    with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
+                        block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon) as cached:
+        for index in timing:
+            cached.reset()
+            cached.render_frame(index - 1)
+            times.append(cached.render_frame(index).ms)
+            meter.step("overhead", f"{node_id} at {OVERHEAD_SIZE[0]}×{OVERHEAD_SIZE[1]}")
+    store.set_overhead(node_id, OVERHEAD_SIZE, len(times), statistics.median(times))
+
+
+def fit_models(store: ProfileStore, settings: TrainingSettings, result: TrainingResult) -> None:
+    """Fit α, λ (per trained node), μ (every trained node's hit rates) and t_hit, t_miss (per
+    trained node, with the measured overhead) from ``store``, into ``result``."""
+    from rrcache.model import fit_error, fit_hit_rate, fit_performance
+
+    overhead = store.overhead()
+    result.overhead_ms = float(overhead["ms"]) if overhead else float("nan")
+    ref_timing = store.reference_timing()
+    if ref_timing:
+        result.pixels = float(np.mean([c for _, _, c in ref_timing]))
+    originals = [ms for _, ms, _ in ref_timing]
+    periods, rates = [], []
+    for nid in result.trained:
+        runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
+        result.error_fits[nid] = fit_error([r.period for r in runs], [r.mean_error for r in runs])
+        periods += [r.period for r in runs]
+        rates += [r.hit_rate for r in runs]
+        hits, misses, times = [], [], []
+        for period, frames in sorted(store.timing_frames(nid).items()):
+            if period not in settings.timing_periods:
+                continue
+            for f in frames:
+                hits.append(f.hits)
+                misses.append(f.misses)
+                times.append(f.ms)
+                originals.append(f.original_ms)
+        result.perf_fits[nid] = fit_performance(hits, misses, times,
+                                                overhead_ms=result.overhead_ms if overhead else None)
+    if periods:
+        result.hit_fit = fit_hit_rate(periods, rates)
+    result.original_ms = float(statistics.median(originals)) if originals else float("nan")

@@ -1,0 +1,222 @@
+"""The profiler through the library, end to end on a tiny scene (an icosphere, 64×48, 12 frames,
+periods 2, 4, 8, a noise-like shader with a dozen cacheable nodes):
+
+- every node is trained costliest first; the error grows with Δn; the fits and μ are stored in
+  profile.json with the schema the CLI and load_profile rely on;
+- progress events count up to their plan; the plots are real PNG/SVG files;
+- a tiny budget trains only the costliest node and reports the rest untrained; raising the budget
+  resumes and trains the rest, skipping every stored run;
+- validation of a selection that caches something: measured error and speed-up are stored beside
+  the prediction, and a stored measurement is reused;
+- load_profile refuses files that are not profiles; select() re-selects from the models.
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from rrcache.errors import RRCacheError
+from rrcache.profile import TrainingSettings, load_profile, profile, read_store, select
+
+SHADER = """#version 330
+in vec4 v_position;
+in vec3 v_normal;
+in vec3 v_objectPosition;
+uniform vec3 u_light;
+uniform float u_scale;
+out vec4 fragColor;
+
+float wave(vec3 p, float f) {
+    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
+}
+
+void main() {
+    vec3 p = v_objectPosition * u_scale;
+    float n = 0.5 + 0.25 * wave(p, 1.0) + 0.125 * wave(p, 2.1) + 0.0625 * wave(p, 4.3);
+    vec3 albedo = mix(vec3(0.9, 0.8, 0.6), vec3(0.3, 0.2, 0.1), n);
+    vec3 nrm = normalize(v_normal);
+    vec3 l = normalize(u_light - v_position.xyz);
+    float diffuse = max(dot(nrm, l), 0.0);
+    fragColor = vec4(albedo * (0.2 + 0.8 * diffuse), 1.0);
+}
+"""
+
+SESSION = {
+    "rrcache_session": 1, "resolution": [64, 48], "frames": 12, "fps": 30,
+    "camera": {"fov": 45, "near": 0.1, "far": 50, "keyframes": [
+        {"frame": 0, "eye": [0, 0.5, 3.2], "target": [0, 0, 0], "up": [0, 1, 0]},
+        {"frame": 11, "eye": [1.2, 0.6, 2.9], "target": [0, 0, 0], "up": [0, 1, 0]}]},
+    "light": {"color": [1, 1, 1], "orbit": {"center": [0, 0, 0], "radius": 4, "height": 3, "degrees_per_frame": 3}},
+    "objects": [{"procedural": {"type": "icosphere", "radius": 1.0, "subdivisions": 3}}],
+    "uniforms": {"u_scale": 3.0},
+}
+
+#: the settings of every test profile: training at 32×24, six timing frames
+SETTINGS = dict(periods=(2, 4, 8), resolution=(32, 24), timing_frames=6, timing_periods=(2, 8))
+CLI_SETTINGS = ["--periods", "2,4,8", "--resolution", "32x24", "--timing-frames", "6", "--timing-periods", "2,8"]
+
+NODE_KEYS = {"id", "type", "line", "column", "text", "call_chain", "cost", "trained", "alpha", "lam",
+             "error_quality", "error_r2", "t_hit", "t_miss", "perf_quality"}
+
+
+def write_scene(folder):
+    """The test shader and session in ``folder``; returns their paths."""
+    folder.mkdir(parents=True, exist_ok=True)
+    shader, session = folder / "noise.frag", folder / "orbit.json"
+    shader.write_text(SHADER)
+    session.write_text(json.dumps(SESSION))
+    return shader, session
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("profile")
+    shader, session = write_scene(folder)
+    events = []
+    prof = profile(shader, session, folder / "out", TrainingSettings(**SETTINGS, validate=False),
+                   progress=events.append)
+    return prof, events, folder
+
+
+def test_every_node_trained_costliest_first(trained):
+    prof, _, _ = trained
+    assert len(prof.nodes) >= 8 and all(n.trained for n in prof.nodes)
+    costs = [n.cost for n in prof.nodes]
+    assert costs == sorted(costs, reverse=True)
+    for node in prof.nodes:
+        assert node.periods == [2, 4, 8]
+        # caching anything but nothing: the error grows with the refresh period
+        assert node.errors[0] < node.errors[1] < node.errors[2], node
+        assert node.alpha > 0 and node.lam > 0
+        fit = node.alpha * (1 - np.exp(-node.lam * (np.array(node.periods) - 1)))
+        assert np.allclose(fit, node.errors, rtol=0.35, atol=1e-4)
+    assert 0.2 < prof.mu <= 1.0
+    assert prof.pixels > 500 and prof.original_ms > 0 and prof.overhead_ms > 0
+
+
+def test_profile_json_schema(trained):
+    prof, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    assert data["rrcache_profile"] == 1
+    assert data["settings"]["periods"] == [2, 4, 8] and data["settings"]["resolution"] == [32, 24]
+    for key in ("mu", "mu_quality", "overhead_ms", "original_ms", "pixels", "training_wall_s", "selections",
+                "shader_hash", "session_hash", "untrained"):
+        assert key in data, key
+    for node in data["nodes"]:
+        assert NODE_KEYS <= set(node), NODE_KEYS - set(node)
+    assert [s["label"] for s in data["selections"]] == ["e1", "e2", "e3", "e4"]
+    for sel in data["selections"]:
+        assert (folder / "out" / sel["files"] / "manifest.json").exists()
+    # nothing non-finite leaks into the JSON
+    assert "NaN" not in (folder / "out" / "profile.json").read_text()
+
+
+def test_progress_events_count_to_their_plan(trained):
+    _, events, _ = trained
+    assert {"reference", "error", "timing", "overhead"} <= {e.stage for e in events}
+    done = [e.done for e in events]
+    assert done == sorted(done) and events[-1].done == events[-1].total
+    assert all(e.done <= e.total for e in events)
+
+
+def test_plots_are_images(trained):
+    _, _, folder = trained
+    out = folder / "out"
+    for name in ("tradeoff.png", "hitrate.png"):
+        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"<svg" in (out / "tradeoff.svg").read_bytes()[:2000]
+    assert not (out / "validation.png").exists()  # validate=False: nothing measured
+
+
+def test_select_from_the_models(trained):
+    prof, _, folder = trained
+    loaded = load_profile(folder / "out")
+    assert [n.id for n in loaded.nodes] == [n.id for n in prof.nodes]
+    loose = loaded.select(1e9)
+    strict = loaded.select(0.0)
+    assert strict.predicted_error <= 1e-12
+    assert loose.predicted_ms <= strict.predicted_ms
+    assert select(folder / "out" / "profile.json", 1e9).predicted_ms == loose.predicted_ms
+    with pytest.raises(RRCacheError, match="--max-error"):
+        loaded.select(float("nan"))
+
+
+def test_budget_stops_new_nodes_and_resume_finishes(tmp_path):
+    shader, session = write_scene(tmp_path)
+    settings = TrainingSettings(**SETTINGS, validate=False, budget_s=1e-6)
+    first = profile(shader, session, tmp_path / "out", settings)
+    trained = [n.id for n in first.nodes if n.trained]
+    assert trained == [first.nodes[0].id]  # the costliest node is always started
+    assert first.data["budget_stopped"] and len(first.data["untrained"]) == len(first.nodes) - 1
+    assert first.counts["error_runs_computed"] == 3 and first.counts["error_runs_skipped"] == 0
+    second = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False))
+    assert all(n.trained for n in second.nodes)
+    assert second.counts["error_runs_skipped"] == 3 and second.counts["timing_runs_skipped"] == 2
+    assert second.counts["error_runs_computed"] == 3 * (len(second.nodes) - 1)
+    assert second.nodes[0].alpha == pytest.approx(first.nodes[0].alpha, rel=1e-9)
+
+
+def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
+    """Validation of a table whose best choice caches the costliest node (the models are replaced
+    by fits that make caching pay, so the choice does not depend on this machine's speed)."""
+    import rrcache.model as model
+    from rrcache.pipeline import load_for_session
+    from rrcache.profile.store import ProfileStore, StoreKey
+    from rrcache.profile.validate import validate
+    from rrcache.session import load_session
+
+    prof, _, folder = trained
+    node = prof.nodes[0]
+    session = load_session(folder / "orbit.json")
+    work = load_for_session(folder / "noise.frag", session)
+    errors, perfs, hit = prof.fits()
+    cheap = model.fit_performance([100, 50, 10], [10, 50, 100], [1.1, 1.5, 2.0], overhead_ms=0.1)
+    table = model.ModelTable.from_fits([node.id], [errors[0]], [cheap], hit, prof.pixels, 1000.0)
+    settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        rows = validate(work, session, settings, store, table)
+        assert [r.label for r in rows] == ["e1", "e2", "e3", "e4"]
+        cached = [r for r in rows if r.node is not None]
+        assert cached, rows
+        for row in cached:
+            assert row.node == node.id and row.frames == 6 and row.measured_speedup > 0
+            if row.period == 1:  # refreshed every frame: the original's image, no hits
+                assert row.measured_error <= 1e-6 and row.hit_rate == 0
+            else:
+                assert row.measured_error > 0 and 0 < row.hit_rate < 1
+                assert math.isfinite(row.measured_psnr)
+        assert any(row.period > 1 for row in cached), rows
+        assert len(store.validations()) == 4
+        events = []
+        again = validate(work, session, settings, store, table, progress=events.append)
+        assert not events  # every (node, period) was measured already
+        assert [r.measured_error for r in again] == [r.measured_error for r in rows]
+
+
+def test_load_profile_refuses_other_files(tmp_path):
+    with pytest.raises(RRCacheError, match="no profile here"):
+        load_profile(tmp_path)
+    bad = tmp_path / "profile.json"
+    bad.write_text("{not json")
+    with pytest.raises(RRCacheError, match="cannot read the profile") as info:
+        load_profile(tmp_path)
+    assert str(bad) in str(info.value)
+    bad.write_text(json.dumps({"rrcache_session": 1}))
+    with pytest.raises(RRCacheError, match="not an rrcache profile"):
+        load_profile(bad)
+    bad.write_text(json.dumps({"rrcache_profile": 1, "shader": "x"}))
+    with pytest.raises(RRCacheError, match="not a complete profile"):
+        load_profile(bad)
+
+
+def test_store_matches_profile_json(trained):
+    prof, _, folder = trained
+    with read_store(folder / "out" / "profile.sqlite") as store:
+        assert store.counts()["error_runs"] == 3 * len(prof.nodes)
+        assert store.run_log()[-1]["status"] == "done"
+        errs = {r.period: r.mean_error for r in store.error_runs(prof.nodes[0].id)}
+    assert [errs[p] for p in (2, 4, 8)] == prof.nodes[0].errors

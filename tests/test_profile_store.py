@@ -1,0 +1,189 @@
+"""The profile store and the training settings, without GL.
+
+- a store opened with another shader, session, settings or rrcache version is refused, naming the
+  file and what differs, with the --out/--fresh hint; ``fresh`` moves it aside as .bak;
+- a damaged file, a text file and a foreign SQLite file (no meta, another schema) are refused;
+- a write interrupted half-way leaves nothing of it behind;
+- settings: bad values are located errors; budget and validate are not part of the key.
+"""
+from __future__ import annotations
+
+import sqlite3
+import warnings
+from types import SimpleNamespace
+
+import pytest
+
+from rrcache.errors import RRCacheError
+from rrcache.profile.settings import TrainingSettings, parse_periods
+from rrcache.profile.store import SCHEMA_VERSION, ErrorFrame, ErrorRun, ProfileStore, StoreKey, read_store
+
+SETTINGS = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), frames=12, validation_frames=12)
+
+
+def _key(**over):
+    base = dict(shader_hash="a" * 64, session_hash="b" * 64, settings_hash=SETTINGS.key_hash(),
+                rrcache_version="0.1.0", settings_json=SETTINGS.key_json())
+    base.update(over)
+    return StoreKey(**base)
+
+
+def _run(node="n1", period=2):
+    return ErrorRun(node, period, 0.01, 40.0, 0.5, 10, 10, 20, 3, 0.1)
+
+
+def _frames():
+    return [ErrorFrame(i, 0.01 * i, 40.0, 5, 5, 10, 0) for i in range(3)]
+
+
+def test_round_trip_and_resume_counters(tmp_path):
+    path = tmp_path / "profile.sqlite"
+    with ProfileStore.open(path, _key()) as store:
+        store.begin_run()
+        store.add_error_run(_run(), _frames())
+        assert store.has_error_run("n1", 2) and not store.has_error_run("n1", 4)
+    with ProfileStore.open(path, _key()) as store:
+        store.begin_run()
+        store.count_skipped(1, 0)
+        assert [r.period for r in store.error_runs("n1")] == [2]
+        assert [f.frame for f in store.error_frames("n1", 2)] == [0, 1, 2]
+        counts = store.counts()
+        assert counts["error_runs"] == 1 and counts["error_runs_computed"] == 0 and counts["error_runs_skipped"] == 1
+        with pytest.raises(sqlite3.IntegrityError):  # a run is never stored twice
+            store.add_error_run(_run(), _frames())
+        assert [r["error_runs_computed"] for r in store.run_log()] == [1, 0]
+        assert store.meta()["schema_version"] == str(SCHEMA_VERSION)
+
+
+@pytest.mark.parametrize("field,words", [("shader_hash", "shader"), ("session_hash", "session"),
+                                         ("rrcache_version", "rrcache version")])
+def test_other_key_is_refused(tmp_path, field, words):
+    path = tmp_path / "profile.sqlite"
+    ProfileStore.open(path, _key()).close()
+    with pytest.raises(RRCacheError) as info:
+        ProfileStore.open(path, _key(**{field: "c" * 64}))
+    text = str(info.value)
+    assert str(path) in text and words in text and "--fresh" in text and "--out" in text
+
+
+def test_other_settings_name_the_difference(tmp_path):
+    path = tmp_path / "profile.sqlite"
+    ProfileStore.open(path, _key()).close()
+    other = TrainingSettings(periods=(2, 4, 9), resolution=(32, 24), frames=12, validation_frames=12)
+    with pytest.raises(RRCacheError, match=r"periods: stored \[2, 4, 8\], now \[2, 4, 9\]"):
+        ProfileStore.open(path, _key(settings_hash=other.key_hash(), settings_json=other.key_json()))
+
+
+def test_fresh_moves_the_old_store_aside(tmp_path):
+    path = tmp_path / "profile.sqlite"
+    with ProfileStore.open(path, _key()) as store:
+        store.add_error_run(_run(), _frames())
+    with ProfileStore.open(path, _key(shader_hash="c" * 64), fresh=True) as store:
+        assert store.counts()["error_runs"] == 0
+    with read_store(tmp_path / "profile.sqlite.bak") as old:
+        assert old.counts()["error_runs"] == 1
+
+
+def test_damaged_file_is_refused(tmp_path):
+    path = tmp_path / "profile.sqlite"
+    with ProfileStore.open(path, _key()) as store:
+        for n in range(40):
+            store.add_error_run(_run(f"n{n}"), _frames())
+        store.conn.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+    data = bytearray(path.read_bytes())
+    assert len(data) > 8192
+    data[4096:8192] = b"\xa5" * 4096  # wipe a page in the middle
+    path.write_bytes(bytes(data))
+    with pytest.raises(RRCacheError, match="damaged") as info:
+        ProfileStore.open(path, _key())
+    assert str(path) in str(info.value) and "--fresh" in str(info.value)
+
+
+def test_text_file_is_refused(tmp_path):
+    path = tmp_path / "profile.sqlite"
+    path.write_text("not a database\n" * 10)
+    with pytest.raises(RRCacheError, match="not an SQLite file"):
+        ProfileStore.open(path, _key())
+
+
+def test_foreign_sqlite_files_are_refused(tmp_path):
+    foreign = tmp_path / "foreign.sqlite"
+    with sqlite3.connect(foreign) as conn:
+        conn.execute("CREATE TABLE samples (x REAL)")
+    with pytest.raises(RRCacheError, match="no meta table"):
+        ProfileStore.open(foreign, _key())
+    other = tmp_path / "other.sqlite"
+    with sqlite3.connect(other) as conn:  # coverage.py-like: a meta table with another schema
+        conn.execute("CREATE TABLE meta (key TEXT, value TEXT)")
+        conn.execute("INSERT INTO meta VALUES ('version', '7.3')")
+    with pytest.raises(RRCacheError, match="no schema version"):
+        ProfileStore.open(other, _key())
+    newer = tmp_path / "newer.sqlite"
+    ProfileStore.open(newer, _key()).close()
+    with sqlite3.connect(newer) as conn:
+        conn.execute("UPDATE meta SET value = '99' WHERE key = 'schema_version'")
+    with pytest.raises(RRCacheError, match="schema '99'"):
+        ProfileStore.open(newer, _key())
+
+
+def test_interrupted_write_leaves_nothing(tmp_path):
+    path = tmp_path / "profile.sqlite"
+    with ProfileStore.open(path, _key()) as store:
+        def statements():
+            yield ("INSERT INTO error_run VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                   ("n1", 2, 0.1, 30.0, 0.5, 1, 1, 2, 3, 0.1, 1))
+            raise KeyboardInterrupt
+        with pytest.raises(KeyboardInterrupt):
+            store._write(statements())
+        assert store.counts()["error_runs"] == 0
+    with ProfileStore.open(path, _key()) as store:
+        assert store.counts()["error_runs"] == 0
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(periods=(2, 0)), "periods: 0"),
+    (dict(periods=(2, 2)), "repeats"),
+    (dict(periods=()), "no periods"),
+    (dict(resolution=(0, 10)), "resolution"),
+    (dict(frames=1), "frames"),
+    (dict(timing_frames=0), "timing_frames"),
+    (dict(algorithm="four-pass"), "unknown algorithm"),
+    (dict(block=3), "block"),
+    (dict(refresh="sometimes"), "refresh"),
+    (dict(depth_epsilon=2.0), "depth_epsilon"),
+    (dict(budget_s=0), "budget_s"),
+])
+def test_bad_settings_are_located(kwargs, match):
+    with pytest.raises(RRCacheError, match=match) as info:
+        TrainingSettings(**kwargs)
+    assert info.value.where == "settings" and info.value.hint
+
+
+def test_parse_periods():
+    assert parse_periods("8,2, 4") == (2, 4, 8)
+    with pytest.raises(RRCacheError, match="--periods") as info:
+        parse_periods("2,x")
+    assert info.value.hint
+
+
+def test_key_ignores_budget_and_validate_and_resolves_defaults():
+    session = SimpleNamespace(resolution=(64, 48), frames=12, path="s.json")
+    a = TrainingSettings(periods=(2, 4, 8)).resolved(session)
+    b = TrainingSettings(periods=(2, 4, 8), resolution=(16, 12), frames=12, budget_s=5, validate=False).resolved(session)
+    assert a.resolution == (16, 12) and a.frames == 12
+    assert a.key_hash() == b.key_hash()
+    assert a.key_hash() != TrainingSettings(periods=(2, 4, 9)).resolved(session).key_hash()
+    assert TrainingSettings.from_json(b.to_json()) == b
+    with pytest.raises(RRCacheError, match="unknown training settings"):
+        TrainingSettings.from_json({**b.to_json(), "octaves": 3})
+
+
+def test_short_session_warns_and_too_many_frames_fail():
+    session = SimpleNamespace(resolution=(64, 48), frames=12, path="s.json")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        TrainingSettings().resolved(session)  # the largest period, 50, exceeds 12 frames
+    assert any("steady state" in str(w.message) for w in caught)
+    with pytest.raises(RRCacheError, match="the session has 12") as info:
+        TrainingSettings(frames=20).resolved(session)
+    assert info.value.where == "s.json"
