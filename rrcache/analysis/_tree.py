@@ -82,13 +82,35 @@ def children(node: A.Node) -> Iterator[A.Node]:
                             yield sub
 
 
+def _child_list(node: A.Node) -> list:
+    """:func:`children` as a list (the hot path of :func:`walk`)."""
+    out = []
+    node_cls = A.Node
+    d = node.__dict__
+    for name in _tree_fields(node.__class__):
+        value = d[name]
+        if isinstance(value, node_cls):
+            out.append(value)
+        elif value.__class__ is list:
+            for item in value:
+                if isinstance(item, node_cls):
+                    out.append(item)
+                elif item.__class__ is tuple:
+                    out.extend(sub for sub in item if isinstance(sub, node_cls))
+    return out
+
+
 def walk(node: A.Node) -> Iterator[A.Node]:
     """``node`` and its syntax descendants, pre-order (iterative: deep trees are fine)."""
     stack = [node]
+    pop, extend = stack.pop, stack.extend
     while stack:
-        n = stack.pop()
+        n = pop()
         yield n
-        stack.extend(reversed(list(children(n))))
+        kids = _child_list(n)
+        if kids:
+            kids.reverse()
+            extend(kids)
 
 
 def iter_exprs(unit: A.Node) -> Iterator[A.Expr]:
@@ -100,22 +122,23 @@ def iter_exprs(unit: A.Node) -> Iterator[A.Expr]:
 
 def clone(node, loc_fn: Optional[Callable[[SourceLoc], SourceLoc]] = None):
     """A structural copy of ``node``; ``loc_fn`` maps every location of the copy."""
-    if isinstance(node, list):
+    cls = node.__class__
+    if cls is list:
         return [clone(x, loc_fn) for x in node]
-    if isinstance(node, tuple):
+    if cls is tuple:
         return tuple(clone(x, loc_fn) for x in node)
     if not isinstance(node, A.Node):
         return node
-    cls = type(node)
     new = cls.__new__(cls)
-    d = dict(node.__dict__)
+    d = node.__dict__.copy()
+    node_cls = A.Node
     for name in _tree_fields(cls):
         value = d[name]
-        if isinstance(value, (A.Node, list)):
+        if isinstance(value, node_cls) or value.__class__ is list:
             d[name] = clone(value, loc_fn)
     if loc_fn is not None and d.get("loc") is not None:
         d["loc"] = loc_fn(d["loc"])
-    new.__dict__.update(d)
+    new.__dict__ = d
     return new
 
 
