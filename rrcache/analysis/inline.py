@@ -84,10 +84,26 @@ def inline_unit(unit: A.TranslationUnit) -> A.TranslationUnit:
 class _Template:
     """A function body prepared for inlining: returns converted to placeholder assignments."""
 
-    def __init__(self, decl: A.FunctionDecl, body: A.Compound, needs_flag: bool):
+    def __init__(self, decl: A.FunctionDecl, body: A.Compound, needs_flag: bool, uses: int):
         self.decl = decl
         self.body = body
         self.needs_flag = needs_flag
+        # call sites still to inline it: the last one takes the body itself instead of a copy
+        # (each node would otherwise be copied once per level of nesting)
+        self.uses = uses
+
+    def instantiate(self, site: str) -> A.Compound:
+        """The body for one call site, every location tagged with ``site``."""
+        if self.body is None:
+            raise AssertionError(f"inlining template of {self.decl.name} used more often than it is called")
+        self.uses -= 1
+        if self.uses > 0:
+            return clone(self.body, lambda loc: with_chain(loc, site))
+        body, self.body = self.body, None
+        for n in walk(body):
+            if n.loc is not None:
+                n.loc = with_chain(n.loc, site)
+        return body
 
 
 def _returns_in_loops(s: A.Node, inside: bool = False) -> bool:
@@ -182,6 +198,13 @@ class _Inliner:
 
     # ------------------------------------------------------------------ driver
     def run(self) -> A.TranslationUnit:
+        self.call_sites: dict[int, int] = {}
+        for d in self.defs:
+            for n in walk(d.body):
+                if isinstance(n, A.Call):
+                    t = self._target(n)
+                    if t is not None:
+                        self.call_sites[id(t)] = self.call_sites.get(id(t), 0) + 1
         for d in self.defs:
             self.inlinable[id(d)] = d.name != "main" and not _returns_in_loops(d.body)
         done: set[int] = set()
@@ -212,7 +235,7 @@ class _Inliner:
             is_void = d.return_type.spec.name == "void"
             body = clone(d.body)
             body.stmts = _convert_returns(body.stmts, is_void, not last_only)
-            self.templates[id(d)] = _Template(d, body, not last_only)
+            self.templates[id(d)] = _Template(d, body, not last_only, self.call_sites.get(id(d), 0))
 
     def _body_effectful(self, d: A.FunctionDecl) -> bool:
         if any(param_qualifier(p) != "in" for p in d.params):
@@ -545,7 +568,7 @@ class _Inliner:
             mapping[_LIVE] = live
             block.append(declare(live, A.FullType([], A.TypeSpecifier("bool")),
                                  A.BoolLit(True, loc=call.loc), loc=call.loc))
-        body = clone(tpl.body, lambda loc: with_chain(loc, site))
+        body = tpl.instantiate(site)
         rewrite_scoped(body, mapping, self.names.fresh)
         block += body.stmts + writebacks
         pre.append(A.Compound(block, loc=call.loc))
