@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import copy
-import os
 from pathlib import Path
 
 import pytest
@@ -115,16 +114,8 @@ def test_to_core_is_idempotent_on_corpus():
 
 # ----------------------------------------------------------------------------- the driver
 
-@pytest.fixture(scope="module")
-def gl_ctx():
-    os.environ.setdefault("LP_NUM_THREADS", "1")
-    moderngl = pytest.importorskip("moderngl")
-    try:
-        ctx = moderngl.create_standalone_context(backend="egl")
-    except Exception as exc:  # no EGL on this machine: nothing to compile with
-        pytest.skip(f"no EGL context: {exc}")
-    yield ctx
-    ctx.release()
+# The driver tests use the shared ``gl_ctx`` fixture (tests/conftest.py): the one context of the
+# process, made by rrcache.gl.context.get_context(); no EGL is a failure, not a skip.
 
 
 def vertex_shader_for(unit: A.TranslationUnit) -> str:
