@@ -22,6 +22,7 @@ from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import Renderer
 from rrcache.harness.vertex import mesh_defines, session_attributes
 from rrcache.session import load_session
+from masks import dilate, erode  # noqa: E402
 
 SHADER = """#version 330
 in vec4 v_position;
@@ -140,19 +141,7 @@ def test_moving_occluder_misses_where_it_uncovers(gl_ctx, tmp_path):
         uncovered = ball_masks[i - 1] & ~ball_masks[i]
         assert uncovered.sum() > 10
         assert not (frames[i].hit_map & uncovered).any(), f"frame {i}: an uncovered pixel reused the ball's payload"
-        interior = frames[i].mask & ~uncovered & ~_dilate(ball_masks[i] ^ _erode(ball_masks[i]))
-        interior &= ~_dilate(ball_masks[i - 1] ^ _erode(ball_masks[i - 1]))
+        interior = frames[i].mask & ~uncovered & ~dilate(ball_masks[i] ^ erode(ball_masks[i]))
+        interior &= ~dilate(ball_masks[i - 1] ^ erode(ball_masks[i - 1]))
         assert frames[i].hit_map[interior].mean() > 0.99, "pixels away from the disocclusion should hit"
 
-
-def _dilate(m):
-    out = m.copy()
-    out[1:] |= m[:-1]
-    out[:-1] |= m[1:]
-    out[:, 1:] |= m[:, :-1]
-    out[:, :-1] |= m[:, 1:]
-    return out
-
-
-def _erode(m):
-    return ~_dilate(~m)

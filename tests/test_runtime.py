@@ -19,6 +19,7 @@ from rrcache.gl.context import get_context  # noqa: E402
 from rrcache.runtime import CacheRuntime  # noqa: E402
 from rrcache.runtime import glsl as G  # noqa: E402
 from rrcache.runtime.refresh import refresh_mask, refresh_offsets  # noqa: E402
+from masks import dilate, erode  # noqa: E402
 
 W, H = 64, 64
 
@@ -208,25 +209,13 @@ def test_disocclusion_misses_where_background_is_uncovered(scene):
                 assert uncovered.sum() > 20
                 assert not (uncovered & hit_map).any(), "a newly uncovered pixel reused the occluder's payload"
                 misses = covered & ~hit_map
-                edges = _dilate(previous_mask & ~_erode(previous_mask)) | _dilate(mask & ~_erode(mask))
+                edges = dilate(previous_mask & ~erode(previous_mask)) | dilate(mask & ~erode(mask))
                 assert not (misses & ~uncovered & ~edges).any(), "misses away from the disocclusion"
                 assert (hit_map & mask).sum() > 0.5 * mask.sum(), "the moving occluder itself should mostly hit"
             previous_mask = mask
     finally:
         rt.release()
 
-
-def _dilate(m):
-    out = m.copy()
-    out[1:] |= m[:-1]
-    out[:-1] |= m[1:]
-    out[:, 1:] |= m[:, :-1]
-    out[:, :-1] |= m[:, 1:]
-    return out
-
-
-def _erode(m):
-    return ~_dilate(~m)
 
 
 def test_reset_makes_every_pixel_miss(scene):
