@@ -11,6 +11,10 @@ import os
 
 import pytest
 
+# the table of extreme cases and bad input (--stability-table PATH; the stability_case fixture)
+from stability_table import (pytest_addoption, pytest_configure, pytest_runtest_makereport,  # noqa: F401
+                             pytest_sessionfinish, stability_case)
+
 os.environ.setdefault("LP_NUM_THREADS", "1")
 
 

@@ -21,7 +21,9 @@ is bounded (every unknown ≥ 0, ``scipy.optimize.lsq_linear``, method ``bvls``)
   least-squares standard error exceeds a quarter of the median frame time (it is then not
   determined by the data), the overhead is fixed at 0 as above: quality ``"collinear"``. If h and
   m are themselves (nearly) proportional (one hit fraction in every frame), t_hit and t_miss are
-  not separable: they are set equal (the safe side: no speed-up predicted from hits).
+  not separable: they are set equal (the safe side: no speed-up predicted from hits). When no
+  frame covers any pixel (the object off-screen throughout) the time is all overhead:
+  t_hit = t_miss = 0, t_overhead = mean(t) (or ``overhead_ms`` when given).
 - fewer than 3 usable frames: ``"insufficient"``, t_hit = t_miss = median(t − o)/median(h + m),
   t_overhead = o (``overhead_ms``, or 0).
 - a bound became active (the unbounded solution had a negative component): ``"clamped"``.
@@ -228,6 +230,10 @@ def fit_performance(hits, misses, times, overhead_ms=None) -> PerfFit:
         (m / cscale[1]) * (cscale[1] / max(cscale[0], cscale[1]))
     cover_scale = max(cscale[0], cscale[1])  # cover * cover_scale = h + m
     denom = float(cover @ cover)
+    if denom <= 0.0 and overhead is None:
+        # no pixel covered in any frame: all the time is the fixed cost, t_overhead = mean(t)
+        x = np.array([0.0, 0.0, float(np.mean(b))])
+        return done(0.0, 0.0, x[2] * tscale / cscale[2], rank, rms_of(x), cond)
     z = max(float(cover @ b) / denom, 0.0) if denom > 0.0 else 0.0  # per-pixel cost, scaled
     per = z * tscale / cover_scale
     x = np.array([z * cscale[0] / cover_scale, z * cscale[1] / cover_scale] + [0.0] * (k - 2))
