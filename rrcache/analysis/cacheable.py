@@ -54,7 +54,7 @@ from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
 
-from rrcache.analysis._tree import chain_of, is_live_flag, iter_exprs, written_roots
+from rrcache.analysis._tree import chain_of, is_live_flag, iter_exprs, paused_gc, written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
@@ -174,8 +174,9 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     >>> [(x.text, x.reason) for x in t.excluded]
     [('vec4(sin(u))', 'uniform'), ('sin(u)', 'uniform'), ('u', 'uniform')]
     """
-    target = shader if analysed else analyse(shader, max_iterations)
-    return _Classifier(target, cheap_below).run()
+    with paused_gc():
+        target = shader if analysed else analyse(shader, max_iterations)
+        return _Classifier(target, cheap_below).run()
 
 
 # ----------------------------------------------------------------------------- classification

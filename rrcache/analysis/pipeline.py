@@ -15,6 +15,7 @@ import dataclasses
 
 from rrcache.glsl.semantic import check
 
+from rrcache.analysis._tree import paused_gc
 from rrcache.analysis.compound import expand_unit
 from rrcache.analysis.inline import inline_unit
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL, unroll_unit
@@ -29,8 +30,9 @@ def analyse(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     expanded, type-checked again. A valid program equivalent to the input; node ids
     (:func:`rrcache.analysis.find_node`) refer to it. The input is not modified.
     """
-    unit = inline_unit(shader.unit)
-    unit = unroll_unit(unit, shader.info, max_iterations, max_total)
-    unit = expand_unit(unit)
-    info = check(unit, shader.path or "<string>")
+    with paused_gc():
+        unit = inline_unit(shader.unit)
+        unit = unroll_unit(unit, shader.info, max_iterations, max_total)
+        unit = expand_unit(unit)
+        info = check(unit, shader.path or "<string>")
     return dataclasses.replace(shader, unit=unit, info=info)
