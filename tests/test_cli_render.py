@@ -63,7 +63,8 @@ def test_json_summary(gl_ctx, files, capsys):
     main([ "render", str(shader), str(session), "--json", "--frames", "2"])
     captured = capsys.readouterr()
     summary = json.loads(captured.out)
-    assert set(summary) == {"frames", "resolution", "ms_per_frame", "covered_pixels"}
+    assert set(summary) == {"frames", "resolution", "ms_per_frame", "covered_pixels", "nonfinite_pixels"}
+    assert summary["nonfinite_pixels"] == [0, 0]
     assert summary["frames"] == 2 and summary["resolution"] == [64, 48]
     assert summary["ms_per_frame"] > 0
     loaded = load_session(session)

@@ -10,7 +10,7 @@ one run, and compared: error, PSNR, hit rate, and the speed-up as a ratio of med
 
 With ``--out`` each frame is written as ``frame_NNNN.exr`` (float, exact) and ``frame_NNNN.png``.
 The summary is a table (or, with ``--json``, an object with ``frames``, ``resolution``,
-``ms_per_frame`` and ``covered_pixels``); notes on the session (uniforms the shader does not use)
+``ms_per_frame``, ``covered_pixels`` and ``nonfinite_pixels``, per frame); notes on the session (uniforms the shader does not use)
 go to stderr.
 """
 from __future__ import annotations
@@ -25,6 +25,7 @@ from rich.table import Table
 
 from rrcache.cli.options import parse_defines, resolution_option
 from rrcache.harness.images import write_image
+from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, render
 from rrcache.runtime import ALGORITHMS, FILTERS, REFRESH_MODES
@@ -76,8 +77,10 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                         console=err_console, transient=True, disable=not show_progress)
     with progress:
         task = progress.add_task("render", total=len(indices))
+        nonfinite = []
 
         def done(frame):
+            nonfinite.append(nonfinite_count(frame.image))
             if out is not None:
                 stem = out / f"frame_{frame.index:04d}"
                 write_image(stem.with_suffix(".exr"), frame.image)
@@ -94,14 +97,17 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
             "resolution": list(result.resolution),
             "ms_per_frame": result.ms_per_frame,
             "covered_pixels": [f.covered_pixels for f in result.frames],
+            "nonfinite_pixels": nonfinite,
         }))
         return
     table = Table(title=f"{prepared.path} × {loaded.path}  ({result.resolution[0]}×{result.resolution[1]})")
     table.add_column("frame", justify="right")
     table.add_column("covered pixels", justify="right")
     table.add_column("ms", justify="right")
-    for frame in result.frames:
-        table.add_row(str(frame.index), str(frame.covered_pixels), f"{frame.ms:.2f}")
+    if any(nonfinite):
+        table.add_column("NaN/Inf pixels", justify="right")
+    for frame, bad in zip(result.frames, nonfinite):
+        table.add_row(str(frame.index), str(frame.covered_pixels), f"{frame.ms:.2f}", *([str(bad)] if any(nonfinite) else []))
     console = Console()
     console.print(table)
     console.print(f"median {result.ms_per_frame:.2f} ms per frame over {len(result.frames)} frames"
@@ -158,3 +164,7 @@ def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resoluti
     console.print(f"speed-up {summary['speedup']:.2f}× ({summary['ms_per_frame']:.2f} ms vs "
                   f"{summary['original_ms_per_frame']:.2f} ms, medians), hit rate {summary['hit_rate']:.3f}, "
                   f"mean error {summary['mean_error']:.5f}, PSNR {summary['psnr']:.1f} dB", highlight=False)
+    if summary["error_left_out_pixels"] or summary["nonfinite_pixels"]:
+        console.print(f"NaN/Inf pixels: {summary['nonfinite_pixels']} in the variant, "
+                      f"{summary['original_nonfinite_pixels']} in the original; the error leaves out "
+                      f"{summary['error_left_out_pixels']} covered pixels", highlight=False)

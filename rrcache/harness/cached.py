@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import statistics
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
@@ -30,6 +31,9 @@ from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
 from rrcache.runtime import CacheRuntime
+
+#: the largest finite 16-bit float: payload values beyond it would be stored as ±inf
+HALF_MAX = 65504.0
 
 
 @dataclass
@@ -68,6 +72,11 @@ class CachedRenderer:
         self.size = tuple(int(v) for v in (resolution or session.resolution))
         self.hit_maps = hit_maps
         self.keep_payload = keep_payload
+        # a 16-bit payload asked for starts in 32 bits: the untimed first frame checks that its
+        # values fit in half floats before the cache is made 16-bit (see _settle_payload)
+        self.payload_dtype = variant.payload_dtype
+        self.payload_note: Optional[str] = None
+        self._check_half = variant.payload_dtype == "f2"
         self._scope = GLScope()
         self._last: Optional[int] = None
         self._warm = False
@@ -79,7 +88,7 @@ class CachedRenderer:
             self.notes = self.drawer.notes
             self.runtime = CacheRuntime(
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
-                refresh=refresh, seed=seed, payload_dtype=variant.payload_dtype,
+                refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
                 clear_color=session_background(session))
         except BaseException:
@@ -93,6 +102,27 @@ class CachedRenderer:
     @period.setter
     def period(self, value: int) -> None:
         self.runtime.period = value
+
+    def _settle_payload(self) -> None:
+        """After the first (untimed) frame of a 16-bit payload request: if any covered pixel's
+        payload is beyond ±65504 (or overflows), keep 32 bits, warn and say so in
+        ``payload_note``; else switch the cache to 16 bits. Later frames are not checked."""
+        self._check_half = False
+        rt = self.runtime
+        payload = rt.read_payload()[..., :rt.payload_components]
+        covered = rt.read_depth() < 1.0
+        values = np.abs(payload[covered])
+        finite = values[np.isfinite(values)]
+        largest = float(finite.max()) if finite.size else 0.0
+        if largest <= HALF_MAX:
+            rt.payload_dtype = "f2"
+            rt.resize(self.size)
+            return
+        self.payload_dtype = "f4"
+        self.payload_note = (f"payload values up to {largest:.6g} are beyond the 16-bit float range (±{HALF_MAX:g}): "
+                             "the cache uses 32-bit floats instead")
+        self.notes.append(self.payload_note)
+        warnings.warn(self.payload_note, RuntimeWarning, stacklevel=3)
 
     def reset(self) -> None:
         """Empty the cache: the next frame misses everywhere."""
@@ -114,6 +144,8 @@ class CachedRenderer:
         self.drawer.set_frame(index)
         if not self._warm:
             self._frame(index, None)
+            if self._check_half:
+                self._settle_payload()
             self.runtime.reset()
             self._warm = True
         hit_box = {} if self.hit_maps else None
@@ -144,6 +176,8 @@ class CachedRenderer:
         median ms of the ``repeats`` hitting frames (the speed-up limit's denominator). The cache
         is reset afterwards and the period restored."""
         index = check_frame_index(self.session, index)
+        if self._check_half:  # decide the payload precision first, on an untimed frame
+            self.render_frame(index)
         saved = self.runtime.period
         self.runtime.period = 2 ** 30
         self.runtime.reset()
@@ -191,6 +225,7 @@ class FrameComparison:
     original_ms: float
     nonfinite: int = 0
     left_out: int = 0
+    original_nonfinite: int = 0
 
 
 @dataclass
@@ -201,6 +236,7 @@ class Comparison:
     notes: list[str] = field(default_factory=list)
     resolution: tuple[int, int] = (0, 0)
     skip_first: int = 1  # frames left out of the summary: the first one has no cache
+    payload_dtype: str = "f4"  # the cache precision used (f4 when an f2 request did not fit)
 
     def _steady(self) -> list[FrameComparison]:
         steady = self.frames[self.skip_first:]
@@ -251,6 +287,12 @@ class Comparison:
             "mean_error": self.mean_error, "psnr": self.psnr, "hit_rate": self.hit_rate,
             "hits": self.hits, "misses": self.misses, "ms_per_frame": self.ms_per_frame,
             "original_ms_per_frame": self.original_ms_per_frame, "speedup": self.speedup,
+            # pixels with NaN/Inf (variant and original), and covered pixels the error left out
+            # because either image was not finite there: summed over the summary's frames
+            "nonfinite_pixels": sum(f.nonfinite for f in self._steady()),
+            "original_nonfinite_pixels": sum(f.original_nonfinite for f in self._steady()),
+            "error_left_out_pixels": sum(f.left_out for f in self._steady()),
+            "payload_dtype": self.payload_dtype,
         }
 
 
@@ -272,8 +314,12 @@ def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
             got = cached.render_frame(index)
             err, left_out = mean_l2(got.image, ref.image, ref.mask)
             row = FrameComparison(index, float(err), float(psnr(got.image, ref.image)), got.hits, got.misses,
-                                  got.covered_pixels, got.ms, ref.ms, nonfinite_count(got.image), int(left_out))
+                                  got.covered_pixels, got.ms, ref.ms, nonfinite_count(got.image), int(left_out),
+                                  nonfinite_count(ref.image))
             result.frames.append(row)
+            result.payload_dtype = cached.payload_dtype
+            if cached.payload_note and cached.payload_note not in result.notes:
+                result.notes.append(cached.payload_note)
             if on_frame is not None:
                 on_frame(row, got, ref)
     return result

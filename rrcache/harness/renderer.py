@@ -27,11 +27,17 @@ import numpy as np
 
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
+from rrcache.gl.limits import check_target_size
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
 from rrcache.harness.vertex import vertex_source
+
+#: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
+#: and flipped (32), the depth read back (4) and the coverage mask (1); checked before allocating
+TARGET_BYTES_PER_PIXEL = 57
+
 
 @dataclass
 class FrameResult:
@@ -91,6 +97,7 @@ class Renderer:
         self.prepared = prepared
         self.session = session
         self.size = tuple(int(v) for v in (resolution or session.resolution))
+        self._asked_size = resolution is not None
         self.cull_back_faces = cull_back_faces
         self._warm = False
         self._scope = GLScope()
@@ -103,6 +110,8 @@ class Renderer:
     # ------------------------------------------------------------------ setup
     def _setup(self) -> None:
         ctx, prepared = self.ctx, self.prepared
+        where = "resolution" if self._asked_size else f"{self.session.path}: resolution"
+        check_target_size(ctx, self.size, TARGET_BYTES_PER_PIXEL, where)
         inputs = {name: d.type for name, d in prepared.inputs.items()}
         locs = {name: d.loc for name, d in prepared.inputs.items()}
         self.vertex_source = vertex_source(inputs, locs)

@@ -44,6 +44,7 @@ import moderngl
 import numpy as np
 
 from rrcache.gl.context import bind_default_framebuffer
+from rrcache.gl.limits import check_target_size
 from rrcache.runtime import glsl as G
 from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_offsets
 
@@ -178,6 +179,7 @@ class CacheRuntime:
         w, h = int(size[0]), int(size[1])
         if w < 1 or h < 1:
             raise ValueError(f"viewport size must be positive, not {w}x{h}")
+        check_target_size(self.ctx, (w, h), self.bytes_per_pixel(), "cache size")
         self._release_targets()
         ctx = self.ctx
         self.size = (w, h)
@@ -204,6 +206,12 @@ class CacheRuntime:
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
         self._make_refresh_texture()
         self.reset()
+
+    def bytes_per_pixel(self) -> int:
+        """Memory per pixel of the cache's targets (depth, colour, two payloads, two inverse
+        depths) plus the colour and depth read back (41): what :meth:`resize` checks first."""
+        payload = self.payload_components * (4 if self.payload_dtype == "f4" else 2)
+        return 4 + 16 + 2 * payload + 2 * 4 + 41
 
     def _make_refresh_texture(self) -> None:
         if self._refresh_tex is not None:
