@@ -29,11 +29,16 @@ from rrcache.errors import SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.types import Type
 
-#: Fields that are annotations or shared sub-objects, never tree children (``target`` and
-#: ``kind`` only on ``Call``: ``Assign.target`` is a child).
-_SHARED = frozenset({"loc", "type", "symbol"})
-_CALL_SHARED = frozenset({"target", "kind"})
-_FIELD_CACHE: dict[type, tuple[str, ...]] = {}
+#: Semantic annotations, never tree children (``target`` and ``kind`` only on ``Call``:
+#: ``Assign.target`` is a child).
+_ANNOTATIONS = frozenset({"loc", "symbol"})
+_CALL_ANNOTATIONS = frozenset({"target", "kind"})
+#: Field annotations that can never hold a node (names, operators, literal values, spellings):
+#: traversal skips such fields without looking at them.
+_ATOMIC_FIELDS = frozenset({"str", "bool", "int", "float", "Optional[str]", "Optional[int]"})
+_SCALAR_FIELDS = _ATOMIC_FIELDS | {"list[str]", "list[tuple[str, str]]", "list[SourceLoc]"}
+_FIELD_CACHE: dict[tuple[type, bool], tuple[str, ...]] = {}
+_CLONE_FIELDS: dict[type, tuple[str, ...]] = {}
 
 RESERVED_PREFIX = "_rr"
 _GENERATED = re.compile(r"^_rr_(.+)_(\d+)$")
@@ -59,42 +64,41 @@ def with_chain(loc: Optional[SourceLoc], step: str) -> Optional[SourceLoc]:
     return InlinedLoc(loc.file, loc.line, loc.col, (step,) + chain_of(loc))
 
 
-def _tree_fields(cls: type) -> tuple[str, ...]:
-    names = _FIELD_CACHE.get(cls)
+def tree_fields(cls: type, decl_types: bool = False) -> tuple[str, ...]:
+    """The names of the fields of AST class ``cls`` that can hold syntax children.
+
+    Never the semantic annotations (``loc``, ``Expr.type``, ``Ident.symbol``, ``Call.target``,
+    ``Call.kind``). The ``type`` of a declaration (a ``FullType``: struct names and array sizes
+    live there) is followed only with ``decl_types``: the analysis passes share it between
+    copies and do not number what is inside; the compiler's rewrites follow it.
+    """
+    key = (cls, decl_types)
+    names = _FIELD_CACHE.get(key)
     if names is None:
-        skip = _SHARED | _CALL_SHARED if issubclass(cls, A.Call) else _SHARED
-        names = tuple(f.name for f in fields(cls) if f.name not in skip)
-        _FIELD_CACHE[cls] = names
+        skip = set(_ANNOTATIONS)
+        if issubclass(cls, A.Call):
+            skip |= _CALL_ANNOTATIONS
+        if not decl_types or issubclass(cls, A.Expr):
+            skip.add("type")
+        names = tuple(f.name for f in fields(cls)
+                      if f.name not in skip and f.type not in _SCALAR_FIELDS)
+        _FIELD_CACHE[key] = names
     return names
 
 
-def children(node: A.Node) -> Iterator[A.Node]:
-    """The direct syntax children of ``node`` in source order (declaration types and
-    ``Call.target`` excluded)."""
-    for name in _tree_fields(type(node)):
-        value = getattr(node, name)
-        if isinstance(value, A.Node):
-            yield value
-        elif isinstance(value, list):
-            for item in value:
-                if isinstance(item, A.Node):
-                    yield item
-                elif isinstance(item, tuple):
-                    for sub in item:
-                        if isinstance(sub, A.Node):
-                            yield sub
-
-
-def _child_list(node: A.Node) -> list:
-    """:func:`children` as a list (the hot path of :func:`walk`)."""
+def _child_list(node: A.Node, decl_types: bool = False) -> list:
+    """The direct syntax children of ``node`` in source order, as a list."""
     out = []
     node_cls = A.Node
     d = node.__dict__
-    for name in _tree_fields(node.__class__):
+    names = _FIELD_CACHE.get((node.__class__, decl_types)) or tree_fields(node.__class__, decl_types)
+    for name in names:
         value = d[name]
+        if value is None:
+            continue
         if isinstance(value, node_cls):
             out.append(value)
-        elif value.__class__ is list:
+        elif isinstance(value, list):
             for item in value:
                 if isinstance(item, node_cls):
                     out.append(item)
@@ -103,14 +107,20 @@ def _child_list(node: A.Node) -> list:
     return out
 
 
-def walk(node: A.Node) -> Iterator[A.Node]:
+def children(node: A.Node, decl_types: bool = False) -> Iterator[A.Node]:
+    """The direct syntax children of ``node`` in source order (``Call.target`` never;
+    declaration types only with ``decl_types``, see :func:`tree_fields`)."""
+    return iter(_child_list(node, decl_types))
+
+
+def walk(node: A.Node, decl_types: bool = False) -> Iterator[A.Node]:
     """``node`` and its syntax descendants, pre-order (iterative: deep trees are fine)."""
     stack = [node]
     pop, extend = stack.pop, stack.extend
     while stack:
         n = pop()
         yield n
-        kids = _child_list(n)
+        kids = _child_list(n, decl_types)
         if kids:
             kids.reverse()
             extend(kids)
@@ -118,8 +128,9 @@ def walk(node: A.Node) -> Iterator[A.Node]:
 
 def iter_exprs(unit: A.Node) -> Iterator[A.Expr]:
     """Every expression node under ``unit`` in pre-order: the order that numbers node ids."""
+    expr_cls = A.Expr
     for n in walk(unit):
-        if isinstance(n, A.Expr):
+        if isinstance(n, expr_cls):
             yield n
 
 
@@ -135,9 +146,15 @@ def clone(node, loc_fn: Optional[Callable[[SourceLoc], SourceLoc]] = None):
     new = cls.__new__(cls)
     d = node.__dict__.copy()
     node_cls = A.Node
-    for name in _tree_fields(cls):
+    names = _CLONE_FIELDS.get(cls)
+    if names is None:      # the syntax fields plus lists of names (copied, not shared)
+        names = _CLONE_FIELDS[cls] = tuple(
+            f.name for f in fields(cls) if f.type not in _ATOMIC_FIELDS
+            and f.name not in _ANNOTATIONS and f.name != "type"
+            and not (f.name in _CALL_ANNOTATIONS and issubclass(cls, A.Call)))
+    for name in names:
         value = d[name]
-        if isinstance(value, node_cls) or value.__class__ is list:
+        if value is not None and (isinstance(value, node_cls) or value.__class__ is list):
             d[name] = clone(value, loc_fn)
     if loc_fn is not None and d.get("loc") is not None:
         d["loc"] = loc_fn(d["loc"])
@@ -341,7 +358,7 @@ class _ScopedRewriter:
             if rep is not None:
                 return rep(e)
             return e
-        for name in _tree_fields(type(e)):
+        for name in tree_fields(type(e)):
             value = getattr(e, name)
             if isinstance(value, A.Expr):
                 setattr(e, name, self.expr(value))

@@ -1,8 +1,9 @@
 """Tree helpers shared by the compiler passes (not a pass itself).
 
-The walkers here follow every syntax child, declaration types included (struct type names and
-array sizes live there), and never the semantic annotations (``Expr.type``, ``Ident.symbol``,
-``Call.target``, ``Call.kind``), so a walk never wanders into another function's body.
+The walkers here are those of :mod:`rrcache.analysis._tree` with declaration types followed
+(struct type names and array sizes live there); like those they never follow the semantic
+annotations (``Expr.type``, ``Ident.symbol``, ``Call.target``, ``Call.kind``), so a walk never
+wanders into another function's body.
 
 >>> from rrcache.glsl.parser import parse_source
 >>> unit = parse_source("void main() { float x = 1.0; x = x + 2.0; }")
@@ -11,50 +12,25 @@ array sizes live there), and never the semantic annotations (``Expr.type``, ``Id
 """
 from __future__ import annotations
 
-from dataclasses import fields
 from typing import Callable, Iterator, Optional
 
+from rrcache.analysis import _tree as tree
 from rrcache.glsl import ast as A
-
-_ANNOTATIONS = {A.Call: frozenset({"target", "kind"}), A.Ident: frozenset({"symbol"})}
-_FIELDS: dict[type, tuple[str, ...]] = {}
 
 
 def tree_fields(cls: type) -> tuple[str, ...]:
-    """The names of the syntax fields of an AST class (annotations left out)."""
-    names = _FIELDS.get(cls)
-    if names is None:
-        skip = {"loc"} | set(_ANNOTATIONS.get(cls, ()))
-        if issubclass(cls, A.Expr):
-            skip.add("type")
-        names = tuple(f.name for f in fields(cls) if f.name not in skip)
-        _FIELDS[cls] = names
-    return names
+    """The names of the syntax fields of an AST class, declaration types included."""
+    return tree.tree_fields(cls, decl_types=True)
 
 
 def children(node: A.Node) -> Iterator[A.Node]:
-    """Direct syntax children in source order."""
-    for name in tree_fields(type(node)):
-        value = getattr(node, name)
-        if isinstance(value, A.Node):
-            yield value
-        elif isinstance(value, list):
-            for item in value:
-                if isinstance(item, A.Node):
-                    yield item
-                elif isinstance(item, tuple):
-                    for sub in item:
-                        if isinstance(sub, A.Node):
-                            yield sub
+    """Direct syntax children in source order, declaration types included."""
+    return tree.children(node, decl_types=True)
 
 
 def walk(node: A.Node) -> Iterator[A.Node]:
-    """``node`` and its syntax descendants, pre-order (iterative)."""
-    stack = [node]
-    while stack:
-        n = stack.pop()
-        yield n
-        stack.extend(reversed(list(children(n))))
+    """``node`` and its syntax descendants, pre-order (iterative), declaration types included."""
+    return tree.walk(node, decl_types=True)
 
 
 def post_order(node: A.Node) -> Iterator[A.Node]:
