@@ -176,15 +176,29 @@ def _convert(err: ValidationError, file: str, prefix: str) -> SessionError:
     return SessionError(err.message, file, where or None, None)
 
 
+def _hinted(error: SessionError, err: ValidationError) -> SessionError:
+    """``error`` with a hint when it has none: what the schema says about the value (its
+    description), and where the format is written down."""
+    if error.hint:
+        return error
+    sch = err.schema if isinstance(err.schema, dict) else {}
+    if err.validator == "required" and isinstance(err.instance, dict):
+        key = next((k for k in err.validator_value if k not in err.instance), None)
+        sch = sch.get("properties", {}).get(key, {}) if key is not None else {}
+    desc = sch.get("description") if isinstance(sch, dict) else None
+    hint = (f"{desc}; " if desc else "") + "the session format is rrcache/session/schema.json"
+    return SessionError(error.message, error.path, error.json_path, hint)
+
+
 def validate_document(doc: Any, file: str) -> None:
     """Raise SessionError for the best schema violation of the whole session ``doc``."""
     err = max(_validator(None).iter_errors(doc), key=relevance, default=None)
     if err is not None:
-        raise _convert(err, file, "")
+        raise _hinted(_convert(err, file, ""), err)
 
 
 def validate_fragment(value: Any, definition: str, file: str, prefix: str) -> None:
     """Validate ``value`` against ``$defs/<definition>``; paths in errors start with ``prefix``."""
     err = max(_validator(definition).iter_errors(value), key=relevance, default=None)
     if err is not None:
-        raise _convert(err, file, prefix)
+        raise _hinted(_convert(err, file, prefix), err)
