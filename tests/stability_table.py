@@ -83,7 +83,7 @@ def stability_case(request):
     return make
 
 
-_PASSING = re.compile(r"(\d+) passing examples?")
+_PASSING = re.compile(r"(\d+) passing")
 
 
 @pytest.hookimpl(hookwrapper=True)
@@ -126,7 +126,7 @@ def pytest_sessionfinish(session, exitstatus):
     outcomes = config.stash[_OUTCOMES]
     cases = list(config.stash[_CASES])
     for nodeid, (max_examples, passing, doc) in config.stash[_FUZZ].items():
-        name = nodeid.split("::")[-1]
+        name = nodeid.split("::")[-1].removeprefix("test_").replace("_", " ")
         case = StabilityCase(nodeid, name, "fuzzing (hypothesis)",
                              f"max_examples={max_examples}" + (f": {doc}" if doc else ""))
         case.observe(examples_run=passing)
@@ -156,7 +156,7 @@ def pytest_sessionfinish(session, exitstatus):
         lines += [f"## {area}", "", "| case | input | observed | result | test |", "|---|---|---|---|---|"]
         for case in (c for c in cases if c.area == area):
             result = outcomes.get(case.nodeid, "not run")
-            test = case.nodeid.split("::", 1)[-1]
+            test = case.nodeid
             lines.append(f"| {_cell(case.name)} | {_cell(case.given)} | {_cell(case.observed_text())} | "
                          f"{result} | `{_cell(test)}` |")
         lines.append("")

@@ -84,7 +84,8 @@ def test_fresh_moves_the_old_store_aside(tmp_path):
         assert old.counts()["error_runs"] == 1
 
 
-def test_damaged_file_is_refused(tmp_path):
+def test_damaged_file_is_refused(tmp_path, stability_case):
+    case = stability_case("damaged store file", "profile store: interruption and damage", "a 4 KiB page in the middle overwritten with 0xa5")
     path = tmp_path / "profile.sqlite"
     with ProfileStore.open(path, _key()) as store:
         for n in range(40):
@@ -96,34 +97,44 @@ def test_damaged_file_is_refused(tmp_path):
     path.write_bytes(bytes(data))
     with pytest.raises(RRCacheError, match="damaged") as info:
         ProfileStore.open(path, _key())
+    case.observe(error=str(info.value).replace(str(tmp_path), "TMP"))
     assert str(path) in str(info.value) and "--fresh" in str(info.value)
 
 
-def test_text_file_is_refused(tmp_path):
+def test_text_file_is_refused(tmp_path, stability_case):
+    case = stability_case("store file that is text", "profile store: interruption and damage", "'not a database' × 10 lines")
     path = tmp_path / "profile.sqlite"
     path.write_text("not a database\n" * 10)
-    with pytest.raises(RRCacheError, match="not an SQLite file"):
+    with pytest.raises(RRCacheError, match="not an SQLite file") as info:
         ProfileStore.open(path, _key())
+    case.observe(error=str(info.value).replace(str(tmp_path), "TMP"))
 
 
-def test_foreign_sqlite_files_are_refused(tmp_path):
+def test_foreign_sqlite_files_are_refused(tmp_path, stability_case):
+    case = stability_case("foreign SQLite store files", "profile store: interruption and damage",
+                          "no meta table; a meta table of another schema; schema version 99")
+    seen = []
     foreign = tmp_path / "foreign.sqlite"
     with sqlite3.connect(foreign) as conn:
         conn.execute("CREATE TABLE samples (x REAL)")
-    with pytest.raises(RRCacheError, match="no meta table"):
+    with pytest.raises(RRCacheError, match="no meta table") as info:
         ProfileStore.open(foreign, _key())
+    seen.append(str(info.value).replace(str(tmp_path), "TMP"))
     other = tmp_path / "other.sqlite"
     with sqlite3.connect(other) as conn:  # coverage.py-like: a meta table with another schema
         conn.execute("CREATE TABLE meta (key TEXT, value TEXT)")
         conn.execute("INSERT INTO meta VALUES ('version', '7.3')")
-    with pytest.raises(RRCacheError, match="no schema version"):
+    with pytest.raises(RRCacheError, match="no schema version") as info:
         ProfileStore.open(other, _key())
+    seen.append(str(info.value).replace(str(tmp_path), "TMP"))
     newer = tmp_path / "newer.sqlite"
     ProfileStore.open(newer, _key()).close()
     with sqlite3.connect(newer) as conn:
         conn.execute("UPDATE meta SET value = '99' WHERE key = 'schema_version'")
-    with pytest.raises(RRCacheError, match="schema '99'"):
+    with pytest.raises(RRCacheError, match="schema '99'") as info:
         ProfileStore.open(newer, _key())
+    seen.append(str(info.value).replace(str(tmp_path), "TMP"))
+    case.observe(errors=" / ".join(seen))
 
 
 def test_interrupted_write_leaves_nothing(tmp_path):
@@ -169,8 +180,11 @@ def test_parse_periods():
 def test_key_ignores_budget_and_validate_and_resolves_defaults():
     session = SimpleNamespace(resolution=(64, 48), frames=12, path="s.json")
     a = TrainingSettings(periods=(2, 4, 8)).resolved(session)
-    b = TrainingSettings(periods=(2, 4, 8), resolution=(16, 12), frames=12, budget_s=5, validate=False).resolved(session)
-    assert a.resolution == (16, 12) and a.frames == 12
+    b = TrainingSettings(periods=(2, 4, 8), resolution=(64, 48), frames=12, budget_s=5, validate=False,
+                         min_saving=0.3).resolved(session)
+    assert a.resolution == (64, 48) and a.frames == 12
+    long = TrainingSettings(periods=(2, 4, 8)).resolved(SimpleNamespace(resolution=(64, 48), frames=150, path="s.json"))
+    assert long.frames == 64  # the default: 64 consecutive frames
     assert a.key_hash() == b.key_hash()
     assert a.key_hash() != TrainingSettings(periods=(2, 4, 9)).resolved(session).key_hash()
     assert TrainingSettings.from_json(b.to_json()) == b
