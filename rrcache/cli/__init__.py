@@ -22,6 +22,7 @@ _COMMANDS = {
     "profile": "profile",
     "select": "select",
     "render": "render",
+    "report": "report",
 }
 
 

@@ -416,6 +416,9 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         from rrcache.profile.plots import write_plots
 
         prof.data["plots"] = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
+        from rrcache.report import write_report
+
+        write_report(prof, out, work=work)
     tmp = out / (JSON_NAME + ".tmp")
     tmp.write_text(json.dumps(_finite(prof.data), indent=2) + "\n", encoding="utf-8")
     os.replace(tmp, out / JSON_NAME)

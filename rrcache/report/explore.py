@@ -1,0 +1,333 @@
+"""The notebooks' figures and the interactive profiler widget (``notebooks/explore.ipynb`` and
+``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.report.demo_profile`).
+
+Figures (matplotlib): :func:`tradeoff_figure` (every node path, the original's time, the Pareto
+front, the selections), :func:`node_figure` (a node's measured errors with the fitted error model,
+and its predicted frame time over Δn), :func:`images_figure` (a choice's original, cached frame,
+error map, payload and hit/miss map). HTML: :func:`source_html` (the shader with a node
+highlighted), :func:`selections_html` (the four selections, predicted against measured).
+
+:class:`Explorer` is the paper's interactive profiler (§4.5): a log-scale slider for the error
+threshold re-selects from the models as it moves (:meth:`Profile.select`, microseconds; the time
+of each re-selection is shown), then shows the chosen node highlighted in the source, its Δn, the
+predicted and measured speed-up and error, a frame with and without the cache side by side, the
+payload and the hit/miss map; a button writes the chosen shader files.
+
+>>> prof = demo_profile("demo.rrprofile")          # doctest: +SKIP
+>>> Explorer(prof)                                 # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import html
+import math
+import time
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from rrcache.report.data import node_benefits, read_source, selection_timing  # noqa: F401 (re-exported)
+from rrcache.report.images import CAPTIONS, FrameShots  # noqa: F401 (FrameShots re-exported)
+
+
+def _pyplot():
+    """pyplot, with figures shown as PNG in IPython whatever the backend (the profiler switches
+    matplotlib to Agg, which leaves a notebook without its inline figure display)."""
+    import matplotlib.pyplot as plt
+
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        return plt
+    shell = get_ipython()
+    if shell is not None:
+        from IPython.core.pylabtools import print_figure
+        from matplotlib.figure import Figure
+
+        formatter = shell.display_formatter.formatters["image/png"]
+        formatter.for_type(Figure, lambda fig: print_figure(fig, "png", bbox_inches="tight"))
+    return plt
+
+
+def _f(value, digits: int = 4) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    return f"{float(value):.{digits}g}"
+
+
+# ---------------------------------------------------------------------- figures
+def tradeoff_figure(prof, log_error: bool = True, highlight: Optional[str] = None):
+    """Error against ms per frame: every trained node over Δn = 1..50 (from the model table), the
+    original's time (dashed), the Pareto front (black) and the four selections (squares);
+    ``highlight`` draws one node's path thicker. Returns the matplotlib figure."""
+    from rrcache.model import pareto_front
+
+    plt = _pyplot()
+    table = prof.table
+    fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
+    cmap = plt.get_cmap("viridis")
+    first = 1 if log_error else 0  # Δn = 1 has error 0: left out of a log axis
+    for i, node_id in enumerate(table.node_ids):
+        wide = node_id == highlight
+        ax.plot(table.T[i, first:], table.E[i, first:], "-", lw=2.5 if wide else 0.9,
+                color="crimson" if wide else cmap(i / max(1, len(table.node_ids) - 1)), alpha=1 if wide else 0.7)
+    front = [p for p in pareto_front(table) if not log_error or p.predicted_error > 0]
+    ax.plot([p.predicted_ms for p in front], [p.predicted_error for p in front], "-", color="black", lw=2,
+            alpha=0.5, label="Pareto front")
+    ax.axvline(prof.original_ms, ls="--", color="gray", label=f"original ({prof.original_ms:.3g} ms)")
+    for sel in prof.selections:
+        if sel.node is not None:
+            ax.plot(sel.predicted_ms, sel.predicted_error, "s", mfc="none", mec="crimson", ms=8, mew=1.8)
+            ax.annotate(f"{sel.label}: {sel.node} Δn={sel.period}", (sel.predicted_ms, sel.predicted_error),
+                        textcoords="offset points", xytext=(7, 4), fontsize=8, color="crimson")
+    if log_error:
+        ax.set_yscale("log")
+    ax.set_xlabel("ms per frame (predicted)")
+    ax.set_ylabel("mean RGB L2 error (predicted)")
+    ax.set_title(f"{Path(prof.shader).name}: {len(table.node_ids)} trained nodes over Δn = 1..{table.max_period}")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    plt.close(fig)
+    return fig
+
+
+def node_figure(prof, node_id: str):
+    """Two panels for one trained node: its measured error runs with the fitted
+    α(1 − e^(−λ(Δn−1))) and the predicted ms per frame over Δn (the original's time dashed)."""
+    plt = _pyplot()
+    node = prof.node(node_id)
+    table = prof.table
+    i = table.node_ids.index(node.id)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 3.4), dpi=100)
+    a.plot(table.periods, table.E[i], "-", color="tab:blue",
+           label=f"model α = {_f(node.alpha, 3)}, λ = {_f(node.lam, 3)}")
+    a.plot(node.periods, node.errors, "o", color="black", label="measured")
+    a.set_xlabel("refresh period Δn")
+    a.set_ylabel("mean RGB L2 error")
+    a.set_title(f"{node.id}: error")
+    a.legend(fontsize=8)
+    b.plot(table.periods, table.T[i], "-", color="tab:green",
+           label=f"t_hit = {_f(node.t_hit, 3)}, t_miss = {_f(node.t_miss, 3)} ms/px")
+    b.axhline(prof.original_ms, ls="--", color="gray", label="original")
+    b.set_xlabel("refresh period Δn")
+    b.set_ylabel("ms per frame (predicted)")
+    b.set_title(f"{node.id}: time")
+    b.legend(fontsize=8)
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    plt.close(fig)
+    return fig
+
+
+def images_figure(images):
+    """A row of a choice's images (:class:`~rrcache.report.images.ChoiceImages`)."""
+    plt = _pyplot()
+    names = [n for n in CAPTIONS if n in images.arrays]
+    fig, axes = plt.subplots(1, len(names), figsize=(2.6 * len(names), 2.4), dpi=100, squeeze=False)
+    for ax, name in zip(axes[0], names):
+        ax.imshow(np.clip(images.arrays[name], 0, 1), interpolation="nearest")
+        ax.set_title(images.caption(name), fontsize=7)
+        ax.axis("off")
+    what = f"{images.node} Δn={images.period}" if images.node else "the original shader"
+    fig.suptitle(f"{what}, frame {images.frame}", fontsize=9)
+    fig.tight_layout()
+    plt.close(fig)
+    return fig
+
+
+def selections_figure(prof, shots: FrameShots):
+    """One row of images per selection (e1..e4; see :func:`images_figure`)."""
+    plt = _pyplot()
+    names = list(CAPTIONS)
+    fig, axes = plt.subplots(len(prof.selections), len(names), figsize=(2.4 * len(names), 2.2 * len(prof.selections)),
+                             dpi=100, squeeze=False)
+    for row, sel in zip(axes, prof.selections):
+        images = shots.images(sel.node, sel.period)
+        for ax, name in zip(row, names):
+            ax.axis("off")
+            if name in images.arrays:
+                ax.imshow(np.clip(images.arrays[name], 0, 1), interpolation="nearest")
+                ax.set_title(images.caption(name), fontsize=7)
+        what = f"{sel.node} Δn={sel.period}" if sel.node else "original"
+        row[0].text(-0.08, 0.5, f"{sel.label}: {what}", transform=row[0].transAxes, rotation=90,
+                    ha="right", va="center", fontsize=8)
+    fig.tight_layout()
+    plt.close(fig)
+    return fig
+
+
+def default_choice(prof) -> tuple:
+    """``(node, Δn)`` worth a first look: the last selection that caches something, else the
+    costliest trained node at the largest trained period."""
+    for sel in reversed(prof.selections):
+        if sel.node is not None:
+            return sel.node, int(sel.period)
+    node = prof.trained_nodes[0]
+    return node.id, int(max(node.periods))
+
+
+# ---------------------------------------------------------------------- HTML pieces
+def source_html(prof, node_id: Optional[str] = None, context: Optional[int] = None) -> str:
+    """The shader source as HTML, the line of ``node_id`` highlighted from its column on (lines
+    where other trained nodes start get a faint mark). ``context``: only that many lines around
+    the node."""
+    lines = read_source(prof)
+    node = prof.node(node_id) if node_id else None
+    starts = {int(n.line) for n in prof.trained_nodes}
+    lo, hi = 1, len(lines)
+    if node is not None and context is not None:
+        lo, hi = max(1, node.line - context), min(len(lines), node.line + context)
+    rows = []
+    for number in range(lo, hi + 1):
+        text = lines[number - 1]
+        if node is not None and number == node.line:
+            col = max(0, node.column - 1)
+            body = (html.escape(text[:col]) + '<mark style="background:#ffe066">' + html.escape(text[col:])
+                    + "</mark>")
+            style = "background:#fff6cc"
+        else:
+            body, style = html.escape(text), ("background:#eef6ee" if number in starts else "")
+        rows.append(f'<div style="{style}"><span style="color:#999;display:inline-block;width:3em">{number}</span>'
+                    f"{body}</div>")
+    return ('<div style="font:12px/1.35 monospace;white-space:pre;max-height:360px;overflow:auto;'
+            'border:1px solid #ddd;padding:4px">' + "".join(rows) + "</div>")
+
+
+def selections_html(prof) -> str:
+    """The four selections as an HTML table: threshold, node, Δn, predicted and measured error,
+    ms per frame and speed-up, PSNR and hit rate."""
+    head = ["", "max error", "node", "Δn", "pred. error", "meas. error", "pred. ms", "meas. ms",
+            "pred. speed-up", "meas. speed-up", "PSNR", "hit rate"]
+    rows = []
+    for s in prof.selections:
+        cells = [s.label, _f(s.max_error), s.node or "original", s.period or "–", _f(s.predicted_error),
+                 _f(s.measured_error), _f(s.predicted_ms), _f(s.measured_ms), _f(s.predicted_speedup, 3),
+                 _f(s.measured_speedup, 3), _f(s.measured_psnr, 3), _f(s.hit_rate, 3)]
+        rows.append("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>")
+    return ("<table><tr>" + "".join(f"<th>{h}</th>" for h in head) + "</tr>" + "".join(rows) + "</table>")
+
+
+# ---------------------------------------------------------------------- measuring a choice
+def measure_choice(prof, node: Optional[str], period: Optional[int], shots: FrameShots,
+                   frames: Optional[int] = None) -> dict:
+    """Render the session with the choice beside the original (:func:`rrcache.harness.cached.compare`,
+    at the session's resolution, the first ``frames`` frames, default the profile's validation
+    frames) and return ``{"error", "psnr", "speedup", "ms", "original_ms", "hit_rate", "frames"}``.
+    A choice the profile validated is not rendered again: its stored figures are returned."""
+    for sel in prof.selections:
+        if sel.node == node and sel.period == period and sel.measured_error is not None and (node or sel.frames):
+            return {"error": sel.measured_error, "psnr": sel.measured_psnr, "speedup": sel.measured_speedup,
+                    "ms": sel.measured_ms, "original_ms": sel.measured_original_ms, "hit_rate": sel.hit_rate,
+                    "frames": sel.frames, "stored": True}
+    if node is None:
+        return {"error": 0.0, "psnr": None, "speedup": 1.0, "ms": prof.original_ms, "original_ms": prof.original_ms,
+                "hit_rate": None, "frames": 0, "stored": True}
+    from rrcache.harness.cached import compare
+    from rrcache.pipeline import variant_for
+
+    settings = prof.settings
+    count = min(int(frames or settings.validation_frames or shots.session.frames), int(shots.session.frames))
+    variant = variant_for(shots.work, node, int(period), settings.algorithm)
+    result = compare(variant, shots.session, shots.work.prepared, range(count), period=int(period),
+                     block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon)
+    return {"error": result.mean_error, "psnr": result.psnr, "speedup": result.speedup, "ms": result.ms_per_frame,
+            "original_ms": result.original_ms_per_frame, "hit_rate": result.hit_rate, "frames": count,
+            "stored": False}
+
+
+# ---------------------------------------------------------------------- the widget
+class Explorer:
+    """The interactive profiler (see the module docstring). ``value`` is the starting threshold
+    (default: the profile's e2 level). Attributes: ``slider``, ``button``, ``choice`` (the last
+    :class:`rrcache.model.Selection`), ``select_ms`` (the last re-selection's time),
+    ``measured`` (the last choice's measurement), ``written`` (files the button wrote).
+    ``measure=False`` skips rendering the session for choices the profile did not validate."""
+
+    def __init__(self, prof, value: Optional[float] = None, out_dir="chosen", measure: bool = True,
+                 shots: Optional[FrameShots] = None):
+        import ipywidgets as w
+
+        self.prof = prof
+        self.out_dir = Path(out_dir)
+        self.measure = measure
+        self.shots = shots or FrameShots(prof)
+        levels = [s.max_error for s in prof.selections if s.max_error and s.max_error > 0] or [1e-3]
+        lo, hi = math.log10(min(levels) / 10.0), math.log10(max(levels) * 10.0)
+        start = value if value is not None else levels[min(1, len(levels) - 1)]
+        self.slider = w.FloatLogSlider(value=start, base=10, min=lo, max=hi, step=(hi - lo) / 200,
+                                       description="max error", readout_format=".2e", continuous_update=True,
+                                       layout=w.Layout(width="640px"))
+        self.button = w.Button(description="Write shader files", icon="save", button_style="primary")
+        self.summary = w.HTML()
+        self.source = w.HTML()
+        self.status = w.HTML()
+        self.frames = w.HBox()
+        self.widget = w.VBox([w.HBox([self.slider, self.button]), self.summary, self.frames, self.source,
+                              self.status])
+        self.choice = None
+        self.select_ms: Optional[float] = None
+        self.measured: Optional[dict] = None
+        self.written: list = []
+        self.slider.observe(lambda change: self.update(change["new"]), names="value")
+        self.button.on_click(lambda _: self.write_files())
+        self.update(self.slider.value)
+
+    def update(self, max_error: float):
+        """Re-select for ``max_error`` and refresh the view (renders only when the choice changes)."""
+        start = time.perf_counter()
+        choice = self.prof.select(max_error)
+        self.select_ms = (time.perf_counter() - start) * 1000.0
+        changed = self.choice is None or (choice.node, choice.period) != (self.choice.node, self.choice.period)
+        self.choice = choice
+        if changed:
+            self._show_choice(choice)
+        self._show_summary(max_error)
+        return choice
+
+    def _show_choice(self, choice) -> None:
+        import ipywidgets as w
+
+        images = self.shots.images(choice.node, choice.period)
+        boxes = []
+        for name in CAPTIONS:
+            if name in images.arrays:
+                boxes.append(w.VBox([w.Image(value=images.png(name), format="png",
+                                             width=2 * images.size[0] if images.size[0] <= 200 else images.size[0]),
+                                     w.HTML(f"<small>{html.escape(images.caption(name))}</small>")]))
+        self.frames.children = boxes
+        self.images = images
+        if self.measure or choice.node is None:
+            self.measured = measure_choice(self.prof, choice.node, choice.period, self.shots)
+        else:
+            self.measured = None
+        self.source.value = source_html(self.prof, choice.node, context=8) if choice.node else source_html(self.prof)
+
+    def _show_summary(self, max_error: float) -> None:
+        c, m = self.choice, self.measured or {}
+        if c.node is None:
+            what = "<b>the original shader</b>: no cached variant is predicted faster within this error"
+        else:
+            what = (f"cache <b>{html.escape(c.node)}</b> <code>{html.escape(self.prof.node(c.node).text)}</code> "
+                    f"every <b>Δn = {c.period}</b> frames")
+        measured = (f"measured over {m.get('frames')} frames{' (stored by the profile)' if m.get('stored') else ''}: "
+                    f"speed-up <b>{_f(m.get('speedup'), 3)}×</b>, error <b>{_f(m.get('error'))}</b>, "
+                    f"PSNR {_f(m.get('psnr'), 3)} dB, hit rate {_f(m.get('hit_rate'), 3)}"
+                    if m else "not measured (measure=False)")
+        self.summary.value = (
+            f"<div>max error {max_error:.3g} → {what}<br>"
+            f"predicted: speed-up <b>{_f(c.predicted_speedup, 3)}×</b>, error <b>{_f(c.predicted_error)}</b>, "
+            f"{_f(c.predicted_ms)} ms per frame (original {_f(self.prof.original_ms)} ms)<br>{measured}<br>"
+            f"<small>re-selected in {self.select_ms:.3f} ms from the models; this frame rendered at "
+            f"{self.images.size[0]}×{self.images.size[1]}, frame {self.images.frame}</small></div>")
+
+    def write_files(self) -> list:
+        """Write the chosen shader files into ``out_dir`` (the button does this)."""
+        self.written = self.prof.write_variant(self.choice, self.out_dir)
+        self.status.value = (f"wrote {len(self.written)} files to <code>{html.escape(str(self.out_dir))}</code>: "
+                             + ", ".join(html.escape(Path(p).name) for p in self.written))
+        return self.written
+
+    def _repr_mimebundle_(self, **kwargs):
+        return self.widget._repr_mimebundle_(**kwargs)

@@ -1,0 +1,225 @@
+"""``report.html``: one self-contained page about a profile, that works offline.
+
+Everything is inside the file: the style sheet and the script (:mod:`rrcache.report.assets`), the
+data (JSON in a ``<script type="application/json">``), and every image as a ``data:`` URI. The page
+has a summary; the interactive error-against-run-time chart (hover: node, Δn, predicted error and
+time; click: the node's source, call chain, α, λ, t_hit, t_miss and measured error runs); the
+shader source with each cacheable node's line marked by its best predicted speed-up; the four
+selections with real renders (original, cached, error map, payload, hit/miss map, from
+:mod:`rrcache.report.images`) and their measured against predicted figures; the model
+validation plots; the settings and how long training took.
+
+>>> write_report(load_profile("demo.rrprofile"), "demo.rrprofile")     # doctest: +SKIP
+PosixPath('demo.rrprofile/report.html')
+"""
+from __future__ import annotations
+
+import html
+import json
+import math
+import os
+import tempfile
+import time
+from pathlib import Path
+from typing import Optional
+
+from rrcache.errors import RRCacheError
+from rrcache.report import assets
+from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
+from rrcache.report.images import CAPTIONS, FrameShots, data_uri
+
+REPORT_NAME = "report.html"
+#: the figures of :mod:`rrcache.profile.plots` the report shows, with their captions
+PLOTS = (("tradeoff.png", "error against run time (static, every node over Δn = 1..50)"),
+         ("hitrate.png", "hit rate: measured per node and the fitted γ(Δn) = μ(1 − 1/Δn)"),
+         ("validation.png", "validation: predicted against measured error and frame time"))
+
+
+def _e(value) -> str:
+    return html.escape(str(value), quote=True)
+
+
+def _f(value, digits: int = 4, suffix: str = "") -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    value = float(value)
+    if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
+        return f"{value:.{max(1, digits - 1)}e}{suffix}"
+    return f"{value:.{digits}g}{suffix}"
+
+
+def benefit_color(speedup: Optional[float], best: float) -> str:
+    """The source view's mark: grey for no predicted gain (or untrained), then pale yellow to
+    green as the node's best predicted speed-up approaches the profile's best.
+
+    >>> benefit_color(None, 2.0), benefit_color(2.0, 2.0)
+    ('#e4e6eb', 'hsl(130,60%,62%)')
+    """
+    if speedup is None or speedup <= 1.0 or best <= 1.0:
+        return "#e4e6eb"
+    share = min(1.0, math.log(speedup) / math.log(best))
+    return f"hsl({round(55 + 75 * share)},{round(85 - 25 * share)}%,{round(82 - 20 * share)}%)"
+
+
+def _summary(prof, timing: dict) -> str:
+    best = max((s for s in prof.selections if s.measured_speedup is not None),
+               key=lambda s: s.measured_speedup, default=None)
+    counts = prof.data.get("counts") or {}
+    cells = [
+        (f"{len(prof.trained_nodes)} / {len(prof.nodes)}", "nodes trained / cacheable"),
+        (_f(prof.original_ms, 4, " ms"), "original frame time"),
+        (_f(prof.mu, 3), "μ (hit rate limit)"),
+        (_f(prof.overhead_ms, 3, " ms"), "cache overhead per frame"),
+        (_f(prof.pixels, 6), "covered pixels per frame"),
+        ((_f(best.measured_speedup, 3, "×") + f" ({best.label})") if best else "–", "best measured speed-up"),
+        (_f(prof.training_wall_s, 3, " s"), "training time"),
+        (_f(timing["median_ms"], 2, " ms"), f"re-selection (median of {timing['repeats']})"),
+    ]
+    if counts:
+        cells.append((f"{counts.get('error_runs_computed', 0)} + {counts.get('timing_runs_computed', 0)}",
+                      "error + timing runs computed"))
+    return '<div class="summary">' + "".join(f"<div><b>{_e(v)}</b><span>{_e(k)}</span></div>" for v, k in cells) + "</div>"
+
+
+def _source(prof, lines: list[str]) -> str:
+    benefits = node_benefits(prof) if prof.trained_nodes else {}
+    best = max([b for b in benefits.values() if b] + [1.0])
+    by_line: dict = {}
+    for node in prof.nodes:
+        by_line.setdefault(int(node.line), []).append(node)
+    rows = []
+    for number, text in enumerate(lines, start=1):
+        nodes = by_line.get(number, [])
+        if not nodes:
+            rows.append(f'<div id="L{number}"><span class="ln">{number}</span><span class="mk"></span>'
+                        f"<code>{_e(text)}</code></div>")
+            continue
+        scored = [(benefits.get(n.id) or 0.0, n) for n in nodes]
+        top, lead = max(scored, key=lambda s: s[0])
+        title = "; ".join(f"{n.id}: " + (f"best {b:.2f}×" if b else "not trained") for b, n in scored)
+        mark = f"{top:.2f}×" if top else "·"
+        rows.append(f'<div id="L{number}" class="has" data-node="{_e(lead.id)}" title="{_e(title)}" '
+                    f'style="background:{benefit_color(top or None, best)}"><span class="ln">{number}</span>'
+                    f'<span class="mk">{_e(mark)} ({len(nodes)})</span><code>{_e(text)}</code></div>')
+    legend = ('<p class="legend">Lines where cacheable nodes start, by their best predicted speed-up '
+              "(over Δn = 1..50; the count of nodes in brackets; click a line for its best node): "
+              f'<span style="background:{benefit_color(None, best)}">no gain or not trained</span>'
+              f'<span style="background:{benefit_color(best ** 0.25, best)}">{best ** 0.25:.2f}×</span>'
+              f'<span style="background:{benefit_color(best ** 0.5, best)}">{best ** 0.5:.2f}×</span>'
+              f'<span style="background:{benefit_color(best, best)}">{best:.2f}×</span></p>')
+    return legend + '<div class="src">' + "".join(rows) + "</div>"
+
+
+def _selection(prof, sel, shots: FrameShots) -> str:
+    images = shots.images(sel.node, sel.period)
+    what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
+            if sel.node else "keep the original shader (nothing is predicted faster within this error)")
+    rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
+            ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
+            ("speed-up", _f(sel.predicted_speedup, 3, "×"), _f(sel.measured_speedup, 3, "×")),
+            ("PSNR", "", _f(sel.measured_psnr, 3, " dB")),
+            ("hit rate", "", _f(sel.hit_rate, 3))]
+    table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
+             + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
+             + "</table>")
+    figures = []
+    for name in CAPTIONS:
+        if name in images.arrays:
+            zoom = 2 if images.size[0] <= 200 else 1  # small frames are shown enlarged, pixel for pixel
+            w, h = (v * zoom for v in images.size)
+            figures.append(f'<figure><img alt="{_e(name)}" data-image="{_e(name)}" width="{w}" height="{h}" '
+                           f'src="{images.uri(name)}"><figcaption>{_e(images.caption(name))}</figcaption></figure>')
+    frame_note = (f"frame {images.frame} at {images.size[0]}×{images.size[1]}"
+                  + (f", after {images.frame + 1} frames with the cache: this frame's error {_f(images.error)}, "
+                     f"hit rate {_f(images.hit_rate, 3)}; the table's measurements are over {sel.frames} "
+                     "frames of the session" if sel.node else ""))
+    files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
+    return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(sel.node or "")}">'
+            f"<h3>{_e(sel.label)}: error ≤ {_f(sel.max_error)}</h3><p>{what}{files}</p>{table}"
+            f'<p class="muted">{_e(frame_note)}</p>'
+            f'<div class="shots">{"".join(figures)}</div></div>')
+
+
+def _plots(prof) -> str:
+    folder = Path(prof.path) if prof.path is not None else None
+    have = {name: folder / name for name, _ in PLOTS if folder is not None and (folder / name).exists()}
+    with tempfile.TemporaryDirectory() as tmp:
+        if len(have) < len(PLOTS) and prof.trained_nodes:
+            from rrcache.profile.plots import write_plots
+
+            for path in write_plots(prof, tmp):
+                have.setdefault(Path(path).name, Path(path))
+        parts = [f'<figure><img alt="{_e(name)}" src="{data_uri(have[name].read_bytes())}">'
+                 f"<figcaption>{_e(caption)}</figcaption></figure>" for name, caption in PLOTS if name in have]
+    return '<div class="plots">' + "".join(parts) + "</div>" if parts else "<p>No plots (no trained node).</p>"
+
+
+def _settings(prof) -> str:
+    rows = [(k, json.dumps(v)) for k, v in prof.settings.to_json().items()]
+    rows += [("shader", prof.shader), ("session", prof.session),
+             ("defines", json.dumps(prof.defines) if prof.defines else "–"),
+             ("training time", _f(prof.training_wall_s, 4, " s")),
+             ("budget stopped training", str(bool(prof.data.get("budget_stopped")))),
+             ("untrained nodes", str(len(prof.data.get("untrained") or [])))]
+    counts = prof.data.get("counts") or {}
+    rows += [(k.replace("_", " "), str(v)) for k, v in counts.items()]
+    return "<table>" + "".join(f"<tr><th>{_e(k)}</th><td><code>{_e(v)}</code></td></tr>" for k, v in rows) + "</table>"
+
+
+def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
+    """The report page of ``prof`` as a string (renders the selections' frames)."""
+    shots = shots or FrameShots(prof, work)
+    lines = read_source(prof)
+    timing = selection_timing(prof) if prof.trained_nodes else {"median_ms": None, "repeats": 0}
+    data = {"source": lines, "details": {n.id: node_details(prof, n.id) for n in prof.nodes}}
+    if prof.trained_nodes:
+        data.update(chart_data(prof))
+    else:
+        data.update({"nodes": [], "front": [], "original_ms": float(prof.original_ms), "selections": []})
+    payload = json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    name = Path(prof.shader).name
+    sections = [
+        "<h2>Summary</h2>", _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
+        "<h2>Error against run time</h2>",
+        '<p class="muted">Each path is one node over Δn = 1..50 as the fitted models predict it (larger '
+        "dots: the trained periods); the black line is the Pareto front, the dashed line the original's "
+        "frame time, the squares the four selections. Hover a point; click it for "
+        "the node. On the log scale Δn = 1 (error 0, refreshed every frame) is left out.</p>",
+        '<p id="yscale">error axis: <button data-scale="log">log</button> <button data-scale="linear">linear</button></p>'
+        '<div class="chartrow"><svg id="chart" viewBox="0 0 720 440" width="720" height="440" '
+        'role="img" aria-label="error against run time"></svg>'
+        '<div id="details"><h3>Node details</h3><p class="muted">Click a point of the chart or a marked '
+        "source line.</p></div></div>",
+        f"<h2>Shader source: {_e(name)}</h2>", _source(prof, lines),
+        "<h2>Selections</h2>",
+        '<p class="muted">The four error thresholds e1..e4; predicted by the models, measured by rendering '
+        "the session with the chosen variant beside the original.</p>",
+        "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        "<h2>Model validation</h2>", _plots(prof),
+        "<h2>Settings and training</h2>", _settings(prof),
+    ]
+    generated = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            '<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>rrcache profile: {_e(name)}</title><style>{assets.CSS}</style></head><body>"
+            f"<header><h1>rrcache profile: {_e(name)}</h1><p>session {_e(Path(prof.session).name)} · "
+            f"written {generated}</p></header><main>{''.join(sections)}</main>"
+            '<div id="tooltip"></div>'
+            f'<script id="rr-data" type="application/json">{payload}</script>'
+            f"<script>{assets.JS}</script></body></html>\n")
+
+
+def write_report(profile, out_dir, work=None, filename: str = REPORT_NAME) -> Path:
+    """Write the report of ``profile`` into ``out_dir`` (as ``filename``, default ``report.html``)
+    and return its path. ``work`` (the profiled :class:`~rrcache.pipeline.ShaderWork`) saves
+    loading the shader again."""
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise RRCacheError("the report's folder is a file", str(out), hint="give a folder, or --out FILE.html")
+    out.mkdir(parents=True, exist_ok=True)
+    text = report_html(profile, work)
+    path = out / filename
+    tmp = out / (filename + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+    return path
