@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import sqlite3
@@ -141,7 +142,9 @@ def test_errors_are_one_located_line(full, tmp_path, args, message):
     assert "Traceback" not in proc.stderr
 
 
-def test_resume_after_sigkill(full, tmp_path):
+def test_resume_after_sigkill(full, tmp_path, stability_case):
+    case = stability_case("profile killed (SIGKILL) and resumed", "profile store: interruption and damage",
+                          "rrcache profile, SIGKILL after 3 stored error runs, then the same command again")
     folder, _ = full
     shader, session = write_scene(tmp_path)
     out = tmp_path / "out"
@@ -166,19 +169,27 @@ def test_resume_after_sigkill(full, tmp_path):
         assert log[1]["error_runs_skipped"] == killed_at
         assert store.counts()["error_runs"] == total
     reference, resumed = _fits(folder / "out"), _fits(out)
+    case.observe(runs_at_kill=killed_at, runs_in_all=total, skipped_on_resume=log[1]["error_runs_skipped"],
+                 computed_on_resume=log[1]["error_runs_computed"], run_log=[r["status"] for r in log],
+                 fits_as_uninterrupted=reference.keys() == resumed.keys() and all(
+                     math.isclose(resumed[n][i], reference[n][i], rel_tol=1e-6, abs_tol=1e-12)
+                     for n in reference for i in (0, 1)))
     assert reference.keys() == resumed.keys()
     for node, (alpha, lam) in reference.items():
         assert resumed[node][0] == pytest.approx(alpha, rel=1e-6, abs=1e-12), node
         assert resumed[node][1] == pytest.approx(lam, rel=1e-6, abs=1e-12), node
 
 
-def test_sigint_exits_130_and_keeps_the_store(tmp_path):
+def test_sigint_exits_130_and_keeps_the_store(tmp_path, stability_case):
+    case = stability_case("profile interrupted (SIGINT)", "profile store: interruption and damage",
+                          "rrcache profile, SIGINT after 2 stored error runs, then resumed")
     shader, session = write_scene(tmp_path)
     out = tmp_path / "out"
     proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS)
     _wait_for_runs(proc, out / "profile.sqlite", 2)
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=60)
+    case.observe(exit=proc.returncode, stderr=" ".join(stderr.split()).replace(str(tmp_path), "TMP"))
     assert proc.returncode == 130, stderr
     assert "interrupted" in stderr and "error runs over" in stderr and "resume" in stderr
     assert "Traceback" not in stderr
@@ -190,4 +201,5 @@ def test_sigint_exits_130_and_keeps_the_store(tmp_path):
             assert len(store.error_frames(run.node, run.period)) == run.frames == 12
     assert not (out / "profile.json").exists()
     resumed = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--no-validate")
+    case.observe(stored_at_interrupt=stored, resumed_skipping=f"computed; {stored} error and" in resumed.stdout)
     assert f"computed; {stored} error and" in resumed.stdout

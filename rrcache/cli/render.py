@@ -10,8 +10,8 @@ one run, and compared: error, PSNR, hit rate, and the speed-up as a ratio of med
 
 With ``--out`` each frame is written as ``frame_NNNN.exr`` (float, exact) and ``frame_NNNN.png``.
 The summary is a table (or, with ``--json``, an object with ``frames``, ``resolution``,
-``ms_per_frame``, ``covered_pixels`` and ``nonfinite_pixels``, per frame); notes on the session (uniforms the shader does not use)
-go to stderr.
+``ms_per_frame``, and per frame ``covered_pixels`` and ``nonfinite_pixels``: pixels with a NaN or
+an infinity); notes on the session (uniforms the shader does not use) go to stderr.
 """
 from __future__ import annotations
 
@@ -107,7 +107,8 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
     if any(nonfinite):
         table.add_column("NaN/Inf pixels", justify="right")
     for frame, bad in zip(result.frames, nonfinite):
-        table.add_row(str(frame.index), str(frame.covered_pixels), f"{frame.ms:.2f}", *([str(bad)] if any(nonfinite) else []))
+        extra = [str(bad)] if any(nonfinite) else []
+        table.add_row(str(frame.index), str(frame.covered_pixels), f"{frame.ms:.2f}", *extra)
     console = Console()
     console.print(table)
     console.print(f"median {result.ms_per_frame:.2f} ms per frame over {len(result.frames)} frames"
