@@ -1,0 +1,9 @@
+"""Other ways to cut pixel cost, for equal-time comparisons with the cache (main paper §5.4):
+
+- :mod:`~rrcache.alternatives.dynres`: dynamic resolution (shade fewer pixels, upsample
+  bilinearly);
+- :mod:`~rrcache.alternatives.simplify`: automatic simplification after Pellacini 2005 (replace
+  expressions by their mean over the session);
+- :mod:`~rrcache.alternatives.search`: tuning either to a target speed-up;
+- :mod:`~rrcache.alternatives.measure`: side-by-side measurement against the original.
+"""
