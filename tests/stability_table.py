@@ -102,7 +102,16 @@ def pytest_runtest_makereport(item, call):
         settings = getattr(item.obj, "_hypothesis_internal_use_settings", None)
         item.config.stash[_FUZZ][item.nodeid] = (
             getattr(settings, "max_examples", None), sum(int(n) for n in _PASSING.findall(stats)),
-            (item.obj.__doc__ or "").strip().split("\n")[0])
+            _what(item))
+
+
+def _what(item) -> str:
+    """What a fuzz test feeds: its docstring's first line, else its module's first sentence."""
+    doc = (item.obj.__doc__ or "").strip().split("\n")[0]
+    if not doc:
+        module_doc = " ".join((getattr(item.module, "__doc__", None) or "").split())
+        doc = re.split(r"(?<=[.:])\s", module_doc, maxsplit=1)[0].rstrip(".:")
+    return doc
 
 
 def _cell(text: str) -> str:
@@ -144,8 +153,11 @@ def pytest_sessionfinish(session, exitstatus):
         "",
         "```sh",
         "python -m pytest -q tests/test_stability_models.py tests/test_stability_render.py \\",
-        "    tests/test_stability_cli.py tests/test_model_fuzz.py tests/test_frontend_fuzz.py \\",
-        "    tests/test_session_fuzz.py --stability-table docs/stability.md",
+        "    tests/test_stability_cli.py tests/test_profile_store.py \\",
+        "    tests/test_cli_profile.py::test_resume_after_sigkill \\",
+        "    tests/test_cli_profile.py::test_sigint_exits_130_and_keeps_the_store \\",
+        "    tests/test_model_fuzz.py tests/test_frontend_fuzz.py tests/test_session_fuzz.py \\",
+        "    --stability-table docs/stability.md",
         "```",
         "",
         f"Run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; GL renderer: {_renderer()}; "
