@@ -87,8 +87,9 @@ class CacheBench:
 
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
-        progress: Optional[Callable[[str], None]] = None) -> CacheBench:
-    """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration."""
+        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4)) -> CacheBench:
+    """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
+    (``periods=()`` or ``blocks=()`` leave those rows out)."""
     say = progress or (lambda _msg: None)
     session = load_session(session_path)
     work = load_for_session(shader_path, session)
@@ -108,7 +109,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         bench.periods.append(row(f"Δn={period}", "three-pass", period, 4))
     for algorithm in ("three-pass", "two-pass", "one-pass"):
         bench.algorithms.append(row(algorithm, algorithm, compare_period, 4))
-    for block in (1, 2, 4):
+    for block in blocks:
         bench.blocks.append(row(f"k={block}", "three-pass", compare_period, block))
 
     say("limit: every pixel hits")

@@ -19,6 +19,7 @@ _COMMANDS = {
     "bench-frontend": "bench_frontend",
     "instance": "instance",
     "bench-cache": "bench_cache",
+    "bench": "bench",
     "profile": "profile",
     "select": "select",
     "render": "render",

@@ -1,0 +1,424 @@
+"""``rrcache bench``: the paper's results on its three scenes, end to end (issue 8; main paper
+§5, Table 1, Figs. 7–10).
+
+Per scene (:func:`run_scene`):
+
+1. **Profile** (:func:`rrcache.profile`) into ``<out>/<scene>.rrprofile``; a second run with the
+   same settings resumes from its store (``precompute_resumed`` says so). The precomputation
+   time is the profile's training wall time, every stored run counted, earlier invocations
+   included. The profile is not validated (``validate=False``): the bench measures the four
+   selections itself, below, in the same run as everything else.
+2. **Size of the problem**: the static cost of the shader (our cost model,
+   :mod:`rrcache.analysis.cost`, summed over every expression that contributes to the output
+   colour of the analysed program, each counted once: :func:`rrcache.alternatives.simplify.static_cost`;
+   the paper gives instruction counts instead) and the number of cacheable nodes.
+3. **The four selections** e1..e4 rendered side by side with the original
+   (:func:`rrcache.harness.cached.compare`) over the bench frames, ``repeats`` times: speed-up
+   = median over the repeats of the ratio of median frame times; mean error (mean RGB L2 over
+   covered pixels) and PSNR from the first repeat (the images do not depend on timing).
+4. On the **medium selection** (e3, the threshold of the paper's Fig. 10; the nearest cached
+   selection when e3 caches nothing): the three cache algorithms side by side and the cache's
+   speed-up limit (every pixel hitting), through :func:`rrcache.bench.cache.run`.
+5. **Equal time** (§5.4): dynamic resolution and simplification tuned to the medium
+   selection's measured speed-up (:mod:`rrcache.alternatives`), then measured over the bench
+   frames beside the original; error and PSNR of all three.
+
+:func:`run` does every scene and rewrites ``bench.json`` and ``bench.md`` in ``out`` as each
+scene finishes, so an interruption loses only the scene in flight (and its profile resumes).
+``QUICK`` shrinks sessions, training and searches so the whole bench fits in a few minutes on
+a two-core machine; its figures are not the paper's full run.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import statistics
+import time
+import warnings
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+
+from rrcache.bench.scenes import Scene, scaled_session
+
+ProgressFn = Callable[[str, Optional[int], Optional[int]], None]
+PSNR_CAP = 100.0
+MEDIUM = "e3"
+
+
+@dataclass(frozen=True)
+class BenchSettings:
+    """How much the bench does.
+
+    - ``resolution``/``frames``: the session is scaled to at most this size and frame count
+      (None: as it is); ``scene_overrides`` per scene name (quick: chess smaller).
+    - ``training``: keyword arguments of :class:`rrcache.profile.TrainingSettings`.
+    - ``repeats``: side-by-side runs per selection (speed-up: the median).
+    - ``candidates``: the costliest nodes considered by the simplification; ``probe_frames``
+      sample frames for its node means and errors, at ``probe_resolution`` (None: a quarter).
+    - ``search_frames``: frames per equal-time search step; ``tolerance`` the relative speed-up
+      tolerance; ``max_steps`` of the dynamic-resolution search; ``min_scale`` its lower end.
+    - ``plots``: let the profiler write its plots.
+    """
+
+    quick: bool = False
+    resolution: Optional[tuple] = None
+    frames: Optional[int] = None
+    training: dict = field(default_factory=lambda: {"validate": False})
+    repeats: int = 3
+    candidates: int = 24
+    probe_frames: int = 6
+    probe_resolution: Optional[tuple] = None
+    search_frames: int = 24
+    tolerance: float = 0.05
+    max_steps: int = 8
+    min_scale: float = 0.1
+    plots: bool = True
+    scene_overrides: dict = field(default_factory=dict)
+
+    def for_scene(self, name: str) -> "BenchSettings":
+        over = self.scene_overrides.get(name)
+        return replace(self, scene_overrides={}, **over) if over else self
+
+    def to_json(self) -> dict:
+        return _finite(asdict(self))
+
+
+FULL = BenchSettings()
+QUICK = BenchSettings(
+    quick=True, resolution=(160, 120), frames=40,
+    training={"periods": (2, 8, 16), "timing_frames": 4, "timing_periods": (2, 16), "budget_s": 15.0,
+              "validate": False},
+    repeats=1, candidates=6, probe_frames=2, probe_resolution=(40, 30), search_frames=8, tolerance=0.1,
+    max_steps=4, plots=False,
+    # the ambient-occlusion shader is ~50× the cost of the others per pixel
+    scene_overrides={"chess": {"resolution": (64, 48), "frames": 20, "probe_resolution": (32, 24),
+                               "search_frames": 5}},
+)
+
+
+@dataclass
+class SelectionRow:
+    label: str
+    max_error: float
+    node_id: Optional[str]
+    node: Optional[str]
+    period: Optional[int]
+    speedup: float
+    mean_error: float
+    psnr: float
+    hit_rate: Optional[float] = None
+    ms: Optional[float] = None
+    original_ms: Optional[float] = None
+    predicted_speedup: Optional[float] = None
+    predicted_error: Optional[float] = None
+    speedups: list = field(default_factory=list)
+
+
+@dataclass
+class MethodRow:
+    """One row of a side-by-side table: the cache algorithms, or the equal-time methods."""
+
+    method: str
+    setting: str
+    speedup: float
+    mean_error: float
+    psnr: float
+    ms: float
+    original_ms: float
+    matched: Optional[bool] = None
+    steps: list = field(default_factory=list)
+
+
+@dataclass
+class SceneResult:
+    name: str
+    shader: str
+    session: str
+    resolution: tuple
+    frames: int
+    static_cost: int
+    cacheable_nodes: int
+    trained_nodes: int = 0
+    precompute_s: Optional[float] = None
+    precompute_resumed: bool = False
+    profile_run_s: Optional[float] = None
+    profile: Optional[str] = None
+    original_ms: Optional[float] = None
+    limit_speedup: Optional[float] = None
+    limit_ms: Optional[float] = None
+    limit_original_ms: Optional[float] = None
+    medium: Optional[str] = None
+    target_speedup: Optional[float] = None
+    selections: list = field(default_factory=list)
+    algorithms: list = field(default_factory=list)
+    equal_time: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    wall_s: float = 0.0
+
+    def to_json(self) -> dict:
+        return _finite(asdict(self))
+
+
+def _finite(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    if isinstance(value, np.generic):
+        return _finite(value.item())
+    return value
+
+
+def _cap(psnr: float) -> float:
+    return min(float(psnr), PSNR_CAP)
+
+
+def _say(progress: Optional[ProgressFn], stage: str, done=None, total=None) -> None:
+    if progress is not None:
+        progress(stage, done, total)
+
+
+def _effective_session(scene: Scene, settings: BenchSettings, out: Path) -> str:
+    """The session the bench runs: the scene's own, or a scaled copy in ``out/sessions``."""
+    from rrcache.session import load_session
+
+    session = load_session(scene.session)
+    w, h = session.resolution
+    size = (w, h)
+    if settings.resolution is not None and settings.resolution[0] * settings.resolution[1] < w * h:
+        size = tuple(int(v) for v in settings.resolution)
+    frames = session.frames if settings.frames is None else min(int(settings.frames), session.frames)
+    if size == (w, h) and frames == session.frames:
+        return scene.session
+    return str(scaled_session(scene.session, out / "sessions" / f"{scene.name}.json", size, frames))
+
+
+def _choose_medium(selections: list) -> Optional[SelectionRow]:
+    by_label = {s.label: s for s in selections}
+    for label in (MEDIUM, "e4", "e2", "e1"):
+        row = by_label.get(label)
+        if row is not None and row.node_id is not None:
+            return row
+    return None
+
+
+def _measure_selections(prof, work, session, frames, settings: BenchSettings, progress) -> list[SelectionRow]:
+    from rrcache.harness.cached import compare
+    from rrcache.pipeline import variant_for
+
+    ps = prof.settings
+    rows = []
+    for sel in prof.selections:
+        _say(progress, f"selection {sel.label}", None, None)
+        row = SelectionRow(sel.label, sel.max_error, sel.node, sel.text, sel.period, 1.0, 0.0, PSNR_CAP,
+                           predicted_speedup=sel.predicted_speedup, predicted_error=sel.predicted_error)
+        if sel.node is not None:
+            variant = variant_for(work, sel.node, int(sel.period), ps.algorithm)
+            runs = []
+            for _ in range(settings.repeats):
+                runs.append(compare(variant, session, work.prepared, frames, period=int(sel.period), block=ps.block,
+                                    refresh=ps.refresh, depth_epsilon=ps.depth_epsilon))
+            first = runs[0]
+            row.speedups = [r.speedup for r in runs]
+            row.speedup = float(statistics.median(row.speedups))
+            row.mean_error, row.psnr, row.hit_rate = first.mean_error, _cap(first.psnr), first.hit_rate
+            row.ms = float(statistics.median(r.ms_per_frame for r in runs))
+            row.original_ms = float(statistics.median(r.original_ms_per_frame for r in runs))
+        rows.append(row)
+    return rows
+
+
+def _equal_time(work, session, frames, medium: SelectionRow,
+                settings: BenchSettings, result: SceneResult, progress) -> list[MethodRow]:
+    from rrcache.alternatives import dynres, simplify
+    from rrcache.alternatives.measure import compare_renderers
+    from rrcache.harness.renderer import Renderer
+
+    target = medium.speedup
+    rows = [MethodRow("reprojection cache (ours)", f"{medium.label}: {medium.node_id} at Δn={medium.period}",
+                      medium.speedup, medium.mean_error, medium.psnr, medium.ms, medium.original_ms, True)]
+    search = list(frames)[:max(1, settings.search_frames)]
+
+    # dynamic resolution
+    def dyn_step(scale, speedup):
+        _say(progress, f"dynres s={scale:.3f}: {speedup:.2f}× (target {target:.2f}×)")
+
+    found = dynres.tune_scale(work.prepared, session, None, search, target, lo=settings.min_scale,
+                              rel_tol=settings.tolerance, max_steps=settings.max_steps, progress=dyn_step)
+    final = dynres.measure_scale(work.prepared, session, None, frames)(found.value)
+    low = dynres.low_size(tuple(session.resolution), found.value)
+    rows.append(MethodRow("dynamic resolution", f"scale {found.value:.3f} ({low[0]}×{low[1]}, bilinear)",
+                          final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
+                          final.original_ms_per_frame, found.matched, [list(s) for s in found.steps]))
+
+    # simplification
+    w, h = session.resolution
+    probe_size = settings.probe_resolution or (max(8, w // 4), max(8, h // 4))
+    probe_size = (min(probe_size[0], w), min(probe_size[1], h))
+    n = len(frames)
+    probe = sorted({int(round(x)) for x in np.linspace(frames[0], frames[-1], max(1, settings.probe_frames))}) \
+        if n > 1 else list(frames)
+    costliest = sorted((x for x in work.table.nodes if not x.final), key=lambda x: -x.cost)[:settings.candidates]
+    ids = [x.id for x in costliest]
+    done = {"k": 0}
+
+    def probe_step(_node_id):
+        done["k"] += 1
+        _say(progress, "simplification: node means and errors", done["k"], 2 * len(ids))
+
+    if not ids:
+        result.notes.append("simplification: no cacheable node besides the final colour; left out")
+        return rows
+    ranking = simplify.rank_candidates(work, session, ids, probe, probe_size, probe_step)
+    if not ranking:
+        result.notes.append("simplification: no candidate saves static cost; left out")
+        return rows
+
+    def simp_step(k, speedup):
+        _say(progress, f"simplification k={k}: {speedup:.2f}× (target {target:.2f}×)")
+
+    # static cost taken as proportional to time: do not go below half the cost the target suggests
+    floor = 0.5 * result.static_cost / max(target, 1.0)
+    tuned = simplify.tune_simplification(work, session, ranking, None, search, target, settings.tolerance, simp_step,
+                                         cost_floor=floor)
+    k = int(tuned.search.value)
+    with Renderer(work.prepared, session) as original, Renderer(tuned.shader.prepared, session) as simple:
+        final = compare_renderers(original, simple, frames)
+    rows.append(MethodRow("simplification (Pellacini 2005)",
+                          f"{k} of {len(tuned.ranking)} nodes in the greedy order replaced by their means "
+                          f"(static cost {tuned.shader.cost} of {result.static_cost}): "
+                          + ", ".join(_short(c.text) for c in tuned.ranking[:k]),
+                          final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
+                          final.original_ms_per_frame, tuned.search.matched,
+                          [list(s) for s in tuned.search.steps]))
+    return rows
+
+
+def _short(text: str, limit: int = 40) -> str:
+    text = " ".join(text.split())
+    return "`" + (text if len(text) <= limit else text[:limit - 1] + "…") + "`"
+
+
+def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[ProgressFn] = None) -> SceneResult:
+    """Bench one scene (see the module docstring); the profile goes to ``out/<name>.rrprofile``."""
+    from rrcache.alternatives.simplify import simplified_shader
+    from rrcache.bench import cache as cache_bench
+    from rrcache.pipeline import load_for_session
+    from rrcache.profile import TrainingSettings, profile
+    from rrcache.session import load_session
+
+    started = time.time()
+    out = Path(out)
+    settings = settings.for_scene(scene.name)
+    session_path = _effective_session(scene, settings, out)
+    session = load_session(session_path)
+    work = load_for_session(scene.shader, session)
+    frames = list(range(session.frames))
+    result = SceneResult(scene.name, scene.shader, session_path, tuple(session.resolution), len(frames),
+                         simplified_shader(work, {}).cost, len(work.table.nodes))
+
+    folder = out / f"{scene.name}.rrprofile"
+    training = TrainingSettings(**settings.training)
+
+    def on_event(event):
+        _say(progress, f"profile: {event.stage} {event.detail}".strip(), event.done, event.total)
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        prof = profile(scene.shader, session_path, folder, training, progress=on_event, plots=settings.plots)
+    result.notes += [f"profile: {w.message}" for w in caught]
+    counts = prof.counts or {}
+    result.profile = str(folder)
+    result.precompute_s = prof.training_wall_s
+    result.precompute_resumed = bool(counts.get("error_runs_skipped", 0) or counts.get("timing_runs_skipped", 0))
+    result.profile_run_s = prof.data.get("run_wall_s")
+    result.trained_nodes = len(prof.trained_nodes)
+    if not prof.selections:
+        result.notes.append("no node was trained (budget too small): nothing selected")
+        result.wall_s = time.time() - started
+        return result
+
+    result.selections = _measure_selections(prof, work, session, frames, settings, progress)
+    originals = [s.original_ms for s in result.selections if s.original_ms is not None]
+    medium = _choose_medium(result.selections)
+    if medium is None:
+        result.notes.append("every selection is the original shader: no algorithm, limit or equal-time comparison")
+        result.original_ms = _original_ms(work, session, frames)
+        result.wall_s = time.time() - started
+        return result
+    result.medium, result.target_speedup = medium.label, medium.speedup
+    if medium.label != MEDIUM:
+        result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
+
+    _say(progress, f"algorithms and limit on {medium.node_id}")
+    bench = cache_bench.run(scene.shader, session_path, medium.node_id, periods=(), compare_period=int(medium.period),
+                            frames=len(frames), blocks=(),
+                            progress=lambda msg: _say(progress, f"algorithms: {msg}"))
+    result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
+                                   r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]
+    originals += [r.original_ms for r in result.algorithms]
+    result.limit_ms, result.limit_original_ms = bench.limit_ms, bench.limit_original_ms
+    result.limit_speedup = bench.limit_speedup
+
+    if medium.speedup > 1.0 + settings.tolerance:
+        result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
+        originals += [r.original_ms for r in result.equal_time[1:]]
+    else:
+        result.notes.append(f"the {medium.label} selection measured {medium.speedup:.2f}×, no faster than the "
+                            "original: no equal-time comparison")
+    result.original_ms = float(statistics.median(originals)) if originals else _original_ms(work, session, frames)
+    result.wall_s = time.time() - started
+    return result
+
+
+def _original_ms(work, session, frames) -> float:
+    from rrcache.harness.renderer import render
+
+    return float(render(work.prepared, session, frames=list(frames)[:10]).ms_per_frame)
+
+
+@dataclass
+class BenchResult:
+    settings: BenchSettings
+    scenes: list = field(default_factory=list)
+    started: str = ""
+    wall_s: float = 0.0
+
+    def to_json(self) -> dict:
+        return {"rrcache_bench": 1, "quick": self.settings.quick, "started": self.started,
+                "wall_s": self.wall_s, "threads": os.environ.get("LP_NUM_THREADS"),
+                "settings": self.settings.to_json(), "scenes": [s.to_json() for s in self.scenes]}
+
+
+def run(scenes: list, settings: BenchSettings = FULL, out="rrcache-bench", progress: Optional[ProgressFn] = None,
+        on_scene: Optional[Callable[[SceneResult], None]] = None) -> BenchResult:
+    """Bench every scene in turn; ``bench.json`` and ``bench.md`` in ``out`` are rewritten after
+    each scene (``on_scene`` is called then too)."""
+    from rrcache.bench.paper_report import markdown
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    result = BenchResult(settings, started=time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()))
+    t0 = time.time()
+    for scene in scenes:
+        _say(progress, f"{scene.name}: starting")
+        result.scenes.append(run_scene(scene, settings, out, lambda s, d=None, t=None, n=scene.name:
+                                       _say(progress, f"{n}: {s}", d, t)))
+        result.wall_s = time.time() - t0
+        _write(out / "bench.json", json.dumps(result.to_json(), indent=2, ensure_ascii=False) + "\n")
+        _write(out / "bench.md", markdown(result))
+        if on_scene is not None:
+            on_scene(result.scenes[-1])
+    return result
+
+
+def _write(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)

@@ -1,0 +1,217 @@
+"""``rrcache bench`` on a tiny scene: an icosphere at 64×48, 16 frames, a noise shader whose
+octave loop runs a uniform number of times (so a pixel is costly but the program has only a
+few cacheable nodes: the loop is not unrolled and its inside is dynamic).
+
+- scene lists: the paper's names, SHADER:SESSION pairs, and their errors;
+- scaled sessions: absolute asset paths, the requested size and frames, not rewritten when equal;
+- the whole bench through the CLI (``--quick --json``) for the shape only (timings are never
+  asserted), bench.json and bench.md written; a second run resumes the profile;
+- an interrupted two-scene run keeps the finished scene in bench.json and exits 130;
+- the medium-selection rule.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from rrcache.bench import paper
+from rrcache.bench.scenes import PAPER_SCENES, Scene, default_root, resolve_scenes, scaled_session
+from rrcache.errors import RRCacheError
+from rrcache.session import load_session
+
+SHADER = """#version 330
+in vec4 v_position;
+in vec3 v_normal;
+in vec3 v_objectPosition;
+uniform vec3 u_light;
+uniform float u_scale;
+uniform int u_octaves;
+out vec4 fragColor;
+
+float wave(vec3 p, float f) {
+    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
+}
+
+void main() {
+    vec3 p = v_objectPosition * u_scale;
+    float n = 0.5;
+    float amp = 0.25;
+    float f = 1.0;
+    for (int i = 0; i < u_octaves; i++) { n += amp * wave(p, f); f *= 1.13; amp *= 0.97; }
+    vec3 albedo = mix(vec3(0.9, 0.8, 0.6), vec3(0.3, 0.2, 0.1), n);
+    vec3 nrm = normalize(v_normal);
+    vec3 l = normalize(u_light - v_position.xyz);
+    float diffuse = max(dot(nrm, l), 0.0);
+    fragColor = vec4(albedo * (0.2 + 0.8 * diffuse), 1.0);
+}
+"""
+
+SESSION = {
+    "rrcache_session": 1, "resolution": [64, 48], "frames": 16, "fps": 30,
+    "camera": {"fov": 45, "near": 0.1, "far": 50, "keyframes": [
+        {"frame": 0, "eye": [0, 0.4, 2.4], "target": [0, 0, 0], "up": [0, 1, 0]},
+        {"frame": 15, "eye": [0.8, 0.5, 2.2], "target": [0, 0, 0], "up": [0, 1, 0]}]},
+    "light": {"color": [1, 1, 1], "orbit": {"center": [0, 0, 0], "radius": 4, "height": 3, "degrees_per_frame": 3}},
+    "objects": [{"procedural": {"type": "icosphere", "radius": 1.0, "subdivisions": 3}}],
+    "uniforms": {"u_scale": 3.0, "u_octaves": 100},
+}
+
+SCENE_KEYS = {"name", "cacheable_nodes", "precompute_s", "original_ms", "limit_speedup", "selections"}
+SELECTION_KEYS = {"label", "max_error", "node", "period", "speedup", "mean_error", "psnr"}
+
+
+def write_scene(folder, name="noise"):
+    folder.mkdir(parents=True, exist_ok=True)
+    shader, session = folder / f"{name}.frag", folder / f"{name}.json"
+    shader.write_text(SHADER)
+    session.write_text(json.dumps(SESSION))
+    return shader, session
+
+
+def rrcache(*args, timeout=240):
+    env = dict(os.environ, LP_NUM_THREADS="1", PYTHONUNBUFFERED="1")
+    return subprocess.run([sys.executable, "-m", "rrcache", *map(str, args)], capture_output=True, text=True,
+                          env=env, timeout=timeout)
+
+
+# ---------------------------------------------------------------- scenes
+def test_resolve_scenes(tmp_path):
+    names = [s.name for s in resolve_scenes("marble,trashcan,chess")]
+    assert names == list(PAPER_SCENES)
+    shader, session = write_scene(tmp_path)
+    (scene,) = resolve_scenes(f"{shader}:{session}")
+    assert scene == Scene("noise", str(shader), str(session))
+    with pytest.raises(RRCacheError, match="unknown scene 'marbel'"):
+        resolve_scenes("marbel")
+    with pytest.raises(RRCacheError, match="no such file"):
+        resolve_scenes(f"{tmp_path / 'none.frag'}:{session}")
+    with pytest.raises(RRCacheError, match="twice"):
+        resolve_scenes("chess,chess")
+    with pytest.raises(RRCacheError, match="no scene"):
+        resolve_scenes(" , ")
+
+
+def test_scaled_session_loads_from_elsewhere(tmp_path):
+    source = default_root() / PAPER_SCENES["trashcan"][1]
+    out = scaled_session(source, tmp_path / "deep" / "trashcan.json", (40, 30), 12)
+    doc = json.loads(out.read_text())
+    assert all(os.path.isabs(t["path"]) for t in doc["textures"].values())
+    session = load_session(out)
+    assert tuple(session.resolution) == (40, 30) and session.frames == 12
+    assert set(session.textures) == set(load_session(source).textures)
+    stamp = out.stat().st_mtime_ns
+    time.sleep(0.01)
+    scaled_session(source, out, (40, 30), 12)
+    assert out.stat().st_mtime_ns == stamp  # unchanged content is not rewritten: profiles keyed on it resume
+
+
+# ---------------------------------------------------------------- end to end
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("bench")
+    shader, session = write_scene(folder)
+    proc = rrcache("bench", "--quick", "--scenes", f"{shader}:{session}", "--out", folder / "out", "--json")
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout), folder, shader, session
+
+
+def test_json_shape(quick_run):
+    doc, _, _, _ = quick_run
+    assert doc["quick"] is True and doc["rrcache_bench"] == 1
+    (scene,) = doc["scenes"]
+    assert SCENE_KEYS <= set(scene), SCENE_KEYS - set(scene)
+    assert scene["name"] == "noise" and scene["cacheable_nodes"] >= 2
+    assert scene["static_cost"] > 0 and scene["precompute_s"] > 0 and scene["original_ms"] > 0
+    assert scene["precompute_resumed"] is False
+    assert [s["label"] for s in scene["selections"]] == ["e1", "e2", "e3", "e4"]
+    for sel in scene["selections"]:
+        assert SELECTION_KEYS <= set(sel)
+        assert sel["speedup"] > 0 and sel["mean_error"] >= 0 and 0 < sel["psnr"] <= 100
+        assert (sel["node"] is None) == (sel["period"] is None)
+    if scene["medium"] is not None:  # something is cached at some level
+        assert scene["limit_speedup"] > 0
+        assert [a["method"] for a in scene["algorithms"]] == ["three-pass", "two-pass", "one-pass"]
+        if scene["equal_time"]:
+            methods = [r["method"] for r in scene["equal_time"]]
+            assert methods[0] == "reprojection cache (ours)" and "dynamic resolution" in methods
+            for row in scene["equal_time"]:
+                assert row["speedup"] > 0 and row["mean_error"] >= 0 and 0 < row["psnr"] <= 100
+        else:
+            assert any("no equal-time" in n for n in scene["notes"])
+
+
+def test_files_written(quick_run):
+    doc, folder, _, _ = quick_run
+    out = folder / "out"
+    stored = json.loads((out / "bench.json").read_text())
+    assert stored["scenes"][0]["name"] == doc["scenes"][0]["name"]
+    md = (out / "bench.md").read_text()
+    assert "quick run" in md and "| scene | static cost | cacheable nodes |" in md
+    assert "| e3 |" in md
+    assert (out / "noise.rrprofile" / "profile.json").exists()
+
+
+def test_second_run_resumes_the_profile(quick_run):
+    doc, folder, shader, session = quick_run
+    again = paper.run([Scene("noise", str(shader), str(session))], paper.QUICK, folder / "out")
+    (scene,) = again.scenes
+    assert scene.precompute_resumed
+    assert scene.precompute_s == pytest.approx(doc["scenes"][0]["precompute_s"], rel=1e-6)
+    assert [s.node_id for s in scene.selections] == [s.get("node_id") for s in doc["scenes"][0]["selections"]]
+
+
+def test_interrupted_run_keeps_finished_scenes(tmp_path):
+    first = write_scene(tmp_path, "first")
+    second = write_scene(tmp_path, "second")
+    out = tmp_path / "out"
+    env = dict(os.environ, LP_NUM_THREADS="1", PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, "-m", "rrcache", "bench", "--quick", "--out", str(out), "--scenes",
+                             f"{first[0]}:{first[1]},{second[0]}:{second[1]}"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.time() + 180
+    while not (out / "bench.json").exists() and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()[1]
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    if proc.returncode == 0:
+        pytest.skip("the second scene finished before the interrupt arrived")
+    assert proc.returncode == 130, err
+    assert "interrupted" in err and "Traceback" not in err
+    doc = json.loads((out / "bench.json").read_text())
+    assert [s["name"] for s in doc["scenes"]] == ["first"]
+
+
+def test_bad_scene_is_one_line_exit_2(tmp_path):
+    proc = rrcache("bench", "--quick", "--scenes", "nosuchscene", "--out", tmp_path / "out", timeout=60)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "unknown scene 'nosuchscene'" in lines[0] and "Traceback" not in proc.stderr
+
+
+# ---------------------------------------------------------------- the medium selection
+def _row(label, node):
+    return paper.SelectionRow(label, 0.01, node, node and f"text of {node}", 8 if node else None, 1.5, 0.01, 40.0)
+
+
+def test_medium_is_e3_or_the_nearest_cached():
+    rows = [_row("e1", "n1"), _row("e2", "n2"), _row("e3", "n3"), _row("e4", "n4")]
+    assert paper._choose_medium(rows).label == "e3"
+    rows[2] = _row("e3", None)
+    assert paper._choose_medium(rows).label == "e4"
+    rows[3] = _row("e4", None)
+    assert paper._choose_medium(rows).label == "e2"
+    assert paper._choose_medium([_row(label, None) for label in ("e1", "e2", "e3", "e4")]) is None
+
+
+def test_quick_settings_shrink_chess_further():
+    chess = paper.QUICK.for_scene("chess")
+    marble = paper.QUICK.for_scene("marble")
+    assert chess.resolution[0] * chess.resolution[1] < marble.resolution[0] * marble.resolution[1]
+    assert chess.quick and chess.scene_overrides == {}
