@@ -71,6 +71,11 @@ def tree_fields(cls: type, decl_types: bool = False) -> tuple[str, ...]:
     ``Call.kind``). The ``type`` of a declaration (a ``FullType``: struct names and array sizes
     live there) is followed only with ``decl_types``: the analysis passes share it between
     copies and do not number what is inside; the compiler's rewrites follow it.
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> decl = parse_source("float[2] a;").decls[0]
+    >>> tree_fields(type(decl)), tree_fields(type(decl), decl_types=True)
+    (('declarators',), ('type', 'declarators'))
     """
     key = (cls, decl_types)
     names = _FIELD_CACHE.get(key)

@@ -248,7 +248,8 @@ class _Classifier:
     def __init__(self, shader, cheap_below: int):
         self.shader = shader
         self.cheap_below = cheap_below
-        self.ids = node_ids(shader.unit)
+        # id(expr) -> k of its id "n<k>" (pre-order index)
+        self.order = {id(e): k for k, e in enumerate(iter_exprs(shader.unit))}
         self.state: dict[tuple, tuple] = {}    # var key -> reaching defs
         self.records: list[tuple] = []        # (expr, reason or None, info, ctx, dup_of_def)
         self.intern: dict[tuple, int] = {}
@@ -284,27 +285,35 @@ class _Classifier:
     def finish(self) -> NodeTable:
         nodes: list[CacheableNode] = []
         excluded: list[ExcludedNode] = []
-        order = {k: int(v[1:]) for k, v in self.ids.items()}
+        order = self.order
         self.records.sort(key=lambda r: order[id(r[0])])
+        final, cheap_below = self.final, self.cheap_below
+        type_names: dict = {}
         for e, reason, info, ctx, dup in self.records:
             cost = self.cost(info) if info is not None else 0
-            if reason is None:
-                is_final = e is self.final
-                if not is_final and dup:
+            is_final = e is final
+            if reason is None and not is_final:
+                if dup:
                     reason = "duplicate"
-                elif not is_final and cost < self.cheap_below:
+                elif cost < cheap_below:
                     reason = "cheap"
             loc = e.loc
-            common = dict(id=self.ids[id(e)], line=loc.line if loc else 0,
-                          column=loc.col if loc else 0, text=print_expr(e), node=e)
-            tname = e.type.glsl_name() if e.type is not None else "void"
-            if reason is None:
-                nodes.append(CacheableNode(type=tname, cost=cost,
-                                           call_chain=list(chain_of(loc)),
-                                           final=e is self.final, **common))
+            t = e.type
+            if t is None:
+                tname = "void"
             else:
-                excluded.append(ExcludedNode(reason=reason, type=tname, cost=cost,
-                                             call_chain=list(chain_of(loc)), **common))
+                tname = type_names.get(t)
+                if tname is None:
+                    tname = type_names[t] = t.glsl_name()
+            node_id = f"n{order[id(e)]}"
+            line, column = (loc.line, loc.col) if loc else (0, 0)
+            chain = list(chain_of(loc))
+            if reason is None:
+                nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
+                                           chain, e, is_final))
+            else:
+                excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
+                                             tname, cost, chain))
         return NodeTable(self.shader, nodes, excluded)
 
     def cost(self, info: _Info) -> int:
