@@ -59,13 +59,14 @@ class CachedRenderer:
     ``prepared`` is the original shader prepared by the harness: its declarations name the places
     in error messages when the session lacks a uniform a pass needs. Frames must be rendered in
     order for the cache to mean anything (frame ``i`` reprojects from the last rendered frame);
-    a jump resets the cache (every pixel misses, as after a camera cut).
+    a jump resets the cache (every pixel misses, as after a camera cut). ``window`` (x, y, w, h)
+    renders only that rectangle at full pixel density (see :mod:`rrcache.gl.window`).
     """
 
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
                  period: int = 8, block: int = 4, refresh: str = "random", depth_epsilon: float = 1e-3,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
-                 ctx: Optional[moderngl.Context] = None):
+                 ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None):
         self.ctx = ctx or get_context()
         self.variant = variant
         self.session = session
@@ -91,6 +92,8 @@ class CachedRenderer:
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
                 clear_color=session_background(session))
+            if window is not None:
+                self.runtime.set_window(window)
         except BaseException:
             self._scope.release()
             raise
@@ -299,14 +302,16 @@ class Comparison:
 def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
             resolution: Optional[tuple[int, int]] = None, block: int = 4, refresh: str = "random",
             depth_epsilon: float = 1e-3, hit_maps: bool = False,
-            on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None) -> Comparison:
+            on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
+            window: Optional[tuple[int, int, int, int]] = None) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
-    is called per frame (for progress bars and writing images)."""
+    is called per frame (for progress bars and writing images). ``window``: both render only
+    that rectangle of the frame (errors and times are then the window's)."""
     result = Comparison()
-    with Renderer(prepared, session, resolution) as original, \
+    with Renderer(prepared, session, resolution, window=window) as original, \
             CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
-                           depth_epsilon=depth_epsilon, hit_maps=hit_maps) as cached:
+                           depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:

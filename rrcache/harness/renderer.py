@@ -30,6 +30,7 @@ from rrcache.gl.context import get_context
 from rrcache.gl.limits import check_target_size
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
+from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
 from rrcache.harness.vertex import vertex_source
@@ -85,19 +86,23 @@ class Renderer:
     Back faces are culled for every object the session does not mark ``double_sided`` (pass
     ``cull_back_faces`` to override). Holds GL objects until :meth:`release` (or the end of a
     ``with`` block). ``notes`` lists what
-    the session supplies that the shader does not use.
+    the session supplies that the shader does not use. ``window`` = (x, y, w, h) (pixels, origin
+    bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
+    images and masks are then of the window's size.
 
     >>> with Renderer(prepared, session) as r:                # doctest: +SKIP
     ...     first = r.render_frame(0)
     """
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
-                 cull_back_faces: Optional[bool] = None, ctx: Optional[moderngl.Context] = None):
+                 cull_back_faces: Optional[bool] = None, ctx: Optional[moderngl.Context] = None,
+                 window: Optional[tuple[int, int, int, int]] = None):
         self.ctx = ctx or get_context()
         self.prepared = prepared
         self.session = session
         self.size = tuple(int(v) for v in (resolution or session.resolution))
         self._asked_size = resolution is not None
+        self.window = check_window(window, self.size)
         self.cull_back_faces = cull_back_faces
         self._warm = False
         self._scope = GLScope()
@@ -124,6 +129,7 @@ class Renderer:
         self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
         self._depth = self._scope.own(ctx.depth_texture((w, h)))
         self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
+        self.fbo.scissor = self.window
         # moderngl's Query has no release(); it goes with the Python object
         self._query = ctx.query(samples=True)
 
@@ -159,8 +165,8 @@ class Renderer:
             self._warm = True
         ms, samples = self._draw(index)
         w, h = self.size
-        image = np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4)[::-1].copy()
-        depth = np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w)[::-1]
+        image = crop_rows(np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4), self.window).copy()
+        depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
         mask = depth < 1.0
         return FrameResult(index, image, int(mask.sum()), ms, mask, samples)
 

@@ -30,6 +30,13 @@ one-pass (program ``single``): a dynamic branch in one shader.
 All passes rely on identical vertex processing to reproduce identical depths; the compiler emits
 one vertex shader for all of them.
 
+Window: :meth:`CacheRuntime.set_window` restricts every pass (clears included) to a rectangle
+of the targets with the scissor test, at the targets' full pixel density; read-backs return
+only that rectangle. The profiler measures the error of a cache this way on part of the frame
+at full resolution (the resampling blur of a cache depends on the pixel size, so a smaller
+render would overstate it). Pixels reprojecting from outside the window miss, as at the edge of
+the screen.
+
 Counting: ``FrameStats.misses`` is the number of fragments the miss pass shaded (an occlusion
 query; it includes overdraw among missed fragments), ``covered`` the number of visible pixels
 (the query of the final three-pass pass). Exact per-pixel hit maps come from
@@ -45,6 +52,7 @@ import numpy as np
 
 from rrcache.gl.context import bind_default_framebuffer
 from rrcache.gl.limits import check_target_size
+from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
 from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_offsets
 
@@ -143,6 +151,7 @@ class CacheRuntime:
         self._query = ctx.query(samples=True)
         self._refresh_tex: Optional[moderngl.Texture] = None
         self.size = (0, 0)
+        self.window: Optional[tuple[int, int, int, int]] = None
         self.resize(size)
 
     # ------------------------------------------------------------------ configuration
@@ -205,7 +214,31 @@ class CacheRuntime:
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
         self._make_refresh_texture()
+        if self.window is not None:
+            try:
+                check_window(self.window, self.size)
+            except ValueError:
+                self.window = None
+        self._apply_window()
         self.reset()
+
+    def set_window(self, window: Optional[tuple[int, int, int, int]]) -> None:
+        """Restrict rendering to ``window`` = (x, y, width, height) in pixels of the targets,
+        origin at the bottom left as in GL (None: the whole target). The cache starts empty."""
+        self.window = check_window(window, self.size)
+        self._apply_window()
+        self.reset()
+
+    def _apply_window(self) -> None:
+        # the inverse depth outside the window is never written again: clear it to "nothing
+        # cached" once, over the whole target, so that reprojecting from there misses
+        for fbo in self._clear_fbos:
+            fbo.scissor = None
+            fbo.use()
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        bind_default_framebuffer(self.ctx)
+        for fbo in (*self._cache_fbos, *self._clear_fbos, self._out_fbo, self._color_only_fbo):
+            fbo.scissor = self.window
 
     def bytes_per_pixel(self) -> int:
         """Memory per pixel of the cache's targets (depth, colour, two payloads, two inverse
@@ -330,16 +363,17 @@ class CacheRuntime:
     def _read(self, tex: moderngl.Texture, components: int) -> np.ndarray:
         w, h = self.size
         data = np.frombuffer(tex.read(), dtype=np.float32 if tex.dtype == "f4" else np.float16)
-        return data.reshape(h, w, components)[::-1].astype(np.float32)
+        return crop_rows(data.reshape(h, w, components), self.window).astype(np.float32)
 
     def read_color(self) -> np.ndarray:
-        """The last frame's colour, float32 (height, width, 4), row 0 = top of the image."""
+        """The last frame's colour, float32 (height, width, 4), row 0 = top of the image (only
+        the window when one is set, as every read)."""
         return self._read(self.color, 4)
 
     def read_depth(self) -> np.ndarray:
         """The last frame's window depth (1.0 where nothing was drawn), row 0 = top."""
         w, h = self.size
-        return np.frombuffer(self.depth.read(), dtype=np.float32).reshape(h, w)[::-1].copy()
+        return crop_rows(np.frombuffer(self.depth.read(), dtype=np.float32).reshape(h, w), self.window).copy()
 
     def read_payload(self) -> np.ndarray:
         """The last frame's cache payload, float32 (height, width, 4; unused channels 0), row 0
@@ -356,3 +390,4 @@ class CacheRuntime:
         ``after_first_pass`` diagnostics: after pass 1 it is non-zero exactly at the hits)."""
         index = self._index if current else 1 - self._index
         return self._read(self._invdepth[index], 1)[..., 0]
+
