@@ -1,8 +1,11 @@
 """The profiler through the library, end to end on a tiny scene (an icosphere, 64×48, 12 frames,
 periods 2, 4, 8, a noise-like shader with a dozen cacheable nodes):
 
-- every node is trained costliest first; the error grows with Δn; the fits and μ are stored in
-  profile.json with the schema the CLI and load_profile rely on;
+- every node worth training (static cost >= 10% of the costliest) is trained, the costliest
+  first, the others skipped with the reason; the error grows with Δn; the fits and μ are stored
+  in profile.json with the schema the CLI and load_profile rely on;
+- without an explicit resolution the error runs render a window of the full-resolution frame,
+  chosen once and kept in the store;
 - progress events count up to their plan; the plots are real PNG/SVG files;
 - a tiny budget trains only the costliest node and reports the rest untrained; raising the budget
   resumes and trains the rest, skipping every stored run;
@@ -81,12 +84,19 @@ def trained(tmp_path_factory):
     return prof, events, folder
 
 
-def test_every_node_trained_costliest_first(trained):
+def test_nodes_worth_training_are_trained_costliest_first(trained):
     prof, _, _ = trained
-    assert len(prof.nodes) >= 8 and all(n.trained for n in prof.nodes)
-    costs = [n.cost for n in prof.nodes]
-    assert costs == sorted(costs, reverse=True)
+    top = max(n.cost for n in prof.nodes)
+    worth = [n for n in prof.nodes if n.cost >= 0.1 * top]
+    assert len(worth) >= 8 and all(n.trained for n in worth)
+    assert prof.nodes[0].cost == top
     for node in prof.nodes:
+        if node.cost < 0.1 * top:
+            assert not node.trained and "static cost" in node.note
+    # the trained nodes come first, in the training order; the skipped ones after them
+    flags = [n.trained for n in prof.nodes]
+    assert flags == sorted(flags, reverse=True)
+    for node in worth:
         assert node.periods == [2, 4, 8]
         # caching anything but nothing: the error grows with the refresh period
         assert node.errors[0] < node.errors[1] < node.errors[2], node
@@ -152,11 +162,34 @@ def test_budget_stops_new_nodes_and_resume_finishes(tmp_path):
     assert trained == [first.nodes[0].id]  # the costliest node is always started
     assert first.data["budget_stopped"] and len(first.data["untrained"]) == len(first.nodes) - 1
     assert first.counts["error_runs_computed"] == 3 and first.counts["error_runs_skipped"] == 0
+    assert first.nodes[1].note.startswith("not reached within the training budget")
     second = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False))
-    assert all(n.trained for n in second.nodes)
+    worth = [n for n in second.nodes if n.note is None]
+    assert all(n.trained for n in worth) and len(worth) == len(second.data["nodes"]) - len(second.data["untrained"])
     assert second.counts["error_runs_skipped"] == 3 and second.counts["timing_runs_skipped"] == 2
-    assert second.counts["error_runs_computed"] == 3 * (len(second.nodes) - 1)
+    assert second.counts["error_runs_computed"] == 3 * (len(worth) - 1)
     assert second.nodes[0].alpha == pytest.approx(first.nodes[0].alpha, rel=1e-9)
+
+
+def test_error_runs_in_a_window_at_full_resolution(tmp_path):
+    """No resolution given: the error runs render a quarter-frame window of the 64×48 frame at
+    full pixel density; the plan is stored and a rerun reuses it without measuring again."""
+    shader, session = write_scene(tmp_path)
+    settings = dict(SETTINGS, resolution=None)
+    first = profile(shader, session, tmp_path / "out", TrainingSettings(**settings, validate=False, budget_s=1e-6))
+    window = first.data["plan"]["error_window"]
+    assert window is not None and window[2:] == [32, 24], window
+    assert first.data["plan"]["timing_window"] is None  # a cheap shader is timed on whole frames
+    store = read_store(tmp_path / "out" / "profile.sqlite")
+    try:
+        assert store.plan() == first.data["plan"]
+        runs = store.error_runs(first.nodes[0].id)
+        # every covered pixel counted lies in the window
+        assert runs and all(r.covered <= 32 * 24 * (r.frames - 1) for r in runs)
+    finally:
+        store.close()
+    again = profile(shader, session, tmp_path / "out", TrainingSettings(**settings, validate=False, budget_s=1e-6))
+    assert again.data["plan"] == first.data["plan"] and again.counts["error_runs_computed"] == 0
 
 
 def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):

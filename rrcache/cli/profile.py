@@ -49,31 +49,40 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--out", "out_dir", type=click.Path(), default=None,
               help="Profile folder (default: <shader>-<session>.rrprofile here).")
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH",
-              help="Resolution of the error runs: the error is measured at this size (default: the session's divided by 4).")
+              help="Render the error runs at this reduced size instead (default: the session's, in a window; "
+                   "a smaller size overstates the error).")
+@click.option("--error-window", type=click.FloatRange(min=0, max=1, min_open=True), default=None,
+              help="Share of the frame the error runs render at full resolution (default: chosen from the "
+                   "original's cost, at most 0.25; 1: the whole frame).")
 @click.option("--frames", type=click.IntRange(min=2), default=None,
-              help="Train the error on the first N frames (default: all).")
+              help="Train the error on the first N frames (default: 64, or all of a shorter session).")
 @click.option("--periods", callback=_periods, default=None, metavar="LIST",
               help=f"Training refresh periods (default: {','.join(map(str, DEFAULT_PERIODS))}).")
-@click.option("--timing-frames", type=click.IntRange(min=1), default=12, show_default=True,
-              help="Frames L timed per node and timing period, at full resolution.")
+@click.option("--timing-frames", type=click.IntRange(min=1), default=None,
+              help=f"Frames L timed per node and timing period, at full resolution (default: {TrainingSettings.timing_frames}).")
 @click.option("--timing-periods", callback=_periods, default=None, metavar="LIST",
               help="Refresh periods at which each node is timed (default: 2,8,50).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
-@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=480.0, show_default=True,
-              help="Seconds of node training; no new node is started once spent.")
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None,
+              help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
+@click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
+              help=f"Skip nodes whose static cost is below this share of the costliest node's "
+                   f"(default: {TrainingSettings.min_saving:g}).")
 @click.option("--validation-frames", type=click.IntRange(min=2), default=None,
               help="Render each selection over the first N frames (default: all).")
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
-def command(shader, session, out_dir, resolution, frames, periods, timing_frames, timing_periods, algorithm,
-            budget, validation_frames, no_validate, fresh, defines):
-    """Train error and performance models of every cacheable node of SHADER over SESSION, select
+def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines):
+    """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
-    kwargs = dict(resolution=resolution, frames=frames, timing_frames=timing_frames, algorithm=algorithm,
-                  budget_s=budget, validate=not no_validate,
-                  validation_frames=validation_frames)
+    kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
+                  validate=not no_validate, validation_frames=validation_frames)
+    for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving)):
+        if value is not None:
+            kwargs[name] = value
     if periods is not None:
         kwargs["periods"] = periods
     if timing_periods is not None:

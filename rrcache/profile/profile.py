@@ -44,7 +44,7 @@ class NodeProfile:
     """One cacheable node in a profile: where it is, its static cost, and (when ``trained``) its
     fitted models: error α, λ (``lam``) with their fit quality and R², per-pixel times t_hit,
     t_miss (ms) with the performance fit's quality, and the measured error runs (``periods``,
-    ``errors``, ``hit_rates``, ``psnrs``)."""
+    ``errors``, ``hit_rates``, ``psnrs``); ``note`` says why an untrained node was not trained."""
 
     id: str
     type: str
@@ -67,6 +67,7 @@ class NodeProfile:
     psnrs: list = field(default_factory=list)
     error_fit: dict = field(default_factory=dict)
     perf_fit: dict = field(default_factory=dict)
+    note: Optional[str] = None
 
 
 @dataclass
@@ -336,7 +337,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     for nid in result.order:
         entry = by_id[nid]
         node = NodeProfile(nid, entry.type, entry.line, entry.column, entry.text, list(entry.call_chain),
-                           int(entry.cost), trained=nid in result.trained)
+                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid))
         runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
         node.periods = [r.period for r in runs]
         node.errors = [r.mean_error for r in runs]
@@ -362,6 +363,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         "trained": len(result.trained),
         "untrained": list(result.untrained),
         "budget_stopped": result.budget_stopped,
+        "plan": result.plan.to_json() if result.plan is not None else None,
         "mu": float(hit.mu) if hit is not None else None,
         "mu_quality": str(hit.quality) if hit is not None else None,
         "hit_fit": _fit_json(hit),
@@ -376,7 +378,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     if result.trained and settings.validate:
         from rrcache.profile.validate import validate
 
-        rows = validate(work, session, settings, store, prof.table, progress)
+        rows = validate(work, session, settings, store, prof.table, progress,
+                        window=result.plan.timing_window if result.plan is not None else None)
         texts = {n.id: n.text for n in nodes}
         prof.selections = [SelectionReport(r.label, r.max_error, r.node, r.period, texts.get(r.node),
                                            r.predicted_error, r.predicted_ms, r.predicted_speedup, r.measured_error,

@@ -7,8 +7,12 @@ refresh pattern, depth epsilon, validation frames) are hashed into the key of th
 ``budget_s`` and ``validate`` only decide how much is done, so they are left out of the key and
 may change between a run and its resumption.
 
-The error is measured at the *training* resolution (default: the session's divided by 4, at
-least 8×8), over consecutive frames; the times are measured at the session's full resolution.
+The error is measured over the first ``frames`` consecutive frames (default 64: the steady state
+of the largest paper period, 50, plus 14 frames) at the session's full resolution, inside a
+window of the frame chosen from the original's cost (:mod:`rrcache.profile.plan`), or at an
+explicit reduced ``resolution`` (errors are then larger: the resampling blur grows with the
+pixel size). The times are measured on ``timing_frames`` frames at the session's full
+resolution.
 
 >>> s = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), frames=12)
 >>> s.periods, s.to_json()["resolution"]
@@ -36,8 +40,10 @@ DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
 #: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
 DEFAULT_TIMING_PERIODS = (2, 8, 50)
 BLOCK_SIZES = (1, 2, 4, 8)
+#: consecutive frames of the error runs when the session has that many
+DEFAULT_TRAINING_FRAMES = 64
 #: the fields that do not change a measurement (left out of the store key)
-UNKEYED = ("budget_s", "validate")
+UNKEYED = ("budget_s", "validate", "min_saving")
 
 
 def _fail(field_name: str, message: str, hint: str) -> RRCacheError:
@@ -66,28 +72,36 @@ class TrainingSettings:
     """What a profile measures (see the module docstring).
 
     - ``periods``: the refresh periods Δn of the error runs.
-    - ``resolution``: (w, h) of the error runs; None: the session's divided by 4.
-    - ``frames``: the first N consecutive session frames of the error runs; None: all.
+    - ``resolution``: (w, h) of the error runs; None: the session's, rendered in a window.
+    - ``error_window``: the share of the frame's area the error runs render (1: all of it);
+      None: chosen from the original's cost (:mod:`rrcache.profile.plan`). Only at the
+      session's resolution.
+    - ``frames``: the first N consecutive session frames of the error runs; None: 64 (or all,
+      when the session is shorter).
     - ``timing_frames``: L, the frames timed per node and timing period (spread evenly).
     - ``timing_periods``: the periods at which each node is timed.
     - ``algorithm``, ``block``, ``refresh``, ``depth_epsilon``: the cache's own settings.
     - ``validation_frames``: consecutive frames of each validation render; None: all.
     - ``budget_s``: node training starts no new node once this many seconds are spent.
     - ``validate``: render the four selections against the original after training.
+    - ``min_saving``: nodes whose static cost is below this share of the costliest node's are
+      not trained (:mod:`rrcache.profile.order`).
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
     resolution: Optional[tuple[int, int]] = None
+    error_window: Optional[float] = None
     frames: Optional[int] = None
-    timing_frames: int = 12
+    timing_frames: int = 8
     timing_periods: tuple[int, ...] = DEFAULT_TIMING_PERIODS
     algorithm: str = "three-pass"
     block: int = 4
     refresh: str = "random"
     depth_epsilon: float = 1e-3
     validation_frames: Optional[int] = None
-    budget_s: float = 480.0
+    budget_s: float = 360.0
     validate: bool = True
+    min_saving: float = 0.1
 
     def __post_init__(self):
         hint = "give whole numbers from 1 to 1000, e.g. 2,10,18,26,34,42,50"
@@ -116,6 +130,16 @@ class TrainingSettings:
         if not (isinstance(self.depth_epsilon, (int, float)) and 0 < self.depth_epsilon < 1):
             raise _fail("depth_epsilon", f"{self.depth_epsilon!r} is not in (0, 1)", "the default is 0.001")
         object.__setattr__(self, "depth_epsilon", float(self.depth_epsilon))
+        if self.error_window is not None:
+            if isinstance(self.error_window, bool) or not isinstance(self.error_window, (int, float)) \
+                    or not 0 < self.error_window <= 1:
+                raise _fail("error_window", f"{self.error_window!r} is not a share of the frame in (0, 1]",
+                            "e.g. 0.25 for a quarter of the frame, 1 for all of it")
+            object.__setattr__(self, "error_window", float(self.error_window))
+        if isinstance(self.min_saving, bool) or not isinstance(self.min_saving, (int, float)) \
+                or not 0 <= self.min_saving < 1:
+            raise _fail("min_saving", f"{self.min_saving!r} is not a share in [0, 1)", "the default is 0.1")
+        object.__setattr__(self, "min_saving", float(self.min_saving))
         if not isinstance(self.budget_s, (int, float)) or not self.budget_s > 0:
             raise _fail("budget_s", f"{self.budget_s!r} is not a positive number of seconds", "e.g. 480")
         object.__setattr__(self, "budget_s", float(self.budget_s))
@@ -156,14 +180,13 @@ class TrainingSettings:
         >>> from types import SimpleNamespace
         >>> s = TrainingSettings(periods=(2, 4)).resolved(SimpleNamespace(resolution=(640, 480), frames=30, path="s.json"))
         >>> s.resolution, s.frames, s.validation_frames
-        ((160, 120), 30, 30)
+        ((640, 480), 30, 30)
         """
         where = str(getattr(session, "path", "session"))
         resolution = self.resolution
         if resolution is None:
-            w, h = session.resolution
-            resolution = (max(8, int(w) // 4), max(8, int(h) // 4))
-        frames = self.frames if self.frames is not None else int(session.frames)
+            resolution = tuple(int(v) for v in session.resolution)
+        frames = self.frames if self.frames is not None else min(DEFAULT_TRAINING_FRAMES, int(session.frames))
         if frames > session.frames:
             raise RRCacheError(f"asked for {frames} training frames; the session has {session.frames}", where,
                                hint=f"use --frames {session.frames} or fewer")

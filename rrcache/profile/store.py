@@ -32,7 +32,9 @@ SCHEMA = """\
 -- rrcache profile store; the schema version is in meta('schema_version').
 --
 -- meta: what the file belongs to. Keys: schema_version, rrcache_version, shader_hash,
---   session_hash, settings_json, settings_hash, created, updated (unix seconds).
+--   session_hash, settings_json, settings_hash, created, updated (unix seconds); and, once the
+--   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profile.plan),
+--   kept so that a resumed run renders exactly what the first one did.
 CREATE TABLE meta (
     key TEXT PRIMARY KEY,
     value TEXT NOT NULL
@@ -449,6 +451,23 @@ class ProfileStore:
     # ------------------------------------------------------------------ readers
     def meta(self) -> dict:
         return dict(self.conn.execute("SELECT key, value FROM meta"))
+
+    def plan(self) -> Optional[dict]:
+        """The windows the first run chose (``rrcache.profile.plan.Plan.to_json``), or None."""
+        row = self.conn.execute("SELECT value FROM meta WHERE key = 'plan'").fetchone()
+        if row is None:
+            return None
+        try:
+            data = json.loads(row[0])
+        except ValueError:
+            raise _refuse(self.path, "the stored training plan is not JSON", _FRESH_HINT) from None
+        if not isinstance(data, dict):
+            raise _refuse(self.path, "the stored training plan is not a JSON object", _FRESH_HINT)
+        return data
+
+    def set_plan(self, plan: dict) -> None:
+        """Keep the windows chosen for this store (once; later runs read :meth:`plan`)."""
+        self._write([("INSERT OR REPLACE INTO meta(key, value) VALUES ('plan', ?)", (json.dumps(plan),))])
 
     def has_error_run(self, node: str, period: int) -> bool:
         return self.conn.execute("SELECT 1 FROM error_run WHERE node = ? AND period = ?",

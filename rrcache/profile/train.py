@@ -3,14 +3,17 @@
 :func:`train` fills a :class:`~rrcache.profile.store.ProfileStore`, skipping whatever it already
 holds, and fits the models from what is stored:
 
-1. **Reference frames.** The original shader over the training frames at the training
-   resolution, rendered once and kept in memory for the run.
-2. **Error runs.** Nodes are trained costliest first (static cost: the "smart order"). Per node
-   one :class:`~rrcache.harness.cached.CachedRenderer` at the training resolution serves every
-   period (``.period = Δn; .reset()``): the training frames are rendered in order from an empty
-   cache and each frame's mean RGB L2 error over covered pixels, PSNR, hits and misses recorded.
-   A run's error is the mean over the frames after the first (which has no cache); so the error
-   is measured at the *training* resolution.
+0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profile.order`
+   (too-cheap nodes skipped, the rest diversity first). The original is timed at full resolution
+   on the timing frames, and from that time the windows of :mod:`rrcache.profile.plan` are
+   chosen (once; kept in the store).
+1. **Reference frames.** The original shader over the training frames inside the error window
+   (full pixel density), rendered once and kept in memory for the run.
+2. **Error runs.** Per node one :class:`~rrcache.harness.cached.CachedRenderer` inside the same
+   window serves every period (``.period = Δn; .reset()``): the training frames are rendered in
+   order from an empty cache and each frame's mean RGB L2 error over covered pixels, PSNR, hits
+   and misses recorded. A run's error is the mean over the frames after the first (which has no
+   cache).
 3. **Timing.** At the session's full resolution the original is timed once on the L timing frames
    (spread evenly over the session), then every node at each timing period: per timing frame f
    the original renders f, then the variant renders f − 1 untimed (an empty cache filled once)
@@ -21,8 +24,9 @@ holds, and fits the models from what is stored:
    trained node's variant rendered at 8×8 (geometry still processed, every pass issued), median
    over the timing frames. DESIGN §3: with constant coverage h + m is nearly constant and the
    hit/miss/overhead system is rank-deficient, so the overhead is measured, not solved for.
-5. **Fits** through :mod:`rrcache.model`: α, λ per node, μ over every node's hit rates, t_hit
-   and t_miss per node given the overhead.
+5. **Fits** through :mod:`rrcache.model`: α, λ per node; μ over every node's hit rates in the
+   timing runs (whole frames: the error window's edges miss more than a frame's, as pixels
+   reproject from outside it); t_hit and t_miss per node given the overhead.
 
 The budget (``settings.budget_s``) counts the seconds of every stored run, earlier invocations
 included: once spent, no new node is started (a started node is finished); the nodes never
@@ -48,6 +52,9 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
+from rrcache.profile.order import TrainingOrder, cost_filter, diversity_order, per_frame_uniforms, signature
+from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, TIMING_TARGET_MS, Plan, coverage_map,
+                                  fraction_for, place_window)
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
 
@@ -92,8 +99,9 @@ class _Meter:
 
 @dataclass
 class TrainingResult:
-    """What training produced: ``order`` (every node id, costliest first), ``trained`` (ids with
-    every error and timing run stored), ``untrained`` (the rest), the fits (``error_fits`` and
+    """What training produced: ``order`` (every node id: the training order, then the skipped
+    nodes), ``trained`` (ids with every error and timing run stored), ``untrained`` (the rest),
+    ``notes`` (id → why an untrained node was not trained), ``plan`` (the windows), the fits (``error_fits`` and
     ``perf_fits`` by node id, ``hit_fit``), ``overhead_ms``, ``original_ms`` (median original
     frame time at full resolution), ``pixels`` (mean covered pixels M at full resolution),
     ``counts`` (runs computed and skipped by this invocation), ``wall_s`` (this invocation) and
@@ -112,12 +120,39 @@ class TrainingResult:
     wall_s: float = 0.0
     spent_s: float = 0.0
     budget_stopped: bool = False
+    notes: dict = field(default_factory=dict)
+    plan: Optional[Plan] = None
 
 
-def training_order(work: ShaderWork) -> list:
-    """The cacheable nodes, costliest first (ties: in the table's order)."""
-    nodes = list(work.table.nodes)
-    return [n for _, n in sorted(enumerate(nodes), key=lambda item: (-item[1].cost, item[0]))]
+def training_order(work: ShaderWork, session, settings: TrainingSettings, variants: Optional[dict] = None) -> TrainingOrder:
+    """The nodes to train in order, and the skipped ones with their reasons
+    (:mod:`rrcache.profile.order`). Compiles each candidate's variant to read what its payload
+    depends on; ``variants`` (id → variant) receives them for reuse."""
+    nodes = [n for _, n in sorted(enumerate(work.table.nodes), key=lambda item: (-item[1].cost, item[0]))]
+    keep, skipped = cost_filter(nodes, settings.min_saving)
+    changing = per_frame_uniforms(session)
+    signatures = {}
+    for node in keep:
+        variant = variant_for(work, node.id, settings.timing_periods[0], settings.algorithm)
+        if variants is not None:
+            variants[node.id] = variant
+        signatures[node.id] = signature(variant, changing)
+    return TrainingOrder(diversity_order(keep, signatures), skipped, signatures)
+
+
+def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames: list[int]) -> Plan:
+    """Choose the error and timing windows (:mod:`rrcache.profile.plan`) for a shader whose
+    full frame costs ``original_ms``, placed over the coverage of ``frames``."""
+    full = tuple(int(v) for v in session.resolution)
+    at_full = tuple(settings.resolution) == full
+    error_fraction = settings.error_window if settings.error_window is not None else \
+        fraction_for(original_ms, ERROR_TARGET_MS, MAX_ERROR_FRACTION)
+    timing_fraction = 1.0 if original_ms <= TIMING_TARGET_MS else fraction_for(original_ms, TIMING_TARGET_MS, 1.0)
+    need = (at_full and error_fraction < 1.0) or timing_fraction < 1.0
+    coverage = coverage_map(work.prepared, session, frames[::max(1, len(frames) // 16)], Renderer) if need else None
+    error_window = place_window(coverage, full, error_fraction) if at_full and error_fraction < 1.0 else None
+    timing_window = place_window(coverage, full, timing_fraction) if timing_fraction < 1.0 else None
+    return Plan(error_window, timing_window, float(original_ms))
 
 
 def timing_frame_indices(session_frames: int, count: int) -> list[int]:
@@ -184,11 +219,12 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     ``settings`` (:meth:`TrainingSettings.resolved`), then fit the models (see the module
     docstring). Returns a :class:`TrainingResult`."""
     start = clock()
-    order = training_order(work)
-    if not order:
+    if not work.table.nodes:
         raise RRCacheError("the shader has no cacheable node to train", str(work.shader.path or "<shader>"),
                            hint="'rrcache nodes SHADER --all' lists the values left out and why")
-    ids = [n.id for n in order]
+    variants: dict = {}
+    order = training_order(work, session, settings, variants)
+    ids = [n.id for n in order.nodes]
     train_frames = list(range(settings.frames))
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     full = tuple(int(v) for v in session.resolution)
@@ -202,22 +238,16 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     need_refs = any(todo_error.values())
     need_ref_timing = not store.reference_timing()
     need_overhead = store.overhead() is None
-    plan = ((len(train_frames) if need_refs else 0) + (len(timing) if need_ref_timing else 0)
-            + sum(len(v) * len(train_frames) for v in todo_error.values())
-            + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
-            + (len(timing) if need_overhead else 0))
-    meter = _Meter(progress, plan)
+    plan_total = ((len(train_frames) if need_refs else 0) + (len(timing) if need_ref_timing else 0)
+                  + sum(len(v) * len(train_frames) for v in todo_error.values())
+                  + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
+                  + (len(timing) if need_overhead else 0))
+    meter = _Meter(progress, plan_total)
     budget_stopped = False
-
-    refs = []
-    if need_refs:
-        with Renderer(work.prepared, session, settings.resolution) as renderer:
-            for index in train_frames:
-                refs.append(renderer.render_frame(index))
-                meter.step("reference", f"frame {index}")
-        store.add_reference({r.index: r.covered_pixels for r in refs})
+    notes = dict(order.skipped)
 
     original: Optional[Renderer] = None
+    timed_original: Optional[Renderer] = None
     try:
         original = Renderer(work.prepared, session, full)
         if need_ref_timing:
@@ -227,8 +257,27 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 rows.append((index, got.ms, got.covered_pixels))
                 meter.step("reference", f"timing frame {index}")
             store.add_reference_timing(rows)
+        stored_plan = store.plan()
+        if stored_plan is None:
+            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()),
+                             train_frames)
+            store.set_plan(plan.to_json())
+        else:
+            plan = Plan.from_json(stored_plan)
+        if plan.timing_window is not None:
+            original.release()
+            original = Renderer(work.prepared, session, full, window=plan.timing_window)
+        timed_original = original
 
-        for node in order:
+        refs = []
+        if need_refs:
+            with Renderer(work.prepared, session, settings.resolution, window=plan.error_window) as renderer:
+                for index in train_frames:
+                    refs.append(renderer.render_frame(index))
+                    meter.step("reference", f"frame {index}")
+            store.add_reference({r.index: r.covered_pixels for r in refs})
+
+        for node in order.nodes:
             nid = node.id
             if not todo_error[nid] and not todo_timing[nid]:
                 continue
@@ -236,12 +285,12 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 budget_stopped = True
                 meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
                 continue
-            variant = variant_for(work, nid, settings.timing_periods[0], settings.algorithm)
+            variant = variants.get(nid) or variant_for(work, nid, settings.timing_periods[0], settings.algorithm)
             if todo_error[nid]:
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, settings.resolution, period=settings.periods[0],
                                     block=settings.block, refresh=settings.refresh,
-                                    depth_epsilon=settings.depth_epsilon) as cached:
+                                    depth_epsilon=settings.depth_epsilon, window=plan.error_window) as cached:
                     compile_s = clock() - built
                     for period in todo_error[nid]:
                         run, frames = _error_run(cached, nid, period, refs, meter)
@@ -252,11 +301,11 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, full, period=settings.timing_periods[0],
                                     block=settings.block, refresh=settings.refresh,
-                                    depth_epsilon=settings.depth_epsilon) as cached:
+                                    depth_epsilon=settings.depth_epsilon, window=plan.timing_window) as cached:
                     compile_s = clock() - built
                     for period in todo_timing[nid]:
                         t0 = clock()
-                        frames = _timing_run(cached, original, nid, period, timing, meter)
+                        frames = _timing_run(cached, timed_original, nid, period, timing, meter)
                         store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
                         compile_s = 0.0
     finally:
@@ -264,11 +313,16 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             original.release()
 
     trained = [i for i in ids if _node_complete(store, i, settings)]
+    for i in ids:
+        if i not in trained:
+            notes[i] = "not reached within the training budget (--budget)"
     if trained and need_overhead:
-        _measure_overhead(work, session, settings, store, trained[0], timing, meter)
+        _measure_overhead(work, session, settings, store, trained[0], timing, meter, variants.get(trained[0]))
 
-    result = TrainingResult(order=ids, trained=trained, untrained=[i for i in ids if i not in trained],
-                            budget_stopped=budget_stopped)
+    skipped_ids = [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
+    result = TrainingResult(order=ids + skipped_ids, trained=trained,
+                            untrained=[i for i in ids + skipped_ids if i not in trained],
+                            budget_stopped=budget_stopped, notes=notes, plan=plan)
     fit_models(store, settings, result)
     result.counts = store.counts()
     result.wall_s = clock() - start
@@ -276,8 +330,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     return result
 
 
-def _measure_overhead(work, session, settings, store, node_id, timing, meter) -> None:
-    variant = variant_for(work, node_id, settings.timing_periods[-1], settings.algorithm)
+def _measure_overhead(work, session, settings, store, node_id, timing, meter, variant=None) -> None:
+    variant = variant or variant_for(work, node_id, settings.timing_periods[-1], settings.algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
                         block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon) as cached:
@@ -300,12 +354,12 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
     if ref_timing:
         result.pixels = float(np.mean([c for _, _, c in ref_timing]))
     originals = [ms for _, ms, _ in ref_timing]
+    # timed in a window, the original's timing-run times are the window's, not a frame's
+    windowed = result.plan is not None and result.plan.timing_window is not None
     periods, rates = [], []
     for nid in result.trained:
         runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
         result.error_fits[nid] = fit_error([r.period for r in runs], [r.mean_error for r in runs])
-        periods += [r.period for r in runs]
-        rates += [r.hit_rate for r in runs]
         hits, misses, times = [], [], []
         for period, frames in sorted(store.timing_frames(nid).items()):
             if period not in settings.timing_periods:
@@ -314,7 +368,12 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
                 hits.append(f.hits)
                 misses.append(f.misses)
                 times.append(f.ms)
-                originals.append(f.original_ms)
+                if not windowed:
+                    originals.append(f.original_ms)
+            counted = sum(f.hits + f.misses for f in frames)
+            if counted:
+                periods.append(period)
+                rates.append(sum(f.hits for f in frames) / counted)
         result.perf_fits[nid] = fit_performance(hits, misses, times,
                                                 overhead_ms=result.overhead_ms if overhead else None)
     if periods:

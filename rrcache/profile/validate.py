@@ -5,7 +5,8 @@ After training, :func:`validate` takes four error thresholds from the models
 selection with :func:`rrcache.harness.cached.compare` side by side with the original at the
 session's full resolution over ``settings.validation_frames`` consecutive frames (alternating
 per frame), and stores the measured error, PSNR, hit rate and speed-up beside the prediction
-(main paper §4.4, Fig. 6). A selection of the original shader (node ``None``) is not rendered:
+(main paper §4.4, Fig. 6). Shaders timed in a window (:mod:`rrcache.profile.plan`: a full frame
+costs more than 150 ms) are validated in the same window. A selection of the original shader (node ``None``) is not rendered:
 its error is 0 and its speed-up 1. A (node, period) already measured in the store is not rendered again.
 
 >>> rows = validate(work, session, settings, store, table)     # doctest: +SKIP
@@ -26,9 +27,9 @@ LABELS = ("e1", "e2", "e3", "e4")
 
 
 def validate(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore, table,
-             progress: Optional[ProgressFn] = None) -> list[ValidationRow]:
+             progress: Optional[ProgressFn] = None, window=None) -> list[ValidationRow]:
     """Select at four thresholds of ``table`` (a ``rrcache.model.ModelTable``), measure each
-    selection, store and return the rows (in label order)."""
+    selection (inside ``window`` when given), store and return the rows (in label order)."""
     from rrcache.model import select, thresholds
 
     levels = [float(t) for t in thresholds(table, len(LABELS))]
@@ -63,7 +64,7 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
 
                 result = compare(variant, session, work.prepared, frames, period=int(choice.period),
                                  block=settings.block, refresh=settings.refresh,
-                                 depth_epsilon=settings.depth_epsilon, on_frame=step)
+                                 depth_epsilon=settings.depth_epsilon, on_frame=step, window=window)
                 measured[key] = (result.mean_error, min(result.psnr, PSNR_CAP), result.ms_per_frame,
                                  result.original_ms_per_frame, result.speedup, result.hit_rate, len(result.frames))
             row = ValidationRow(label, level, choice.node, int(choice.period), float(choice.predicted_error),

@@ -1,0 +1,124 @@
+"""The order of training: which cacheable nodes are worth measuring, and in which order.
+
+Brute force (every node, costliest first) spends the budget on near-copies of the costliest
+node: in Marble the 20 costliest of 492 nodes are all "the whole noise and a few operations
+after it", so the paper's progression (an octave or a partial sum at low thresholds, the whole
+noise, the final colour) never gets measured. Two rules replace it:
+
+1. **Too cheap to win.** A node whose static cost (:mod:`rrcache.analysis.cost`) is below
+   ``min_saving`` of the shader's costliest node is not trained: caching it saves at most that
+   share of the shading, while the cache's own passes cost more than that on every scene we
+   measured (with every pixel hitting, the cached pipeline of Marble's final colour still costs
+   27–30% of the original). Such nodes are reported as untrained with this reason.
+2. **Diversity first.** The remaining nodes are grouped by what their value depends on that
+   can change between frames: the varyings their payload pass reads and the per-frame uniforms
+   (camera, light, time, keyframed session uniforms). Nodes with the same inputs differ in error
+   mostly through how much of the computation they hold, so within a group the order is
+   farthest-point over the static cost (the costliest first, then the node whose cost is
+   farthest from every node already ordered); across groups it is round-robin, costliest group
+   first. So lighting-dependent nodes (the final colour, albedo × diffuse) and the pure noise
+   chain (whole noise, partial sums, octaves) are all reached early, and near-duplicates late.
+
+>>> from types import SimpleNamespace as N
+>>> nodes = [N(id=f"n{c}", cost=c) for c in (100, 98, 60, 30, 5)]
+>>> [n.id for n in diversity_order(nodes, {n.id: "a" for n in nodes})]
+['n100', 'n5', 'n60', 'n30', 'n98']
+>>> [n.id for n in diversity_order(nodes, {"n100": "b", "n98": "a", "n60": "a", "n30": "a", "n5": "a"})]
+['n100', 'n98', 'n5', 'n60', 'n30']
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+#: nodes saving less than this share of the costliest node's static cost are not trained
+DEFAULT_MIN_SAVING = 0.1
+#: glslViewer built-in uniforms that change from frame to frame when the scene moves
+_PER_FRAME_BUILTINS = ("u_camera", "u_light", "u_lightColor", "u_time", "u_frame", "u_viewMatrix",
+                       "u_projectionMatrix")
+_INPUT = re.compile(r"^\s*(?:(?:flat|smooth|noperspective|centroid|invariant)\s+)*in\s+\w+\s+(\w+)\s*;", re.M)
+
+
+@dataclass
+class TrainingOrder:
+    """``nodes``: the table entries to train, in order; ``skipped``: node id → the reason it is
+    not trained; ``signatures``: node id → the inputs its value depends on (sorted names)."""
+
+    nodes: list
+    skipped: dict = field(default_factory=dict)
+    signatures: dict = field(default_factory=dict)
+
+
+def cost_filter(nodes, min_saving: float) -> tuple[list, dict]:
+    """(nodes worth training, {id: reason} for the others); see rule 1 of the module docstring."""
+    if not nodes:
+        return [], {}
+    top = max(n.cost for n in nodes)
+    keep, skipped = [], {}
+    for n in nodes:
+        if n.cost >= min_saving * top:
+            keep.append(n)
+        else:
+            skipped[n.id] = f"saves {n.cost / top:.0%} of the shader's static cost (< {min_saving:.0%})"
+    return keep, skipped
+
+
+def per_frame_uniforms(session) -> set[str]:
+    """The uniforms whose value can differ between frames of ``session``: the per-frame
+    built-ins and every keyframed session uniform."""
+    names = set(_PER_FRAME_BUILTINS)
+    frames = int(getattr(session, "frames", 1))
+    if frames > 1:
+        first, last = session.uniform_values(0), session.uniform_values(frames - 1)
+        middle = session.uniform_values(frames // 2)
+        for name, value in first.items():
+            try:
+                same = all(_equal(value, other.get(name)) for other in (middle, last))
+            except (TypeError, ValueError):
+                same = False
+            if not same:
+                names.add(name)
+    return names
+
+
+def _equal(a, b) -> bool:
+    import numpy as np
+
+    return b is not None and np.array_equal(np.asarray(a), np.asarray(b))
+
+
+def signature(variant, changing: set[str]) -> str:
+    """The inputs the cached value of ``variant`` depends on: the varyings its payload pass
+    reads and the per-frame uniforms among its uniforms, as one sorted string."""
+    name = "payload" if "payload" in variant.passes else next(iter(variant.passes))
+    inputs = set(_INPUT.findall(variant.passes[name].fragment))
+    uniforms = {u for u in variant.uniforms.get(name, []) if u in changing}
+    return " ".join(sorted(inputs | uniforms))
+
+
+def diversity_order(nodes, signatures: dict) -> list:
+    """Round-robin over the signature groups (costliest group first), farthest-point over the
+    static cost within a group (rule 2 of the module docstring). Deterministic."""
+    groups: dict[str, list] = {}
+    for n in sorted(nodes, key=lambda n: -n.cost):
+        groups.setdefault(signatures.get(n.id, ""), []).append(n)
+    queues = [_farthest_first(members) for members in groups.values()]
+    queues.sort(key=lambda q: -q[0].cost)
+    out = []
+    while any(queues):
+        for q in queues:
+            if q:
+                out.append(q.pop(0))
+    return out
+
+
+def _farthest_first(members: list) -> list:
+    """``members`` (costliest first) reordered: the costliest, then repeatedly the node whose
+    cost is farthest from every chosen node's (ties: the costlier)."""
+    remaining = list(members)
+    chosen = [remaining.pop(0)]
+    while remaining:
+        best = max(range(len(remaining)),
+                   key=lambda i: (min(abs(remaining[i].cost - c.cost) for c in chosen), remaining[i].cost, -i))
+        chosen.append(remaining.pop(best))
+    return chosen
