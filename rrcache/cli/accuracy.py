@@ -1,0 +1,70 @@
+"""``rrcache accuracy PROFILE``: the models against measurements at held-out refresh periods.
+
+    rrcache accuracy marble-marble.rrprofile
+    rrcache accuracy marble-marble.rrprofile --periods 6,14,30 --nodes n2392,n958 --json
+
+Measures the nodes that matter (the predicted Pareto front and the four selections, or
+``--nodes``) at periods training did not use, as training measures, and prints predicted against
+measured error and frame time per point, the mean relative error of the predicted frame time and
+the error model's R² over the held-out points (``--json``: the whole report).
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import click
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from rrcache.profile.accuracy import DEFAULT_PERIODS, held_out
+from rrcache.profile.profile import load_profile
+from rrcache.profile.settings import parse_periods
+
+
+def _clean(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_clean(v) for v in value]
+    return value
+
+
+@click.command("accuracy")
+@click.argument("profile_path", metavar="PROFILE", type=click.Path())
+@click.option("--periods", default=",".join(map(str, DEFAULT_PERIODS)), show_default=True,
+              help="Held-out refresh periods, comma-separated.")
+@click.option("--nodes", default=None, help="Node ids to measure (default: the Pareto front and the selections).")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
+def command(profile_path, periods, nodes, as_json):
+    """Check the profile's models at refresh periods they were not trained on."""
+    prof = load_profile(profile_path)
+    chosen = [n.strip() for n in nodes.split(",") if n.strip()] if nodes else None
+    err_console = Console(stderr=True)
+    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                  TimeRemainingColumn(), console=err_console, transient=True) as bar:
+        task = bar.add_task("measuring", total=None)
+
+        def progress(event):
+            bar.update(task, completed=event.done, total=event.total, description=f"{event.stage} {event.detail}")
+
+        report = held_out(prof, parse_periods(periods, "--periods"), chosen, progress)
+    if as_json:
+        click.echo(json.dumps(_clean(report.to_json()), indent=2))
+        return
+    table = Table(title=f"held-out periods {report.periods} ({report.chosen_by})")
+    for col in ("node", "Δn", "predicted error", "measured error", "predicted ms", "measured ms", "time error", "hit rate"):
+        table.add_column(col, justify="right")
+    for p in report.points:
+        table.add_row(p.node, str(p.period), f"{p.predicted_error:.5f}", f"{p.measured_error:.5f}",
+                      f"{p.predicted_ms:.2f}", f"{p.measured_ms:.2f}", f"{p.time_relative_error:.1%}",
+                      f"{p.hit_rate:.3f}")
+    console = Console()
+    console.print(table)
+    r2 = ", ".join(f"{k} {v:.3f}" for k, v in report.training_r2.items() if v is not None)
+    console.print(f"frame time: mean relative error {report.time_mean_relative_error:.1%}, "
+                  f"max {report.time_max_relative_error:.1%}; error model R² over the held-out points "
+                  f"{report.error_r2:.3f}; R² on the training periods: {r2}", highlight=False)
