@@ -22,6 +22,7 @@ _COMMANDS = {
     "bench": "bench",
     "profile": "profile",
     "select": "select",
+    "accuracy": "accuracy",
     "render": "render",
     "report": "report",
 }
