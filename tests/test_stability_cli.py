@@ -114,8 +114,7 @@ def test_bad_session(tmp_path, stability_case, name):
     case.observe(exit=code, stderr=" / ".join(lines).replace(str(tmp_path), "TMP"))
     line = _one_line(code, lines)
     assert place in line
-    if name != "session: missing session file":
-        assert "hint:" in line
+    assert "hint:" in line
     if name == "session: invalid field":
         debug = _debug_shows_traceback(tmp_path, ["render", "ok.frag", session, "--frames", "1"])
         case.observe(debug_traceback=debug)

@@ -223,7 +223,8 @@ def load_session(path: str | os.PathLike) -> Session:
         with open(file, "rb") as f:
             raw = f.read()
     except OSError as e:
-        raise SessionError(f"cannot read the session file: {e.strerror}", file, None) from None
+        raise SessionError(f"cannot read the session file: {e.strerror}", file, None,
+                           "check the path; a relative one starts from the current folder") from None
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
