@@ -37,6 +37,15 @@ PARAM_QUALIFIERS = frozenset({"const", "in", "out", "inout", "precise"}) | PRECI
 MAX_DEPTH = 120
 
 
+#: what to check when an expected punctuator is missing (the error names the token found instead)
+_EXPECT_HINTS = {
+    ";": "every statement and declaration ends with ';': is one missing just before here?",
+    ")": "check that the parentheses are balanced",
+    "]": "check that the brackets are balanced",
+    "}": "check that the braces are balanced",
+}
+
+
 def _describe(tok: Token) -> str:
     return "end of file" if tok.kind == "eof" else f"'{tok.text}'"
 
@@ -83,7 +92,8 @@ class _Parser:
     def expect(self, text: str, context: str, hint: Optional[str] = None) -> Token:
         if self.at(text):
             return self.advance()
-        raise self.error(f"expected '{text}' {context}, found {_describe(self.tok)}", hint=hint)
+        raise self.error(f"expected '{text}' {context}, found {_describe(self.tok)}",
+                         hint=hint or _EXPECT_HINTS.get(text))
 
     def expect_ident(self, context: str) -> Token:
         t = self.tok
