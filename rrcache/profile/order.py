@@ -87,38 +87,77 @@ def _equal(a, b) -> bool:
     return b is not None and np.array_equal(np.asarray(a), np.asarray(b))
 
 
-def signature(variant, changing: set[str]) -> str:
-    """The inputs the cached value of ``variant`` depends on: the varyings its payload pass
-    reads and the per-frame uniforms among its uniforms, as one sorted string."""
-    name = "payload" if "payload" in variant.passes else next(iter(variant.passes))
-    inputs = set(_INPUT.findall(variant.passes[name].fragment))
-    uniforms = {u for u in variant.uniforms.get(name, []) if u in changing}
-    return " ".join(sorted(inputs | uniforms))
+def dependency_map(unit) -> dict[str, set[str]]:
+    """For every name assigned or declared with an initialiser anywhere in ``unit`` (after
+    inlining: ``main``'s locals), the names its values are computed from (every definition
+    counted: conservative)."""
+    from rrcache.glsl import ast as A
+
+    deps: dict[str, set[str]] = {}
+    for node in unit.walk():
+        if isinstance(node, A.Declarator) and node.init is not None:
+            deps.setdefault(node.name, set()).update(_names(node.init))
+        elif isinstance(node, A.Assign):
+            root = node.target
+            while isinstance(root, (A.Field, A.Index)):
+                root = root.obj
+            if isinstance(root, A.Ident):
+                reads = _names(node.value) | (_names(node.target) - {root.name})
+                if node.op != "=":
+                    reads.add(root.name)
+                deps.setdefault(root.name, set()).update(reads)
+    return deps
+
+
+def _names(expr) -> set[str]:
+    from rrcache.glsl import ast as A
+
+    return {n.name for n in expr.walk() if isinstance(n, A.Ident)}
+
+
+def signature(expr, deps: dict[str, set[str]], inputs: set[str], changing: set[str]) -> str:
+    """The inputs the value of ``expr`` depends on, through the local definitions in ``deps``:
+    the shader inputs (varyings) and per-frame uniforms it reaches, as one sorted string."""
+    seen, todo = set(), list(_names(expr))
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        todo.extend(deps.get(name, ()))
+    return " ".join(sorted(n for n in seen if n in inputs or n in changing))
+
+
+def shader_inputs(source: str) -> set[str]:
+    """The ``in`` variables a core fragment shader declares."""
+    return set(_INPUT.findall(source))
 
 
 def diversity_order(nodes, signatures: dict) -> list:
-    """Round-robin over the signature groups (costliest group first), farthest-point over the
-    static cost within a group (rule 2 of the module docstring). Deterministic."""
-    groups: dict[str, list] = {}
-    for n in sorted(nodes, key=lambda n: -n.cost):
-        groups.setdefault(signatures.get(n.id, ""), []).append(n)
-    queues = [_farthest_first(members) for members in groups.values()]
-    queues.sort(key=lambda q: -q[0].cost)
+    """Farthest-point order over the static cost within signature groups (rule 2 of the module
+    docstring): each step takes the node whose cost is farthest from every node already taken
+    *in its group*; a group's first node counts as farther than any distance, so every group's
+    costliest node comes first (costliest groups first). Deterministic; ties go to the costlier
+    node, then to the table's order."""
+    import numpy as np
+
+    ordered = sorted(nodes, key=lambda n: -n.cost)
+    if not ordered:
+        return []
+    cost = np.array([n.cost for n in ordered], dtype=np.float64)
+    names = [signatures.get(n.id, "") for n in ordered]
+    group_of = {name: i for i, name in enumerate(dict.fromkeys(names))}
+    group = np.array([group_of[name] for name in names])
+    head = float(cost.max()) + 1.0
+    novelty = cost + head  # nothing taken in any group yet
+    taken = np.zeros(len(ordered), dtype=bool)
     out = []
-    while any(queues):
-        for q in queues:
-            if q:
-                out.append(q.pop(0))
+    for _ in range(len(ordered)):
+        score = np.where(taken, -np.inf, novelty)
+        pick = int(np.argmax(score))  # first maximum: the costlier (they are sorted), then table order
+        taken[pick] = True
+        out.append(ordered[pick])
+        same = group == group[pick]
+        novelty = np.where(same, np.minimum(np.where(novelty > head, np.inf, novelty), np.abs(cost - cost[pick])),
+                           novelty)
     return out
-
-
-def _farthest_first(members: list) -> list:
-    """``members`` (costliest first) reordered: the costliest, then repeatedly the node whose
-    cost is farthest from every chosen node's (ties: the costlier)."""
-    remaining = list(members)
-    chosen = [remaining.pop(0)]
-    while remaining:
-        best = max(range(len(remaining)),
-                   key=lambda i: (min(abs(remaining[i].cost - c.cost) for c in chosen), remaining[i].cost, -i))
-        chosen.append(remaining.pop(best))
-    return chosen

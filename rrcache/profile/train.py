@@ -52,7 +52,8 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
-from rrcache.profile.order import TrainingOrder, cost_filter, diversity_order, per_frame_uniforms, signature
+from rrcache.profile.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
+                                   shader_inputs, signature)
 from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, TIMING_TARGET_MS, Plan, coverage_map,
                                   fraction_for, place_window)
 from rrcache.profile.settings import TrainingSettings
@@ -124,19 +125,15 @@ class TrainingResult:
     plan: Optional[Plan] = None
 
 
-def training_order(work: ShaderWork, session, settings: TrainingSettings, variants: Optional[dict] = None) -> TrainingOrder:
+def training_order(work: ShaderWork, session, settings: TrainingSettings) -> TrainingOrder:
     """The nodes to train in order, and the skipped ones with their reasons
-    (:mod:`rrcache.profile.order`). Compiles each candidate's variant to read what its payload
-    depends on; ``variants`` (id → variant) receives them for reuse."""
+    (:mod:`rrcache.profile.order`)."""
     nodes = [n for _, n in sorted(enumerate(work.table.nodes), key=lambda item: (-item[1].cost, item[0]))]
     keep, skipped = cost_filter(nodes, settings.min_saving)
     changing = per_frame_uniforms(session)
-    signatures = {}
-    for node in keep:
-        variant = variant_for(work, node.id, settings.timing_periods[0], settings.algorithm)
-        if variants is not None:
-            variants[node.id] = variant
-        signatures[node.id] = signature(variant, changing)
+    deps = dependency_map(work.table.shader.unit)
+    inputs = shader_inputs(work.prepared.source)
+    signatures = {n.id: signature(n.node, deps, inputs, changing) for n in keep}
     return TrainingOrder(diversity_order(keep, signatures), skipped, signatures)
 
 
@@ -222,8 +219,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     if not work.table.nodes:
         raise RRCacheError("the shader has no cacheable node to train", str(work.shader.path or "<shader>"),
                            hint="'rrcache nodes SHADER --all' lists the values left out and why")
-    variants: dict = {}
-    order = training_order(work, session, settings, variants)
+    order = training_order(work, session, settings)
     ids = [n.id for n in order.nodes]
     train_frames = list(range(settings.frames))
     timing = timing_frame_indices(session.frames, settings.timing_frames)
@@ -285,7 +281,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 budget_stopped = True
                 meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
                 continue
-            variant = variants.get(nid) or variant_for(work, nid, settings.timing_periods[0], settings.algorithm)
+            variant = variant_for(work, nid, settings.timing_periods[0], settings.algorithm)
             if todo_error[nid]:
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, settings.resolution, period=settings.periods[0],
@@ -317,7 +313,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         if i not in trained:
             notes[i] = "not reached within the training budget (--budget)"
     if trained and need_overhead:
-        _measure_overhead(work, session, settings, store, trained[0], timing, meter, variants.get(trained[0]))
+        _measure_overhead(work, session, settings, store, trained[0], timing, meter)
 
     skipped_ids = [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
     result = TrainingResult(order=ids + skipped_ids, trained=trained,
@@ -330,8 +326,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     return result
 
 
-def _measure_overhead(work, session, settings, store, node_id, timing, meter, variant=None) -> None:
-    variant = variant or variant_for(work, node_id, settings.timing_periods[-1], settings.algorithm)
+def _measure_overhead(work, session, settings, store, node_id, timing, meter) -> None:
+    variant = variant_for(work, node_id, settings.timing_periods[-1], settings.algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
                         block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon) as cached:
