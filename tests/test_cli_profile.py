@@ -185,7 +185,8 @@ def test_sigint_exits_130_and_keeps_the_store(tmp_path, stability_case):
                           "rrcache profile, SIGINT after 2 stored error runs, then resumed")
     shader, session = write_scene(tmp_path)
     out = tmp_path / "out"
-    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS)
+    # every node trained (--min-saving 0): enough work that the signal lands before the end
+    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS, "--min-saving", "0")
     _wait_for_runs(proc, out / "profile.sqlite", 2)
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=60)
@@ -200,6 +201,6 @@ def test_sigint_exits_130_and_keeps_the_store(tmp_path, stability_case):
         for run in store.error_runs():  # every stored run is complete
             assert len(store.error_frames(run.node, run.period)) == run.frames == 12
     assert not (out / "profile.json").exists()
-    resumed = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--no-validate")
+    resumed = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--min-saving", "0", "--no-validate")
     case.observe(stored_at_interrupt=stored, resumed_skipping=f"computed; {stored} error and" in resumed.stdout)
     assert f"computed; {stored} error and" in resumed.stdout
