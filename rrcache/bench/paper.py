@@ -21,7 +21,10 @@ Per scene (:func:`run_scene`):
    speed-up limit (every pixel hitting), through :func:`rrcache.bench.cache.run`.
 5. **Equal time** (§5.4): dynamic resolution and simplification tuned to the medium
    selection's measured speed-up (:mod:`rrcache.alternatives`), then measured over the bench
-   frames beside the original; error and PSNR of all three.
+   frames beside the original; error and PSNR of all three. The simplification's candidates
+   are the ``candidates`` costliest nodes whose cost is at most what the target allows to save
+   (static cost taken as proportional to time, keeping at least half of ``cost / target``);
+   a medium selection no faster than the original gets no equal-time comparison.
 
 :func:`run` does every scene and rewrites ``bench.json`` and ``bench.md`` in ``out`` as each
 scene finishes, so an interruption loses only the scene in flight (and its profile resumes).
@@ -92,7 +95,7 @@ QUICK = BenchSettings(
     quick=True, resolution=(160, 120), frames=40,
     training={"periods": (2, 8, 16), "timing_frames": 4, "timing_periods": (2, 16), "budget_s": 15.0,
               "validate": False},
-    repeats=1, candidates=6, probe_frames=2, probe_resolution=(40, 30), search_frames=8, tolerance=0.1,
+    repeats=1, candidates=8, probe_frames=2, probe_resolution=(40, 30), search_frames=8, tolerance=0.1,
     max_steps=4, plots=False,
     # the ambient-occlusion shader is ~50× the cost of the others per pixel
     scene_overrides={"chess": {"resolution": (64, 48), "frames": 20, "probe_resolution": (32, 24),
@@ -234,6 +237,10 @@ def _measure_selections(prof, work, session, frames, settings: BenchSettings, pr
     return rows
 
 
+def _within(speedup: float, target: float, tolerance: float) -> bool:
+    return bool(math.isfinite(speedup) and abs(speedup / target - 1.0) <= tolerance)
+
+
 def _equal_time(work, session, frames, medium: SelectionRow,
                 settings: BenchSettings, result: SceneResult, progress) -> list[MethodRow]:
     from rrcache.alternatives import dynres, simplify
@@ -255,7 +262,8 @@ def _equal_time(work, session, frames, medium: SelectionRow,
     low = dynres.low_size(tuple(session.resolution), found.value)
     rows.append(MethodRow("dynamic resolution", f"scale {found.value:.3f} ({low[0]}×{low[1]}, bilinear)",
                           final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
-                          final.original_ms_per_frame, found.matched, [list(s) for s in found.steps]))
+                          final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
+                          [list(s) for s in found.steps]))
 
     # simplification
     w, h = session.resolution
@@ -264,7 +272,11 @@ def _equal_time(work, session, frames, medium: SelectionRow,
     n = len(frames)
     probe = sorted({int(round(x)) for x in np.linspace(frames[0], frames[-1], max(1, settings.probe_frames))}) \
         if n > 1 else list(frames)
-    costliest = sorted((x for x in work.table.nodes if not x.final), key=lambda x: -x.cost)[:settings.candidates]
+    # static cost taken as proportional to time: the simplified shader should keep at least half the
+    # cost the target suggests, so the candidates are the costliest nodes saving no more than the rest
+    floor = 0.5 * result.static_cost / max(target, 1.0)
+    pool = [x for x in work.table.nodes if not x.final and x.cost <= result.static_cost - floor]
+    costliest = sorted(pool, key=lambda x: (-x.cost, x.id))[:settings.candidates]
     ids = [x.id for x in costliest]
     done = {"k": 0}
 
@@ -273,7 +285,8 @@ def _equal_time(work, session, frames, medium: SelectionRow,
         _say(progress, "simplification: node means and errors", done["k"], 2 * len(ids))
 
     if not ids:
-        result.notes.append("simplification: no cacheable node besides the final colour; left out")
+        result.notes.append("simplification: no cacheable node (besides the final colour) saves less than the "
+                            "target allows; left out")
         return rows
     ranking = simplify.rank_candidates(work, session, ids, probe, probe_size, probe_step)
     if not ranking:
@@ -283,8 +296,6 @@ def _equal_time(work, session, frames, medium: SelectionRow,
     def simp_step(k, speedup):
         _say(progress, f"simplification k={k}: {speedup:.2f}× (target {target:.2f}×)")
 
-    # static cost taken as proportional to time: do not go below half the cost the target suggests
-    floor = 0.5 * result.static_cost / max(target, 1.0)
     tuned = simplify.tune_simplification(work, session, ranking, None, search, target, settings.tolerance, simp_step,
                                          cost_floor=floor)
     k = int(tuned.search.value)
@@ -293,9 +304,9 @@ def _equal_time(work, session, frames, medium: SelectionRow,
     rows.append(MethodRow("simplification (Pellacini 2005)",
                           f"{k} of {len(tuned.ranking)} nodes in the greedy order replaced by their means "
                           f"(static cost {tuned.shader.cost} of {result.static_cost}): "
-                          + ", ".join(_short(c.text) for c in tuned.ranking[:k]),
+                          + ", ".join(_short(c.text) for c in tuned.ranking[:min(k, 3)]) + (", …" if k > 3 else ""),
                           final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
-                          final.original_ms_per_frame, tuned.search.matched,
+                          final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                           [list(s) for s in tuned.search.steps]))
     return rows
 

@@ -33,7 +33,7 @@ def _methods(rows, title: str) -> list[str]:
     lines = [f"**{title}**", "", "| method | setting | speed-up | mean error | PSNR dB | ms | original ms |",
              "|---|---|---|---|---|---|---|"]
     for r in rows:
-        flag = "" if r.matched in (None, True) else " (target not reached)"
+        flag = "" if r.matched in (None, True) else " (not within the tolerance of the target)"
         lines.append(f"| {r.method}{flag} | {r.setting} | {_f(r.speedup, '.2f')}× | {_f(r.mean_error, '.4f')} | "
                      f"{_f(r.psnr, '.1f')} | {_f(r.ms, '.2f')} | {_f(r.original_ms, '.2f')} |")
     return lines + [""]
