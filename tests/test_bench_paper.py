@@ -155,6 +155,9 @@ def test_files_written(quick_run):
     assert "quick run" in md and "| scene | static cost | cacheable nodes |" in md
     assert "| e3 |" in md
     assert (out / "noise.rrprofile" / "profile.json").exists()
+    figure = out / doc["scenes"][0]["figure"]
+    assert figure.name == "noise-error-time.png" and figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert f"]({figure.name})" in md
 
 
 def test_second_run_resumes_the_profile(quick_run):

@@ -46,6 +46,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from rrcache.bench.scenes import Scene, scaled_session
+from rrcache.errors import RRCacheError
 
 ProgressFn = Callable[[str, Optional[int], Optional[int]], None]
 PSNR_CAP = 100.0
@@ -64,7 +65,8 @@ class BenchSettings:
       sample frames for its node means and errors, at ``probe_resolution`` (None: a quarter).
     - ``search_frames``: frames per equal-time search step; ``tolerance`` the relative speed-up
       tolerance; ``max_steps`` of the dynamic-resolution search; ``min_scale`` its lower end.
-    - ``plots``: let the profiler write its plots.
+    - ``plots``: let the profiler write its plots; ``figures``: write the bench's own figure
+      per scene (:mod:`rrcache.bench.paper_plots`).
     """
 
     quick: bool = False
@@ -80,6 +82,7 @@ class BenchSettings:
     max_steps: int = 8
     min_scale: float = 0.1
     plots: bool = True
+    figures: bool = True
     scene_overrides: dict = field(default_factory=dict)
 
     def for_scene(self, name: str) -> "BenchSettings":
@@ -90,7 +93,8 @@ class BenchSettings:
         return _finite(asdict(self))
 
 
-FULL = BenchSettings()
+#: chess is ~1.4 s per frame at 640×480: one side-by-side run per selection there
+FULL = BenchSettings(scene_overrides={"chess": {"repeats": 1}})
 QUICK = BenchSettings(
     quick=True, resolution=(160, 120), frames=40,
     training={"periods": (2, 8, 16), "timing_frames": 4, "timing_periods": (2, 16), "budget_s": 15.0,
@@ -161,6 +165,7 @@ class SceneResult:
     equal_time: list = field(default_factory=list)
     notes: list = field(default_factory=list)
     wall_s: float = 0.0
+    figure: Optional[str] = None
 
     def to_json(self) -> dict:
         return _finite(asdict(self))
@@ -243,16 +248,28 @@ def _within(speedup: float, target: float, tolerance: float) -> bool:
 
 def _equal_time(work, session, frames, medium: SelectionRow,
                 settings: BenchSettings, result: SceneResult, progress) -> list[MethodRow]:
-    from rrcache.alternatives import dynres, simplify
-    from rrcache.alternatives.measure import compare_renderers
-    from rrcache.harness.renderer import Renderer
-
     target = medium.speedup
     rows = [MethodRow("reprojection cache (ours)", f"{medium.label}: {medium.node_id} at Δn={medium.period}",
                       medium.speedup, medium.mean_error, medium.psnr, medium.ms, medium.original_ms, True)]
     search = list(frames)[:max(1, settings.search_frames)]
 
-    # dynamic resolution
+    try:
+        rows.append(_dynres_row(work, session, frames, search, target, settings, progress))
+    except RRCacheError as err:
+        result.notes.append(f"dynamic resolution failed: {err}")
+    try:
+        row = _simplification_row(work, session, frames, search, target, settings, result, progress)
+    except RRCacheError as err:
+        result.notes.append(f"simplification failed: {err}")
+    else:
+        if row is not None:
+            rows.append(row)
+    return rows
+
+
+def _dynres_row(work, session, frames, search, target, settings, progress) -> MethodRow:
+    from rrcache.alternatives import dynres
+
     def dyn_step(scale, speedup):
         _say(progress, f"dynres s={scale:.3f}: {speedup:.2f}× (target {target:.2f}×)")
 
@@ -260,12 +277,17 @@ def _equal_time(work, session, frames, medium: SelectionRow,
                               rel_tol=settings.tolerance, max_steps=settings.max_steps, progress=dyn_step)
     final = dynres.measure_scale(work.prepared, session, None, frames)(found.value)
     low = dynres.low_size(tuple(session.resolution), found.value)
-    rows.append(MethodRow("dynamic resolution", f"scale {found.value:.3f} ({low[0]}×{low[1]}, bilinear)",
-                          final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
-                          final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
-                          [list(s) for s in found.steps]))
+    return MethodRow("dynamic resolution", f"scale {found.value:.3f} ({low[0]}×{low[1]}, bilinear)",
+                     final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
+                     final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
+                     [list(s) for s in found.steps])
 
-    # simplification
+
+def _simplification_row(work, session, frames, search, target, settings, result, progress) -> Optional[MethodRow]:
+    from rrcache.alternatives import simplify
+    from rrcache.alternatives.measure import compare_renderers
+    from rrcache.harness.renderer import Renderer
+
     w, h = session.resolution
     probe_size = settings.probe_resolution or (max(8, w // 4), max(8, h // 4))
     probe_size = (min(probe_size[0], w), min(probe_size[1], h))
@@ -287,11 +309,11 @@ def _equal_time(work, session, frames, medium: SelectionRow,
     if not ids:
         result.notes.append("simplification: no cacheable node (besides the final colour) saves less than the "
                             "target allows; left out")
-        return rows
+        return None
     ranking = simplify.rank_candidates(work, session, ids, probe, probe_size, probe_step)
     if not ranking:
         result.notes.append("simplification: no candidate saves static cost; left out")
-        return rows
+        return None
 
     def simp_step(k, speedup):
         _say(progress, f"simplification k={k}: {speedup:.2f}× (target {target:.2f}×)")
@@ -301,14 +323,13 @@ def _equal_time(work, session, frames, medium: SelectionRow,
     k = int(tuned.search.value)
     with Renderer(work.prepared, session) as original, Renderer(tuned.shader.prepared, session) as simple:
         final = compare_renderers(original, simple, frames)
-    rows.append(MethodRow("simplification (Pellacini 2005)",
-                          f"{k} of {len(tuned.ranking)} nodes in the greedy order replaced by their means "
-                          f"(static cost {tuned.shader.cost} of {result.static_cost}): "
-                          + ", ".join(_short(c.text) for c in tuned.ranking[:min(k, 3)]) + (", …" if k > 3 else ""),
-                          final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
-                          final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
-                          [list(s) for s in tuned.search.steps]))
-    return rows
+    return MethodRow("simplification (Pellacini 2005)",
+                     f"{k} of {len(tuned.ranking)} nodes in the greedy order replaced by their means "
+                     f"(static cost {tuned.shader.cost} of {result.static_cost}): "
+                     + ", ".join(_short(c.text) for c in tuned.ranking[:min(k, 3)]) + (", …" if k > 3 else ""),
+                     final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
+                     final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
+                     [list(s) for s in tuned.search.steps])
 
 
 def _short(text: str, limit: int = 40) -> str:
@@ -422,6 +443,10 @@ def run(scenes: list, settings: BenchSettings = FULL, out="rrcache-bench", progr
         result.scenes.append(run_scene(scene, settings, out, lambda s, d=None, t=None, n=scene.name:
                                        _say(progress, f"{n}: {s}", d, t)))
         result.wall_s = time.time() - t0
+        if settings.figures:
+            from rrcache.bench.paper_plots import write_scene_plot
+
+            result.scenes[-1].figure = Path(write_scene_plot(result.scenes[-1], out)).name
         _write(out / "bench.json", json.dumps(result.to_json(), indent=2, ensure_ascii=False) + "\n")
         _write(out / "bench.md", markdown(result))
         if on_scene is not None:

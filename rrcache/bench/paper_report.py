@@ -60,6 +60,8 @@ def scene_markdown(s) -> str:
                   f"at most {_f(s.limit_speedup, '.2f')}×.", ""]
     if s.equal_time:
         lines += _methods(s.equal_time, f"equal time: tuned to the {s.medium} speed-up {_f(s.target_speedup, '.2f')}×")
+    if getattr(s, "figure", None):
+        lines += [f"![{s.name}: error against frame time]({s.figure})", ""]
     for note in s.notes:
         lines.append(f"- note: {note}")
     if s.notes:
