@@ -218,3 +218,14 @@ def test_quick_settings_shrink_chess_further():
     marble = paper.QUICK.for_scene("marble")
     assert chess.resolution[0] * chess.resolution[1] < marble.resolution[0] * marble.resolution[1]
     assert chess.quick and chess.scene_overrides == {}
+
+
+def test_effective_session_fits_the_size_and_keeps_the_aspect(tmp_path):
+    shader, session = write_scene(tmp_path)
+    scene = Scene("noise", str(shader), str(session))
+    path = paper._effective_session(scene, paper.BenchSettings(resolution=(40, 40), frames=10), tmp_path / "out")
+    scaled = load_session(path)
+    assert tuple(scaled.resolution) == (40, 30) and scaled.frames == 10
+    assert paper._effective_session(scene, paper.BenchSettings(), tmp_path / "out") == str(session)
+    assert paper._effective_session(scene, paper.BenchSettings(resolution=(640, 480), frames=99),
+                                    tmp_path / "out") == str(session)

@@ -57,8 +57,9 @@ MEDIUM = "e3"
 class BenchSettings:
     """How much the bench does.
 
-    - ``resolution``/``frames``: the session is scaled to at most this size and frame count
-      (None: as it is); ``scene_overrides`` per scene name (quick: chess smaller).
+    - ``resolution``/``frames``: the session is scaled down to fit this size (aspect ratio kept)
+      and cut to this frame count (None: as it is); ``scene_overrides`` per scene name (quick:
+      chess smaller).
     - ``training``: keyword arguments of :class:`rrcache.profile.TrainingSettings`.
     - ``repeats``: side-by-side runs per selection (speed-up: the median).
     - ``candidates``: the costliest nodes considered by the simplification; ``probe_frames``
@@ -199,8 +200,11 @@ def _effective_session(scene: Scene, settings: BenchSettings, out: Path) -> str:
     session = load_session(scene.session)
     w, h = session.resolution
     size = (w, h)
-    if settings.resolution is not None and settings.resolution[0] * settings.resolution[1] < w * h:
-        size = tuple(int(v) for v in settings.resolution)
+    if settings.resolution is not None:
+        # fit inside the requested size, keeping the session's aspect ratio
+        scale = min(settings.resolution[0] / w, settings.resolution[1] / h)
+        if scale < 1:
+            size = (max(8, int(round(w * scale))), max(8, int(round(h * scale))))
     frames = session.frames if settings.frames is None else min(int(settings.frames), session.frames)
     if size == (w, h) and frames == session.frames:
         return scene.session
