@@ -339,9 +339,28 @@ def _measure_overhead(work, session, settings, store, node_id, timing, meter) ->
     store.set_overhead(node_id, OVERHEAD_SIZE, len(times), statistics.median(times))
 
 
+def _typical_originals(store: ProfileStore, nodes, settings: TrainingSettings) -> dict[int, float]:
+    """Per timing frame, the median of the original's times measured beside the variants."""
+    samples: dict[int, list[float]] = {}
+    for nid in nodes:
+        for period, frames in store.timing_frames(nid).items():
+            if period in settings.timing_periods:
+                for f in frames:
+                    samples.setdefault(f.frame, []).append(f.original_ms)
+    return {frame: float(statistics.median(v)) for frame, v in samples.items()}
+
+
 def fit_models(store: ProfileStore, settings: TrainingSettings, result: TrainingResult) -> None:
-    """Fit α, λ (per trained node), μ (every trained node's hit rates) and t_hit, t_miss (per
-    trained node, with the measured overhead) from ``store``, into ``result``."""
+    """Fit α, λ (per trained node), μ (every trained node's hit rates in the timing runs) and
+    t_hit, t_miss (per trained node, with the measured overhead) from ``store``, into ``result``.
+
+    Each variant frame time enters the performance fit *relative to the original timed just
+    before it on the same frame*: ``ms × typical / original_ms``, ``typical`` being the median of
+    every original time of that frame. Other work on a shared machine slows both renders of a
+    pair alike, so the ratio keeps what the cache changes and drops most of the noise (on a
+    loaded machine single variant times varied 2-3× while their ratios held). The original's
+    frame time is the median over the timing frames of ``typical`` (whole frames), else of the
+    reference timing."""
     from rrcache.model import fit_error, fit_hit_rate, fit_performance
 
     overhead = store.overhead()
@@ -349,7 +368,7 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
     ref_timing = store.reference_timing()
     if ref_timing:
         result.pixels = float(np.mean([c for _, _, c in ref_timing]))
-    originals = [ms for _, ms, _ in ref_timing]
+    typical = _typical_originals(store, result.trained, settings)
     # timed in a window, the original's timing-run times are the window's, not a frame's
     windowed = result.plan is not None and result.plan.timing_window is not None
     periods, rates = [], []
@@ -363,9 +382,8 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
             for f in frames:
                 hits.append(f.hits)
                 misses.append(f.misses)
-                times.append(f.ms)
-                if not windowed:
-                    originals.append(f.original_ms)
+                scale = typical[f.frame] / f.original_ms if f.original_ms > 0 else 1.0
+                times.append(f.ms * scale)
             counted = sum(f.hits + f.misses for f in frames)
             if counted:
                 periods.append(period)
@@ -374,4 +392,5 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
                                                 overhead_ms=result.overhead_ms if overhead else None)
     if periods:
         result.hit_fit = fit_hit_rate(periods, rates)
+    originals = list(typical.values()) if typical and not windowed else [ms for _, ms, _ in ref_timing]
     result.original_ms = float(statistics.median(originals)) if originals else float("nan")
