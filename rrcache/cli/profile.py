@@ -136,9 +136,10 @@ def _summary(prof, console: Console) -> None:
     c = prof.counts
     trained = len(prof.trained_nodes)
     console.print(f"profile: {prof.path}", highlight=False)
-    console.print(f"nodes trained: {trained} of {len(prof.nodes)}"
-                  + (" (budget spent: the rest are untrained)" if prof.data.get("budget_stopped") else ""),
-                  highlight=False)
+    cheap = sum(1 for n in prof.nodes if not n.trained and n.note and "static cost" in n.note)
+    late = sum(1 for n in prof.nodes if not n.trained and n.note and "budget" in n.note)
+    console.print(f"nodes trained: {trained} of {len(prof.nodes)}; {cheap} too cheap to win (static cost under "
+                  f"{prof.settings.min_saving:.0%} of the costliest), {late} not reached within the budget", highlight=False)
     console.print(f"runs: {c.get('error_runs_computed', 0)} error and {c.get('timing_runs_computed', 0)} timing runs "
                   f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
                   "runs were stored and skipped", highlight=False)
