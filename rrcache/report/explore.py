@@ -259,7 +259,9 @@ class Explorer:
         self.slider = w.FloatLogSlider(value=start, base=10, min=lo, max=hi, step=(hi - lo) / 200,
                                        description="max error", readout_format=".2e", continuous_update=True,
                                        layout=w.Layout(width="640px"))
-        self.button = w.Button(description="Write shader files", icon="save", button_style="primary")
+        self.button = w.Button(description="Write shader files", icon="save", button_style="primary",
+                               tooltip=f"write the chosen variant's passes and manifest into {self.out_dir}/",
+                               layout=w.Layout(width="190px"))
         self.summary = w.HTML()
         self.source = w.HTML()
         self.status = w.HTML()

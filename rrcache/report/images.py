@@ -138,7 +138,9 @@ class ChoiceImages:
         if name == "error_map" and self.error_scale is not None:
             return f"{CAPTIONS[name]} (white = {self.error_scale:.3g})"
         if name == "payload" and self.payload_ranges:
-            return CAPTIONS[name] + " (" + ", ".join(f"{lo:.3g}…{hi:.3g}" for lo, hi in self.payload_ranges) + ")"
+            lo = min(r[0] for r in self.payload_ranges)
+            hi = max(r[1] for r in self.payload_ranges)
+            return f"{CAPTIONS[name]} ({lo:.3g}…{hi:.3g}, stretched)"
         return CAPTIONS[name]
 
 
