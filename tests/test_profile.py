@@ -169,6 +169,9 @@ def test_budget_stops_new_nodes_and_resume_finishes(tmp_path):
     assert second.counts["error_runs_skipped"] == 3 and second.counts["timing_runs_skipped"] == 2
     assert second.counts["error_runs_computed"] == 3 * (len(worth) - 1)
     assert second.nodes[0].alpha == pytest.approx(first.nodes[0].alpha, rel=1e-9)
+    # the precomputation time adds up both invocations
+    saved = json.loads((tmp_path / "out" / "profile.json").read_text())
+    assert saved["invocations"] == 2 and saved["precompute_s"] > saved["run_wall_s"] > 0
 
 
 def test_error_runs_in_a_window_at_full_resolution(tmp_path):

@@ -316,6 +316,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         prof = _assemble(work, session, shader_path, session_path, resolved, result, store, progress)
         _write_outputs(prof, out, work, plots)
         store.end_run("done")
+        _write_times(prof, out, store, time.time() - started)
     except KeyboardInterrupt:
         store.end_run("interrupted")
         store.close()
@@ -327,8 +328,24 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             store.close()
         raise
     store.close()
-    prof.data["run_wall_s"] = time.time() - started
     return prof
+
+
+def _write_times(prof: Profile, out: Path, store, run_wall_s: float) -> None:
+    """Add to profile.json the wall time of this invocation (``run_wall_s``) and the
+    precomputation time: every invocation on this store added up (``precompute_s``), so a
+    resumed profile counts the time of its earlier runs too (an invocation killed outright left
+    no finish time and is not counted)."""
+    total = 0.0
+    for row in store.run_log():
+        if row["finished"] is not None:
+            total += float(row["finished"]) - float(row["started"])
+    prof.data["run_wall_s"] = run_wall_s
+    prof.data["precompute_s"] = total
+    prof.data["invocations"] = len(store.run_log())
+    tmp = out / (JSON_NAME + ".tmp")
+    tmp.write_text(json.dumps(_finite(prof.data), indent=2) + "\n", encoding="utf-8")
+    os.replace(tmp, out / JSON_NAME)
 
 
 def _assemble(work, session, shader_path, session_path, settings, result: TrainingResult, store, progress) -> Profile:
