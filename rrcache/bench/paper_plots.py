@@ -52,7 +52,9 @@ def write_scene_plot(scene, out) -> str:
                        label=f"cache limit ({scene.limit_speedup:.1f}×)")
         ax.set_xlabel("frame time / original frame time")
         ax.set_ylabel("mean RGB L2 error")
-        ax.set_xlim(left=0)
+        xs = [x for x in ([s[1] for s in sel] + [_x(r.speedup) for r in scene.algorithms + scene.equal_time])
+              if x is not None]
+        ax.set_xlim(0, 1.05 * max([1.0] + xs))
         ax.set_ylim(bottom=0)
         w, h = scene.resolution
         ax.set_title(f"{scene.name}: {w}×{h}, {scene.frames} frames", fontsize=10)
