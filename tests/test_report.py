@@ -136,3 +136,20 @@ def test_reselection_is_fast(demo):
     timing = selection_timing(demo, repeats=100)
     assert timing["repeats"] == 100 and timing["nodes"] == len(demo.trained_nodes)
     assert timing["median_ms"] < 1.0, timing
+
+
+def test_tiny_profile_and_the_plots_flag(tmp_path):
+    """The tests' tiny scene (nothing beats the original at 64×48): the report still carries every
+    node and the four selections; ``plots=False`` writes neither plots nor report."""
+    from test_profile import SETTINGS, write_scene
+
+    from rrcache.profile import TrainingSettings, profile
+
+    shader, session = write_scene(tmp_path)
+    prof = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False))
+    data = _data((tmp_path / "out" / REPORT_NAME).read_text(encoding="utf-8"))
+    assert set(data["details"]) == {n.id for n in prof.nodes}
+    assert [s["label"] for s in data["selections"]] == ["e1", "e2", "e3", "e4"]
+    bare = profile(shader, session, tmp_path / "bare", TrainingSettings(**SETTINGS, validate=False), plots=False)
+    assert bare.trained_nodes and not (tmp_path / "bare" / REPORT_NAME).exists()
+    assert not (tmp_path / "bare" / "tradeoff.png").exists()
