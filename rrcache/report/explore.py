@@ -225,11 +225,10 @@ def measure_choice(prof, node: Optional[str], period: Optional[int], shots: Fram
         return {"error": 0.0, "psnr": None, "speedup": 1.0, "ms": prof.original_ms, "original_ms": prof.original_ms,
                 "hit_rate": None, "frames": 0, "stored": True}
     from rrcache.harness.cached import compare
-    from rrcache.pipeline import variant_for
 
     settings = prof.settings
     count = min(int(frames or settings.validation_frames or shots.session.frames), int(shots.session.frames))
-    variant = variant_for(shots.work, node, int(period), settings.algorithm)
+    variant = shots.variant(node)
     result = compare(variant, shots.session, shots.work.prepared, range(count), period=int(period),
                      block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon)
     return {"error": result.mean_error, "psnr": result.psnr, "speedup": result.speedup, "ms": result.ms_per_frame,
@@ -241,7 +240,8 @@ def measure_choice(prof, node: Optional[str], period: Optional[int], shots: Fram
 class Explorer:
     """The interactive profiler (see the module docstring). ``value`` is the starting threshold
     (default: the profile's e2 level). Attributes: ``slider``, ``button``, ``choice`` (the last
-    :class:`rrcache.model.Selection`), ``select_ms`` (the last re-selection's time),
+    :class:`rrcache.model.Selection`), ``select_ms`` (the last re-selection's time), ``render_ms``
+    (the last new choice's frames and measurement),
     ``measured`` (the last choice's measurement), ``written`` (files the button wrote).
     ``measure=False`` skips rendering the session for choices the profile did not validate."""
 
@@ -269,6 +269,8 @@ class Explorer:
         self.widget = w.VBox([w.HBox([self.slider, self.button]), self.summary, self.frames, self.source,
                               self.status])
         self.choice = None
+        self.images = None
+        self.render_ms: Optional[float] = None
         self.select_ms: Optional[float] = None
         self.measured: Optional[dict] = None
         self.written: list = []
@@ -283,8 +285,12 @@ class Explorer:
         self.select_ms = (time.perf_counter() - start) * 1000.0
         changed = self.choice is None or (choice.node, choice.period) != (self.choice.node, self.choice.period)
         self.choice = choice
-        if changed:
+        if changed:  # the predictions show at once; the frames and the measurement follow
+            self.measured = None
+            self._show_summary(max_error, pending=True)
+            start = time.perf_counter()
             self._show_choice(choice)
+            self.render_ms = (time.perf_counter() - start) * 1000.0
         self._show_summary(max_error)
         return choice
 
@@ -306,7 +312,7 @@ class Explorer:
             self.measured = None
         self.source.value = source_html(self.prof, choice.node, context=8) if choice.node else source_html(self.prof)
 
-    def _show_summary(self, max_error: float) -> None:
+    def _show_summary(self, max_error: float, pending: bool = False) -> None:
         c, m = self.choice, self.measured or {}
         if c.node is None:
             what = "<b>the original shader</b>: no cached variant is predicted faster within this error"
@@ -316,13 +322,14 @@ class Explorer:
         measured = (f"measured over {m.get('frames')} frames{' (stored by the profile)' if m.get('stored') else ''}: "
                     f"speed-up <b>{_f(m.get('speedup'), 3)}×</b>, error <b>{_f(m.get('error'))}</b>, "
                     f"PSNR {_f(m.get('psnr'), 3)} dB, hit rate {_f(m.get('hit_rate'), 3)}"
-                    if m else "not measured (measure=False)")
+                    if m else ("rendering and measuring…" if pending else "not measured (measure=False)"))
+        shown = (f"this frame rendered at {self.images.size[0]}×{self.images.size[1]}, frame {self.images.frame}, "
+                 f"with the measurement in {self.render_ms:.0f} ms" if self.images is not None and not pending else "")
         self.summary.value = (
             f"<div>max error {max_error:.3g} → {what}<br>"
             f"predicted: speed-up <b>{_f(c.predicted_speedup, 3)}×</b>, error <b>{_f(c.predicted_error)}</b>, "
             f"{_f(c.predicted_ms)} ms per frame (original {_f(self.prof.original_ms)} ms)<br>{measured}<br>"
-            f"<small>re-selected in {self.select_ms:.3f} ms from the models; this frame rendered at "
-            f"{self.images.size[0]}×{self.images.size[1]}, frame {self.images.frame}</small></div>")
+            f"<small>re-selected in {self.select_ms:.3f} ms from the models; {shown}</small></div>")
 
     def write_files(self) -> list:
         """Write the chosen shader files into ``out_dir`` (the button does this)."""

@@ -162,6 +162,15 @@ class FrameShots:
         self.size = image_size(self.session.resolution, max_width)
         self._originals: dict = {}
         self._images: dict = {}
+        self._variants: dict = {}
+
+    def variant(self, node: str):
+        """The compiled variant caching ``node`` (one per node: the refresh period is the runtime's)."""
+        if node not in self._variants:
+            from rrcache.pipeline import variant_for
+
+            self._variants[node] = variant_for(self.work, node, None, self.profile.settings.algorithm)
+        return self._variants[node]
 
     def frame_for(self, period: Optional[int]) -> int:
         """The frame shown for a refresh period: Δn + 2 frames into the session (at most its last)."""
@@ -192,10 +201,9 @@ class FrameShots:
             return out
         from rrcache.harness.cached import CachedRenderer
         from rrcache.harness.metrics import mean_l2
-        from rrcache.pipeline import variant_for
 
         settings = self.profile.settings
-        variant = variant_for(self.work, node, period, settings.algorithm)
+        variant = self.variant(node)
         with CachedRenderer(variant, self.session, self.work.prepared, self.size, period=period,
                             block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon,
                             hit_maps=True, keep_payload=True) as cached:
