@@ -76,4 +76,4 @@ def test_interactive_reselects_and_writes_files(executed):
     moved = next(t for t in texts if t.startswith("(Selection("))
     assert f"node={expected.node!r}" in moved and f"period={expected.period!r}" in moved
     assert float(moved.rsplit("'", 2)[-2].split()[0]) < 5.0  # that re-selection's milliseconds
-    assert (folder / "chosen" / "manifest.json").exists()
+    assert (folder / "demo.rrprofile" / "chosen" / "manifest.json").exists()

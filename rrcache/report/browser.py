@@ -59,10 +59,11 @@ class Chromium:
         self.events: list[dict] = []
         self._id = 0
         self._dir = tempfile.mkdtemp(prefix="rrcache-chromium-")
+        self._log = tempfile.TemporaryFile()  # Chromium's own messages (a pipe could fill and stall it)
         self._proc = subprocess.Popen(
             [self.executable, *FLAGS, f"--user-data-dir={self._dir}", "--remote-debugging-port=0",
              f"--window-size={width},{height}", "about:blank"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+            stdout=subprocess.DEVNULL, stderr=self._log)
         try:
             port = self._port()
             page = self._page_target(port)
@@ -81,7 +82,8 @@ class Chromium:
         deadline = time.monotonic() + self.timeout
         while time.monotonic() < deadline:
             if self._proc.poll() is not None:
-                err = self._proc.stderr.read().decode(errors="replace")[-800:]
+                self._log.seek(0)
+                err = self._log.read().decode(errors="replace")[-800:]
                 raise RRCacheError(f"Chromium exited at start ({self._proc.returncode}): {err.strip()}",
                                    self.executable, hint="run it by hand with --headless to see why")
             if marker.exists():
@@ -215,6 +217,7 @@ class Chromium:
             except subprocess.TimeoutExpired:
                 self._proc.kill()
                 self._proc.wait()
+        self._log.close()
         shutil.rmtree(self._dir, ignore_errors=True)
 
     def __enter__(self) -> "Chromium":

@@ -122,7 +122,7 @@ def selection_timing(prof, repeats: int = 200) -> dict:
 
     levels = [s.max_error for s in prof.selections if s.max_error and s.max_error > 0] or [1e-3]
     lo, hi = min(levels) / 10.0, max(levels) * 10.0
-    prof.table  # built once, like the first move of a slider
+    _ = prof.table  # built once, like the first move of a slider
     times = []
     for level in np.geomspace(lo, hi, max(1, int(repeats))):
         start = time.perf_counter()

@@ -26,7 +26,7 @@ from typing import Optional
 
 import numpy as np
 
-from rrcache.report.data import node_benefits, read_source, selection_timing  # noqa: F401 (re-exported)
+from rrcache.report.data import read_source, selection_timing  # noqa: F401 (selection_timing re-exported)
 from rrcache.report.images import CAPTIONS, FrameShots  # noqa: F401 (FrameShots re-exported)
 
 
@@ -242,15 +242,16 @@ class Explorer:
     (default: the profile's e2 level). Attributes: ``slider``, ``button``, ``choice`` (the last
     :class:`rrcache.model.Selection`), ``select_ms`` (the last re-selection's time), ``render_ms``
     (the last new choice's frames and measurement),
-    ``measured`` (the last choice's measurement), ``written`` (files the button wrote).
+    ``measured`` (the last choice's measurement), ``written`` (files the button wrote into
+    ``out_dir``, default ``chosen/`` in the profile folder).
     ``measure=False`` skips rendering the session for choices the profile did not validate."""
 
-    def __init__(self, prof, value: Optional[float] = None, out_dir="chosen", measure: bool = True,
+    def __init__(self, prof, value: Optional[float] = None, out_dir=None, measure: bool = True,
                  shots: Optional[FrameShots] = None):
         import ipywidgets as w
 
         self.prof = prof
-        self.out_dir = Path(out_dir)
+        self.out_dir = Path(out_dir) if out_dir is not None else Path(prof.path or ".") / "chosen"
         self.measure = measure
         self.shots = shots or FrameShots(prof)
         levels = [s.max_error for s in prof.selections if s.max_error and s.max_error > 0] or [1e-3]
