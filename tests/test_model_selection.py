@@ -14,12 +14,13 @@ from rrcache.model import (ErrorFit, HitRateFit, ModelTable, PerfFit, pareto_fro
 
 
 def brute_force(table: ModelTable, max_error: float):
-    """The paper's rule written as a plain loop over nodes and periods, from the raw parameters."""
+    """The paper's rule written as a plain loop over nodes and periods, from the raw parameters;
+    Δn = 1 (every pixel refreshed every frame) is never a gain and never chosen."""
     best = (table.original_ms, None, None)
     for i, node in enumerate(table.node_ids):
         a, lam = table.alpha[i], table.lam[i]
         perf = PerfFit(table.t_hit[i], table.t_miss[i], table.t_overhead[i], "ok", 3, 0.0)
-        for p in range(1, table.max_period + 1):
+        for p in range(2, table.max_period + 1):
             err = a * (1 - math.exp(-lam * (p - 1)))
             ms = float(predict_ms(perf, table.mu, table.pixels, p))
             if err <= max_error and ms < best[0]:

@@ -2,7 +2,8 @@
 
 Per pixel r̂(Δn) = γ(Δn)·t_hit + (1 − γ(Δn))·t_miss with γ(Δn) = μ(1 − 1/Δn); per frame
 t = t_overhead + M·r̂ for M covered pixels. Δn = 1 refreshes every pixel every frame: γ = 0, all
-misses.
+misses. A miss does all that a hit does and computes the payload besides, so a t_miss fitted
+below t_hit (noisy frames) is taken as t_hit.
 
 >>> from rrcache.model.performance import PerfFit
 >>> perf = PerfFit(t_hit=1e-5, t_miss=1e-4, t_overhead=0.5, quality="ok", rank=3, residual_rms=0.0)
@@ -50,7 +51,8 @@ def predict_ms(perf, mu: float, pixels: float, periods) -> np.ndarray:
         raise RRCacheError(f"pixels must be >= 0, got {pixels}", "model")
     p = np.maximum(_periods(periods), 1.0)
     gamma = mu * (1.0 - 1.0 / p)
-    t_hit, t_miss = float(perf.t_hit), float(perf.t_miss)
+    t_hit = float(perf.t_hit)
+    t_miss = max(float(perf.t_miss), t_hit)
     return float(perf.t_overhead) + pixels * (gamma * t_hit + (1.0 - gamma) * t_miss)
 
 

@@ -122,19 +122,26 @@ class ModelTable:
         params = np.stack([self.alpha, self.lam, self.t_hit, self.t_miss, self.t_overhead])
         self.valid = np.all(np.isfinite(params) & (params >= 0.0), axis=0)
         p = self.periods[None, :].astype(np.float64)
+        # a miss does all a hit does and computes the payload besides: a fit on noisy frames
+        # that puts t_miss below t_hit would predict refreshing to be a gain (as predict_ms)
+        t_miss = np.maximum(self.t_miss, self.t_hit)
         with np.errstate(all="ignore"):
             err = self.alpha[:, None] * -np.expm1(-self.lam[:, None] * (p - 1.0))
             gamma = self.mu * (1.0 - 1.0 / p)
             ms = self.t_overhead[:, None] + self.pixels * (gamma * self.t_hit[:, None]
-                                                           + (1.0 - gamma) * self.t_miss[:, None])
+                                                           + (1.0 - gamma) * t_miss[:, None])
         ok = self.valid[:, None] & np.isfinite(err) & np.isfinite(ms)
         self.E = np.where(ok, err, np.inf)
         self.T = np.where(ok, ms, np.inf)
         self.E.setflags(write=False)
         self.T.setflags(write=False)
-        # flat views for selection: options not faster than the original are +inf from the start
+        # flat views for selection: options not faster than the original are +inf from the start,
+        # and so is Δn = 1: refreshed every frame, the cache recomputes every pixel and adds its
+        # own passes, so it is never faster than the original, whatever a fit predicts
         self._e_flat = self.E.ravel()
-        self._t_fast = np.where(self.T < self.original_ms, self.T, np.inf).ravel()
+        fast = np.where(self.T < self.original_ms, self.T, np.inf)
+        fast[:, 0] = np.inf
+        self._t_fast = fast.ravel()
 
     @classmethod
     def from_fits(cls, node_ids, error_fits, perf_fits, hit_fit, pixels, original_ms,
@@ -267,8 +274,8 @@ def thresholds(table: ModelTable, k: int = 4) -> np.ndarray:
         raise RRCacheError(f"k must be a whole number, got {k!r}", "thresholds") from None
     if k < 1:
         raise RRCacheError(f"k must be >= 1, got {k}", "thresholds")
-    e, t = table.E.ravel(), table.T.ravel()
-    fast = np.isfinite(e) & (t < table.original_ms)
+    e, t = table.E.ravel(), table._t_fast
+    fast = np.isfinite(e) & np.isfinite(t)
     pool = e[fast & (e > 0)]
     if pool.size:
         fastest = int(np.argmin(np.where(fast, t, np.inf)))
