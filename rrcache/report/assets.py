@@ -192,7 +192,9 @@ JS = r"""
     tip.innerHTML = "<b>" + esc(q.node.id) + "</b> Δn = " + q.p[0] + "<br>error " + fmt(q.p[2]) +
                     " · " + fmt(q.p[1]) + " ms · " + fmt(data.original_ms / q.p[1], 3) + "×";
     tip.style.display = "block";
-    tip.style.left = (ev.clientX + 14) + "px";
+    var left = ev.clientX + 14;
+    if (left + tip.offsetWidth > window.innerWidth - 8) { left = ev.clientX - tip.offsetWidth - 14; }
+    tip.style.left = left + "px";
     tip.style.top = (ev.clientY + 12) + "px";
   });
   svg.addEventListener("mouseleave", function () { tip.style.display = "none"; });
@@ -218,6 +220,7 @@ JS = r"""
     details.innerHTML =
       "<h3>" + esc(d.id) + " <span class=muted>" + esc(d.type) + " at line " + d.line + ", column " + d.column +
       (period ? " · Δn = " + period : "") + "</span></h3>" +
+      (d.note ? "<p class=muted>" + esc(d.note) + "</p>" : "") +
       "<div class=muted>source</div><code class=srcline>" + src + "</code>" +
       "<div class=muted>value (after inlining)</div><code>" + esc(d.text) + "</code>" +
       "<div class=muted>call chain</div><code>" + esc(d.call_chain.join(" › ") || "main") + "</code>" +

@@ -63,8 +63,8 @@ def node_benefits(prof) -> dict:
 
 def node_details(prof, node_id: str) -> dict:
     """One node as JSON-able data: id, type, line, column, text, call chain, static cost, whether
-    trained, α, λ (with fit quality and R²), t_hit and t_miss (ms per pixel), the measured error
-    runs (Δn, error, hit rate, PSNR), its best predicted speed-up, and the predicted error and ms at
+    trained (and the profiler's ``note`` on why not, when it gives one), α, λ (with fit quality and
+    R²), t_hit and t_miss (ms per pixel), the measured error runs (Δn, error, hit rate, PSNR), its best predicted speed-up, and the predicted error and ms at
     each trained Δn."""
     node = prof.node(node_id)
     out = {
@@ -72,7 +72,7 @@ def node_details(prof, node_id: str) -> dict:
         "call_chain": [str(c) for c in node.call_chain], "cost": node.cost, "trained": node.trained,
         "alpha": _num(node.alpha), "lam": _num(node.lam), "error_quality": node.error_quality,
         "error_r2": _num(node.error_r2), "t_hit": _num(node.t_hit), "t_miss": _num(node.t_miss),
-        "perf_quality": node.perf_quality,
+        "perf_quality": node.perf_quality, "note": getattr(node, "note", None),
         "runs": [{"period": int(p), "error": _num(e), "hit_rate": _num(h), "psnr": _num(s)}
                  for p, e, h, s in zip(node.periods, node.errors, node.hit_rates,
                                        node.psnrs or [None] * len(node.periods))],
