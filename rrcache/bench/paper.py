@@ -94,8 +94,11 @@ class BenchSettings:
         return _finite(asdict(self))
 
 
-#: chess is ~1.4 s per frame at 640×480: one side-by-side run per selection there
-FULL = BenchSettings(scene_overrides={"chess": {"repeats": 1}})
+#: chess is ~1.4 s per frame at 640×480 (2 threads): its bench runs at 320×240 over the first 60
+#: frames (the steady state of Δn = 50 and 10 frames more), one side-by-side run per selection,
+#: so that the whole bench takes about an hour on a two-core machine; ``rrcache profile`` on the
+#: full session gives its precomputation time at 640×480
+FULL = BenchSettings(scene_overrides={"chess": {"repeats": 1, "resolution": (320, 240), "frames": 60}})
 QUICK = BenchSettings(
     quick=True, resolution=(160, 120), frames=40,
     training={"periods": (2, 8, 16), "timing_frames": 4, "timing_periods": (2, 16), "budget_s": 15.0,
