@@ -74,7 +74,7 @@ def test_every_node_and_selection_is_in_the_page(demo, page):
     assert [s["label"] for s in data["selections"]] == ["e1", "e2", "e3", "e4"]
     for sel in demo.selections:
         block = re.search(rf'<div class="sel" id="sel-{sel.label}".*?</div></div>', page, re.S).group(0)
-        assert f"{sel.predicted_speedup:.3g}×" in block and f"{sel.measured_speedup:.3g}×" in block
+        assert f"{sel.predicted_speedup:.2f}×" in block and f"{sel.measured_speedup:.2f}×" in block
         names = re.findall(r'data-image="(\w+)"', block)
         if sel.node is None:
             assert names == ["original"]

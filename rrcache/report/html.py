@@ -48,6 +48,13 @@ def _f(value, digits: int = 4, suffix: str = "") -> str:
     return f"{value:.{digits}g}{suffix}"
 
 
+def _x(value) -> str:
+    """A speed-up with two decimals (1.995 is 2.00×, not 2×)."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    return f"{float(value):.2f}×"
+
+
 def benefit_color(speedup: Optional[float], best: float) -> str:
     """The source view's mark: grey for no predicted gain (or untrained), then pale yellow to
     green as the node's best predicted speed-up approaches the profile's best.
@@ -71,7 +78,7 @@ def _summary(prof, timing: dict) -> str:
         (_f(prof.mu, 3), "μ (hit rate limit)"),
         (_f(prof.overhead_ms, 3, " ms"), "cache overhead per frame"),
         (_f(prof.pixels, 6), "covered pixels per frame"),
-        ((_f(best.measured_speedup, 3, "×") + f" ({best.label})") if best else "–", "best measured speed-up"),
+        ((_x(best.measured_speedup) + f" ({best.label})") if best else "–", "best measured speed-up"),
         (_f(prof.training_wall_s, 3, " s"), "training time"),
         (_f(timing["median_ms"], 2, " ms"), f"re-selection (median of {timing['repeats']})"),
     ]
@@ -116,7 +123,7 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             if sel.node else "keep the original shader (nothing is predicted faster within this error)")
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
-            ("speed-up", _f(sel.predicted_speedup, 3, "×"), _f(sel.measured_speedup, 3, "×")),
+            ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
             ("PSNR", "", _f(sel.measured_psnr, 3, " dB")),
             ("hit rate", "", _f(sel.hit_rate, 3))]
     table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
@@ -125,8 +132,10 @@ def _selection(prof, sel, shots: FrameShots) -> str:
     figures = []
     for name in CAPTIONS:
         if name in images.arrays:
-            zoom = 2 if images.size[0] <= 200 else 1  # small frames are shown enlarged, pixel for pixel
-            w, h = (v * zoom for v in images.size)
+            # small frames are shown enlarged, up to five of them across a 1280-pixel-wide window
+            w0, h0 = images.size
+            w = max(w0, min(2 * w0, 228))
+            h = round(h0 * w / w0)
             figures.append(f'<figure><img alt="{_e(name)}" data-image="{_e(name)}" width="{w}" height="{h}" '
                            f'src="{images.uri(name)}"><figcaption>{_e(images.caption(name))}</figcaption></figure>')
     frame_note = (f"frame {images.frame} at {images.size[0]}×{images.size[1]}"
