@@ -33,9 +33,12 @@ from dataclasses import dataclass, field
 
 #: nodes saving less than this share of the costliest node's static cost are not trained
 DEFAULT_MIN_SAVING = 0.1
-#: glslViewer built-in uniforms that change from frame to frame when the scene moves
-_PER_FRAME_BUILTINS = ("u_camera", "u_light", "u_lightColor", "u_time", "u_frame", "u_viewMatrix",
-                       "u_projectionMatrix")
+#: glslViewer built-in uniforms that change from frame to frame in every session, and those that
+#: follow the camera or the light (they change when it moves)
+_ALWAYS = ("u_time", "u_frame")
+_CAMERA = ("u_camera", "u_viewMatrix", "u_projectionMatrix")
+_LIGHT_POSITION = ("u_light",)
+_LIGHT_COLOR = ("u_lightColor",)
 _INPUT = re.compile(r"^\s*(?:(?:flat|smooth|noperspective|centroid|invariant)\s+)*in\s+\w+\s+(\w+)\s*;", re.M)
 
 
@@ -64,20 +67,32 @@ def cost_filter(nodes, min_saving: float) -> tuple[list, dict]:
 
 
 def per_frame_uniforms(session) -> set[str]:
-    """The uniforms whose value can differ between frames of ``session``: the per-frame
-    built-ins and every keyframed session uniform."""
-    names = set(_PER_FRAME_BUILTINS)
+    """The uniforms whose value differs between frames of ``session`` (compared at the first,
+    middle and last frames): ``u_time`` and ``u_frame``, the camera's and the light's built-ins
+    when they move or change, and the keyframed session uniforms."""
+    names = set(_ALWAYS)
     frames = int(getattr(session, "frames", 1))
-    if frames > 1:
-        first, last = session.uniform_values(0), session.uniform_values(frames - 1)
-        middle = session.uniform_values(frames // 2)
-        for name, value in first.items():
-            try:
-                same = all(_equal(value, other.get(name)) for other in (middle, last))
-            except (TypeError, ValueError):
-                same = False
-            if not same:
-                names.add(name)
+    if frames < 2:
+        return names
+    probe = (0, frames // 2, frames - 1)
+
+    def varies(get) -> bool:
+        try:
+            values = [get(f) for f in probe]
+        except (AttributeError, TypeError, ValueError):
+            return True  # unknown: assume it changes
+        return not all(_equal(values[0], v) for v in values[1:])
+
+    if varies(lambda f: session.camera_at(f).eye) or varies(lambda f: session.camera_at(f).target):
+        names.update(_CAMERA)
+    if varies(lambda f: session.light_at(f).position):
+        names.update(_LIGHT_POSITION)
+    if varies(lambda f: session.light_at(f).color):
+        names.update(_LIGHT_COLOR)
+    first = session.uniform_values(0)
+    for name in first:
+        if varies(lambda f: session.uniform_values(f).get(name)):
+            names.add(name)
     return names
 
 
