@@ -104,7 +104,7 @@ def _resolve(word: str, n: int, g: str, mat: Optional[tuple[int, int]]) -> Type:
         t = Type({"": "float", "i": "int", "u": "uint"}[g], 4)
     elif word == "gscalar":
         t = Type({"": "float", "i": "int", "u": "uint"}[g])
-    elif word.startswith("gsampler") or word.startswith("gimage"):
+    elif word.startswith(("gsampler", "gimage", "gsubpassInput", "gtexture")):
         t = Type.from_name(g + word[1:])
     else:
         t = Type.from_name(word)
@@ -581,13 +581,22 @@ def _image_specs() -> list[tuple[str, str, str]]:
     return [("image", "", "\n".join(pure)), ("image", "s", "\n".join(writes))]
 
 
+# Vulkan GLSL (GL_KHR_vulkan_glsl) subpass inputs.
+_VULKAN_SPECS = [("texture", "", """
+        gvec4 subpassLoad(gsubpassInput)  gvec4 subpassLoad(gsubpassInputMS, int)
+"""), ("common", "", """
+        genType nonuniformEXT(genType)  genIType nonuniformEXT(genIType)
+        genUType nonuniformEXT(genUType)  genBType nonuniformEXT(genBType)
+        genDType nonuniformEXT(genDType)
+""")]
+
 _SPLIT_RE = re.compile(r"\S+\s+\w+\s*\([^()]*\)")
 
 
 def _build() -> dict[str, list[BuiltinFunction]]:
     table: dict[str, list[BuiltinFunction]] = {}
     seen: set[tuple[str, tuple[Type, ...]]] = set()
-    for category, flags, text in _SPECS + _image_specs():
+    for category, flags, text in _SPECS + _image_specs() + _VULKAN_SPECS:
         for spec in _SPLIT_RE.findall(text):
             for f in _expand(spec, category, "d" in flags, "s" in flags, "l" in flags):
                 # genType specs overlap at size 1 (mod(genType, float) and mod(genType, genType))
@@ -679,6 +688,11 @@ def _variables() -> dict[str, BuiltinVariable]:
         BuiltinVariable("gl_PrimitiveID", i, "in", True),
         BuiltinVariable("gl_Layer", i, "in", True),
         BuiltinVariable("gl_ViewportIndex", i, "in", True),
+        # GL_EXT_device_group / GL_EXT_multiview (and the GL_KHX_ experimental spellings).
+        BuiltinVariable("gl_DeviceIndex", i, "in", True),
+        BuiltinVariable("gl_ViewIndex", i, "in", True),
+        BuiltinVariable("gl_DeviceIndexKHR", i, "in", True),
+        BuiltinVariable("gl_ViewIndexKHR", i, "in", True),
         BuiltinVariable("gl_ClipDistance", f.array_of(_CONSTANTS["gl_MaxClipDistances"]),
                         "in", True),
         BuiltinVariable("gl_CullDistance", f.array_of(_CONSTANTS["gl_MaxCullDistances"]),

@@ -58,7 +58,7 @@ STORAGE_QUALIFIERS = frozenset(
 INTERPOLATION_QUALIFIERS = frozenset({"smooth", "flat", "noperspective"})
 PRECISION_QUALIFIERS = frozenset({"lowp", "mediump", "highp"})
 MEMORY_QUALIFIERS = frozenset({"coherent", "volatile", "restrict", "readonly", "writeonly"})
-OTHER_QUALIFIERS = frozenset({"invariant", "precise"})
+OTHER_QUALIFIERS = frozenset({"invariant", "precise", "nonuniformEXT"})
 QUALIFIER_WORDS: frozenset[str] = (
     STORAGE_QUALIFIERS | INTERPOLATION_QUALIFIERS | PRECISION_QUALIFIERS | MEMORY_QUALIFIERS
     | OTHER_QUALIFIERS

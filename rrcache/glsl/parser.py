@@ -21,6 +21,7 @@ from rrcache.glsl.preprocessor import preprocess
 from rrcache.glsl.lexer import (
     MEMORY_QUALIFIERS, PRECISION_QUALIFIERS, QUALIFIER_WORDS, TYPE_NAMES, Token, lex,
 )
+from rrcache.glsl.types import SOFT_TYPE_NAMES
 
 #: Binary operator precedence (higher binds tighter); all are left-associative.
 BINARY_PRECEDENCE: dict[str, int] = {
@@ -30,7 +31,8 @@ BINARY_PRECEDENCE: dict[str, int] = {
 }
 ASSIGN_OPS = frozenset({"=", "+=", "-=", "*=", "/=", "%=", "<<=", ">>=", "&=", "^=", "|="})
 PREFIX_OPS = frozenset({"+", "-", "!", "~", "++", "--"})
-PARAM_QUALIFIERS = frozenset({"const", "in", "out", "inout", "precise"}) | PRECISION_QUALIFIERS \
+PARAM_QUALIFIERS = frozenset({"const", "in", "out", "inout", "precise", "nonuniformEXT"}) \
+    | PRECISION_QUALIFIERS \
     | MEMORY_QUALIFIERS
 
 #: Deepest nesting of expressions/statements accepted before a ParseError.
@@ -113,10 +115,23 @@ class _Parser:
     def is_struct(self, name: str) -> bool:
         return any(name in s for s in self.scopes)
 
+    def is_soft_type(self, i: int = 0) -> bool:
+        """Whether the identifier at ``i`` is a Vulkan type word (``sampler``, ``texture2D``...)
+        used as a type: only when a declared name follows it (``uniform sampler s;``), so the
+        same word stays a variable or function name elsewhere (``texture(sampler, uv)``)."""
+        t = self.peek(i)
+        return (t.kind == "ident" and t.text in SOFT_TYPE_NAMES and not self.is_struct(t.text)
+                and self.peek(self.skip_dims(i + 1)).kind == "ident")
+
+    def is_named_type(self, i: int = 0) -> bool:
+        """A struct name or a Vulkan type word in type position at ``i``."""
+        t = self.peek(i)
+        return t.kind == "ident" and (self.is_struct(t.text) or self.is_soft_type(i))
+
     def is_type_start(self, i: int = 0) -> bool:
         t = self.peek(i)
         return (t.kind == "keyword" and (t.text in TYPE_NAMES or t.text == "struct")) or (
-            t.kind == "ident" and self.is_struct(t.text))
+            self.is_named_type(i))
 
     def skip_dims(self, i: int) -> int:
         """Index (relative to pos) after any balanced ``[...]`` groups starting at ``i``."""
@@ -138,6 +153,8 @@ class _Parser:
 
     def looks_like_declaration(self) -> bool:
         t = self.tok
+        if t.kind == "keyword" and t.text == "nonuniformEXT" and self.peek().text == "(":
+            return False  # the GL_EXT_nonuniform_qualifier function-like form, an expression
         if t.kind == "keyword" and (t.text in QUALIFIER_WORDS or t.text in (
                 "layout", "precision", "struct", "subroutine")):
             return True
@@ -157,7 +174,7 @@ class _Parser:
 
     def external_declaration(self):
         t = self.tok
-        if t.kind == "ident" and not self.is_struct(t.text) and self.peek().kind == "ident":
+        if t.kind == "ident" and not self.is_named_type() and self.peek().kind == "ident":
             raise self.error(f"unknown type name '{t.text}'",
                              hint="declare the struct before using it, or check the spelling")
         if t.kind == "ident" and self.peek().text == "(":
@@ -178,7 +195,7 @@ class _Parser:
             if self.at(";"):
                 self.advance()
                 return A.QualifierDecl(quals, [], loc=start.loc)
-            if t.kind == "ident" and not self.is_struct(t.text):
+            if t.kind == "ident" and not self.is_named_type():
                 nxt = self.peek()
                 if nxt.text == "{":
                     return self.interface_block(quals, start)
@@ -263,8 +280,7 @@ class _Parser:
         if t.kind == "keyword" and t.text == "struct":
             struct = self.struct_specifier()
             return A.TypeSpecifier(None, struct, self.array_dims(), loc=t.loc)
-        if (t.kind == "keyword" and t.text in TYPE_NAMES) or (
-                t.kind == "ident" and self.is_struct(t.text)):
+        if (t.kind == "keyword" and t.text in TYPE_NAMES) or self.is_named_type():
             self.advance()
             return A.TypeSpecifier(t.text, None, self.array_dims(), loc=t.loc)
         if t.kind == "ident":
@@ -651,6 +667,9 @@ class _Parser:
             self.expect(")", "to close '('")
             self.depth -= 1
             return expr
+        if k == "keyword" and t.text == "nonuniformEXT" and self.peek().text == "(":
+            self.advance()  # nonuniformEXT(expr): marks a value non-uniform, a built-in call
+            return A.Call(t.text, self.call_args(), loc=t.loc)
         if k == "keyword" and t.text in TYPE_NAMES:
             self.advance()
             dims = self.array_dims()

@@ -18,6 +18,7 @@ carrying the file:line:col and, where it helps, a hint.
 from __future__ import annotations
 
 import difflib
+import re
 from dataclasses import dataclass, field
 from typing import Any, Optional, Union
 
@@ -25,7 +26,7 @@ from rrcache.errors import SemanticError, SourceLoc
 from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import BUILTIN_VARIABLES, BuiltinFunction
 from rrcache.glsl.builtins import lookup as builtin_lookup
-from rrcache.glsl.types import BOOL, INT, UINT, FLOAT, DOUBLE, VOID, Type, swizzle
+from rrcache.glsl.types import BOOL, INT, UINT, FLOAT, DOUBLE, VOID, SOFT_TYPE_NAMES, Type, swizzle
 
 __all__ = ["Symbol", "UserFunction", "SemanticInfo", "check", "implicit_conversions"]
 
@@ -175,6 +176,9 @@ class _Checker:
         es = profile == "es" or version in (100, 300, 310, 320)
         self.info = SemanticInfo(version, profile, es)
         self.conv = implicit_conversions(version, es)
+        # GL_ARB/NV_bindless_texture make samplers and images plain values that can be assigned.
+        self.bindless = any(name in ("GL_ARB_bindless_texture", "GL_NV_bindless_texture")
+                            and behavior != "disable" for name, behavior in unit.extensions)
         self.scope = _Scope(None)
         self.global_scope = self.scope
         self.by_name: dict[str, list[UserFunction]] = {}
@@ -233,7 +237,7 @@ class _Checker:
         if name.startswith("gl_") and name not in BUILTIN_VARIABLES:
             raise _err(f"identifier '{name}' is reserved", node,
                        "names starting with 'gl_' belong to GLSL; choose another name")
-        if Type.is_type_name(name):
+        if Type.is_type_name(name) and name not in SOFT_TYPE_NAMES:
             raise _err(f"'{name}' is a type name and cannot be declared as a {what}", node)
 
     def _sizes_unsized_array(self, sym: Symbol) -> bool:
@@ -513,7 +517,7 @@ class _Checker:
         if uf is None:
             if fd.name in self.global_scope.vars or fd.name in self.global_scope.structs:
                 raise _err(f"'{fd.name}' is already declared as a variable or type", fd)
-            if Type.is_type_name(fd.name):
+            if Type.is_type_name(fd.name) and fd.name not in SOFT_TYPE_NAMES:
                 raise _err(f"'{fd.name}' is a type name and cannot name a function", fd)
             uf = UserFunction(fd.name, ret, tuple(ptypes), tuple(pquals))
             self.by_name.setdefault(fd.name, []).append(uf)
@@ -854,7 +858,7 @@ class _Checker:
         vt = self.expr(e.value)
         self.check_lvalue(e.target, e.op)
         if e.op == "=":
-            if tt.contains_opaque():
+            if tt.contains_opaque() and not self.bindless:
                 raise _err(f"cannot assign to a variable of type '{tt}'", e.target)
             if not self.convertible(vt, tt):
                 raise _err(f"cannot assign a value of type '{vt}' to '{tt}'", e,
@@ -948,7 +952,7 @@ class _Checker:
             elem = self._named_type(e.name, e)
             dims = [None if d is None else self.array_size(d) for d in e.array_dims]
             return self.construct(elem.array_of(*dims), args, e)
-        if Type.is_type_name(e.name):
+        if Type.is_type_name(e.name) and e.name not in SOFT_TYPE_NAMES:
             return self.construct(Type.from_name(e.name), args, e)
         found = self.lookup(e.name)
         if isinstance(found, Type):
@@ -1035,6 +1039,10 @@ class _Checker:
         e.kind = "constructor"
         if not args:
             raise _err(f"constructor of '{t}' needs arguments", e)
+        combined = _combined_sampler(t, args) or _bindless_handle(t, args)
+        if combined is not None:
+            e.target = combined
+            return combined
         if t.dims:
             elem = t.element_type()
             n = t.dims[0]
@@ -1061,7 +1069,10 @@ class _Checker:
                                f"member '{fname}' is '{ft}'", e.args[i])
             return t
         if not t.is_basic:
-            raise _err(f"cannot construct a value of type '{t}'", e)
+            m = None if t.base in SOFT_TYPE_NAMES else _SAMPLER_RE.match(t.base)
+            raise _err(f"cannot construct a value of type '{t}'", e,
+                       f"a combined sampler is built as {t.base}({m.group(1)}texture"
+                       f"{m.group(2)}, sampler{m.group(3) or ''})" if m else None)
         for i, a in enumerate(args):
             if not a.is_basic:
                 raise _err(f"argument {i + 1} of the '{t}' constructor has type '{a}'", e.args[i],
@@ -1238,6 +1249,39 @@ def _fold_binary(op: str, a: Any, b: Any, t: Optional[Type]) -> Any:
     elif t is not None and t.base == "int" and isinstance(v, int):
         v = (v + 2**31) % 2**32 - 2**31
     return v
+
+
+_SAMPLER_RE = re.compile(r"^([iu]?)sampler(\d\w*?|Cube\w*?|Buffer)(Shadow)?$")
+
+
+def _combined_sampler(t: Type, args: list[Type]) -> Optional[Type]:
+    """The type built by a Vulkan combined-sampler constructor, or None when ``t(args)`` is not
+    one: ``sampler2D(texture2D, sampler)``, ``sampler2DShadow(texture2D, samplerShadow)`` and
+    the array form ``sampler3D[4](texture3D[4], sampler)``."""
+    m = _SAMPLER_RE.match(t.base)
+    if not m or len(args) != 2 or args[1].dims or args[1].base not in ("sampler", "samplerShadow"):
+        return None
+    tex = args[0]
+    if tex.base != f"{m.group(1)}texture{m.group(2)}" or len(tex.dims) != len(t.dims):
+        return None
+    if t.dims and t.dims[0] is not None and t.dims != tex.dims:
+        return None
+    return t.without_array().array_of(*tex.dims) if t.dims else t
+
+
+def _bindless_handle(t: Type, args: list[Type]) -> Optional[Type]:
+    """GL_ARB_bindless_texture: a sampler or image made from its 64-bit handle, ``sampler2D(uvec2)``,
+    and the handle of one, ``uvec2(sampler2D)``; None for any other constructor."""
+    if len(args) != 1 or t.dims or args[0].dims:
+        return None
+    handle = Type("uint", 2)
+    if t.is_opaque and t.base != "atomic_uint" and t.base not in SOFT_TYPE_NAMES \
+            and args[0] == handle:
+        return t
+    a = args[0]
+    if t == handle and a.is_opaque and a.base != "atomic_uint" and a.base not in SOFT_TYPE_NAMES:
+        return t
+    return None
 
 
 def check(unit: A.TranslationUnit, filename: Optional[str] = None) -> SemanticInfo:

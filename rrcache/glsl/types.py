@@ -33,8 +33,19 @@ OPAQUE_NAMES = frozenset(
     [f"{p}sampler{s}" for p in ("", "i", "u") for s in _SAMPLER_SHAPES]
     + [f"sampler{s}" for s in _SHADOW_SHAPES]
     + [f"{p}image{s}" for p in ("", "i", "u") for s in _IMAGE_SHAPES]
-    + ["atomic_uint", "samplerExternalOES", "sampler", "samplerShadow"]
+    + ["atomic_uint", "samplerExternalOES"]
 )
+
+#: Vulkan GLSL (GL_KHR_vulkan_glsl) opaque types: separate textures and samplers, combined by
+#: constructors such as ``sampler2D(texture2D, sampler)``, and subpass inputs. In OpenGL GLSL these
+#: words are ordinary identifiers (``uniform sampler2D sampler;`` is valid there), so they are
+#: types only where a declaration expects one (see the parser) and may still name variables.
+SOFT_TYPE_NAMES = frozenset(
+    [f"{p}texture{s}" for p in ("", "i", "u") for s in _SAMPLER_SHAPES]
+    + [f"{p}subpassInput{ms}" for p in ("", "i", "u") for ms in ("", "MS")]
+    + ["sampler", "samplerShadow"]
+)
+OPAQUE_NAMES = OPAQUE_NAMES | SOFT_TYPE_NAMES
 
 SWIZZLE_SETS = ("xyzw", "rgba", "stpq")
 
