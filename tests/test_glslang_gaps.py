@@ -154,3 +154,55 @@ def test_bindless_handles_and_sampler_assignment():
 def test_sampler_assignment_needs_the_bindless_extension():
     with pytest.raises(SemanticError, match="cannot assign to a variable of type 'sampler2D'"):
         accepted(BINDLESS.replace("#extension GL_ARB_bindless_texture : require", ""))
+
+
+# ----------------------------------------------------------------- constant expressions
+
+@pytest.mark.parametrize("decls, size_expr, size", [
+    ("const ivec4 v = ivec4(1, 2, 3, 4);", "v.y", 2),                      # swizzle
+    ("const ivec4 v = ivec4(1, 2, 3, 4);", "v[2] + v.w", 7),               # index, vector
+    ("const ivec4 v = ivec4(1, 2, 3, 4); const ivec4 u = ~v;", "u.x + 3", 1),
+    ("", "int(max(2.0, 3.5))", 3),                                         # pure built-in
+    ("", "int(sin(3.2)) + 1", 1),
+    ("const struct S { ivec2 iv; } s = S(ivec2(3, 4));", "s.iv.y", 4),     # struct member
+    ("const mat2 m2 = mat2(2, 3, 4, 5); const mat3 m3 = mat3(m2);", "int(m3[2][2])", 1),
+    ("const mat2 m2 = mat2(2, 3, 4, 5); const mat3 m3 = mat3(m2);", "int(m3[1][0])", 4),
+    ("const vec2 a = vec2(1, 2); const vec3 b = vec3(3, 4, 5);",
+     "uint(mat3(a, b, a, a)[2][2])", 2),                                   # matrix constructor
+    ("const int k[3] = int[3](4, 5, 6);", "k[1] - ivec2(1, 2).y", 3),       # const array
+    ("const ivec3 w = ivec3(2) * ivec3(1, 2, 3) + 1;", "w.z", 7),          # broadcast scalars
+    ("const vec2 p = vec2(3.0, 4.0);", "int(length(p) + dot(p, p))", 30),  # geometric
+])
+def test_constant_array_sizes(decls, size_expr, size):
+    unit = accepted(f"""
+        #version 430
+        {decls}
+        out vec4 color;
+        void main() {{ float sized[{size_expr}]; color = vec4(sized.length()); }}
+    """)
+    sizes = []
+
+    def walk(node):
+        if isinstance(node, A.VariableDecl):
+            for d in node.declarators:
+                if d.name == "sized":
+                    sizes.append(d.array_dims)
+        if isinstance(node, A.Node):
+            for value in vars(node).values():
+                for item in value if isinstance(value, list) else [value]:
+                    if isinstance(item, A.Node):
+                        walk(item)
+    walk(unit)
+    assert len(sizes) == 1
+    from rrcache.glsl.constfold import const_value
+    assert const_value(sizes[0][0]) == size
+
+
+@pytest.mark.parametrize("size_expr", ["v.y", "int(max(u, 2.0))"])
+def test_non_constant_array_sizes_stay_rejected(size_expr):
+    with pytest.raises(SemanticError, match="array size must be a constant integer expression"):
+        accepted(f"""
+            #version 430
+            uniform float u;
+            void main() {{ ivec4 v = ivec4(1); float a[{size_expr}]; }}
+        """)

@@ -26,6 +26,7 @@ from rrcache.errors import SemanticError, SourceLoc
 from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import BUILTIN_VARIABLES, BuiltinFunction
 from rrcache.glsl.builtins import lookup as builtin_lookup
+from rrcache.glsl.constfold import const_value
 from rrcache.glsl.types import BOOL, INT, UINT, FLOAT, DOUBLE, VOID, SOFT_TYPE_NAMES, Type, swizzle
 
 __all__ = ["Symbol", "UserFunction", "SemanticInfo", "check", "implicit_conversions"]
@@ -1100,62 +1101,9 @@ class _Checker:
 
     # ================================================================== constant folding
     def const_value(self, e: A.Expr) -> Any:
-        """The value of a scalar constant expression, or None when it is not one."""
-        if isinstance(e, A.IntLit):
-            return e.value & 0xFFFFFFFF if e.unsigned else e.value
-        if isinstance(e, (A.FloatLit, A.BoolLit)):
-            return e.value
-        if isinstance(e, A.Ident):
-            sym = e.symbol
-            return sym.const_value if sym is not None and sym.kind in ("const", "builtin") \
-                else None
-        if isinstance(e, A.Unary):
-            v = self.const_value(e.operand)
-            if v is None:
-                return None
-            if e.op == "-":
-                return -v
-            if e.op == "+":
-                return v
-            if e.op == "!":
-                return not v
-            if e.op == "~" and isinstance(v, int):
-                return ~v
-            return None
-        if isinstance(e, A.Binary):
-            a = self.const_value(e.left)
-            if a is None:
-                return None
-            b = self.const_value(e.right)
-            if b is None:
-                return None
-            return _fold_binary(e.op, a, b, e.type)
-        if isinstance(e, A.Ternary):
-            c = self.const_value(e.cond)
-            if c is None:
-                return None
-            return self.const_value(e.then if c else e.else_)
-        if isinstance(e, A.Length):
-            t = e.obj.type
-            if t is not None and t.dims:
-                return t.dims[0]
-            if t is not None and (t.is_vector or t.is_matrix):
-                return t.cols or t.size
-            return None
-        if isinstance(e, A.Call) and e.kind == "constructor" and len(e.args) == 1 and \
-                isinstance(e.target, Type) and e.target.is_scalar:
-            v = self.const_value(e.args[0])
-            if v is None:
-                return None
-            base = e.target.base
-            if base == "int":
-                return int(v)
-            if base == "uint":
-                return int(v) & 0xFFFFFFFF
-            if base == "bool":
-                return bool(v)
-            return float(v)
-        return None
+        """The value of a constant expression (scalars, vectors, matrices, arrays, structs; see
+        :mod:`rrcache.glsl.constfold`), or None when it is not one."""
+        return const_value(e)
 
     # ================================================================== hints
     def _visible_names(self, types: bool = False, functions: bool = False) -> list[str]:
@@ -1198,57 +1146,6 @@ class _Checker:
         if sym.kind == "const":
             return "remove 'const' from its declaration to modify it"
         return None
-
-
-def _fold_binary(op: str, a: Any, b: Any, t: Optional[Type]) -> Any:
-    integer = isinstance(a, int) and isinstance(b, int) and not isinstance(a, bool)
-    try:
-        if op == "+":
-            v = a + b
-        elif op == "-":
-            v = a - b
-        elif op == "*":
-            v = a * b
-        elif op == "/":
-            if integer:
-                if b == 0:
-                    return None
-                q = abs(a) // abs(b)
-                v = q if (a >= 0) == (b >= 0) else -q
-            else:
-                v = a / b
-        elif op == "%":
-            if not integer or b == 0:
-                return None
-            v = a - b * (abs(a) // abs(b) * (1 if (a >= 0) == (b >= 0) else -1))
-        elif op == "<<":
-            v = a << b
-        elif op == ">>":
-            v = a >> b
-        elif op == "&":
-            v = a & b
-        elif op == "|":
-            v = a | b
-        elif op == "^":
-            v = a ^ b
-        elif op in ("<", ">", "<=", ">=", "==", "!="):
-            v = {"<": a < b, ">": a > b, "<=": a <= b, ">=": a >= b, "==": a == b,
-                 "!=": a != b}[op]
-        elif op == "&&":
-            v = a and b
-        elif op == "||":
-            v = a or b
-        elif op == "^^":
-            v = bool(a) != bool(b)
-        else:
-            return None
-    except (TypeError, ZeroDivisionError, ValueError, OverflowError):
-        return None
-    if t is not None and t.base == "uint" and isinstance(v, int):
-        v &= 0xFFFFFFFF
-    elif t is not None and t.base == "int" and isinstance(v, int):
-        v = (v + 2**31) % 2**32 - 2**31
-    return v
 
 
 _SAMPLER_RE = re.compile(r"^([iu]?)sampler(\d\w*?|Cube\w*?|Buffer)(Shadow)?$")
