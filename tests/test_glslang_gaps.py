@@ -206,3 +206,27 @@ def test_non_constant_array_sizes_stay_rejected(size_expr):
             uniform float u;
             void main() {{ ivec4 v = ivec4(1); float a[{size_expr}]; }}
         """)
+
+
+# ----------------------------------------------------------------- invalid neighbours
+
+def test_embedded_struct_definition_is_rejected():
+    with pytest.raises(SemanticError, match="struct 'Inner' is defined inside struct 'Outer'"):
+        accepted("""
+            struct Outer { float x; struct Inner { int a; } inner; };
+            uniform Outer o;
+            void main() { gl_FragColor = vec4(o.x); }
+        """)
+
+
+def test_opaque_block_member_is_rejected_without_bindless():
+    src = """
+        #version 450
+        {ext}
+        layout(std140) uniform Material {{ vec4 tint; sampler2D albedo; }};
+        out vec4 color;
+        void main() {{ color = tint * texture(albedo, vec2(0.5)); }}
+    """
+    with pytest.raises(SemanticError, match="block member of type 'sampler2D' is not allowed"):
+        accepted(src.format(ext=""))
+    accepted(src.format(ext="#extension GL_ARB_bindless_texture : require"))

@@ -298,6 +298,12 @@ class _Checker:
         fields: list[tuple[str, Type]] = []
         seen: set[str] = set()
         for member in st.members:
+            inner = member.type.spec.struct
+            if inner is not None:
+                raise _err(f"struct '{inner.name or '<anonymous>'}' is defined inside struct "
+                           f"'{st.name or '<anonymous>'}'", member,
+                           "GLSL has no embedded struct definitions; declare the inner struct "
+                           "first and use its name")
             mtype = self.type_of_spec(member.type.spec)
             if mtype.is_void:
                 raise _err("a struct member cannot be void", member)
@@ -484,6 +490,10 @@ class _Checker:
         fields: list[tuple[str, Type]] = []
         for member in block.members:
             mtype = self.type_of_spec(member.type.spec)
+            if mtype.contains_opaque() and not self.bindless:
+                raise _err(f"block member of type '{mtype}' is not allowed", member,
+                           "samplers, images and atomic counters are declared as uniforms "
+                           "outside blocks")
             for d in member.declarators:
                 ft = mtype.array_of(*self.array_dims(d.array_dims)) if d.array_dims else mtype
                 fields.append((d.name, ft))
