@@ -230,3 +230,42 @@ def test_opaque_block_member_is_rejected_without_bindless():
     with pytest.raises(SemanticError, match="block member of type 'sampler2D' is not allowed"):
         accepted(src.format(ext=""))
     accepted(src.format(ext="#extension GL_ARB_bindless_texture : require"))
+
+
+# ----------------------------------------------------------------- sparse texture lookups
+
+def test_sparse_texture_and_lod_clamp_builtins():
+    unit = accepted("""
+        #version 450
+        #extension GL_ARB_sparse_texture2 : enable
+        #extension GL_ARB_sparse_texture_clamp : enable
+        uniform sampler2D tex;
+        uniform sampler2DShadow depth;
+        uniform isampler2DArray layers;
+        in vec2 uv;
+        out vec4 color;
+        void main() {
+            vec4 texel = vec4(0.0);
+            ivec4 itexel = ivec4(0);
+            float d = 0.0;
+            int code = sparseTextureARB(tex, uv, texel, 1.0);
+            code |= sparseTextureGatherARB(layers, vec3(uv, 1.0), itexel, 2);
+            code |= sparseTextureLodARB(depth, vec3(uv, 0.5), 0.0, d);
+            code |= sparseTextureClampARB(tex, uv, 2.0, texel);
+            texel += textureGradOffsetClampARB(tex, uv, uv, uv, ivec2(1), 3.0);
+            color = sparseTexelsResidentARB(code) ? texel + vec4(itexel) + d : vec4(0.0);
+        }
+    """)
+    sparse = calls(unit, "sparseTextureARB")[0]
+    assert sparse.type == Type("int") and sparse.target.out_params == (2,)
+    assert sparse.target.derivative  # an implicit-LOD lookup, like texture()
+
+
+def test_sparse_lookup_needs_its_out_texel():
+    with pytest.raises(SemanticError, match="no matching overload for 'sparseTextureARB"):
+        accepted("""
+            #version 450
+            uniform sampler2D tex;
+            out vec4 color;
+            void main() { color = vec4(sparseTextureARB(tex, vec2(0.5))); }
+        """)

@@ -592,11 +592,47 @@ _VULKAN_SPECS = [("texture", "", """
 
 _SPLIT_RE = re.compile(r"\S+\s+\w+\s*\([^()]*\)")
 
+# GL_ARB_sparse_texture2 / GL_ARB_sparse_texture_clamp, derived from the core lookups: the sparse
+# form returns a residency code and writes the texel to an ``out`` argument placed before the
+# optional bias or component; the clamp forms take a ``float lodClamp`` at the same place.
+_SPARSE_BASES = ("texture", "textureLod", "textureOffset", "textureLodOffset", "textureGrad",
+                 "textureGradOffset", "texelFetch", "texelFetchOffset", "textureGather",
+                 "textureGatherOffset", "textureGatherOffsets")
+_CLAMP_BASES = ("texture", "textureOffset", "textureGrad", "textureGradOffset")
+
+
+def _with_extra(params: str, extra: str) -> str:
+    """``params`` with ``extra`` inserted before the optional ``[, ...]`` tail (or appended)."""
+    m = re.search(r"\[\s*,", params)
+    return f"{params[:m.start()].rstrip()}, {extra} {params[m.start():]}" if m else \
+        f"{params}, {extra}"
+
+
+def _sparse_specs() -> list[tuple[str, str, str]]:
+    out = [("texture", "", "bool sparseTexelsResidentARB(int)")]
+    for category, flags, text in _SPECS:
+        if category != "texture" or "l" in flags:
+            continue
+        lines = []
+        for spec in _SPLIT_RE.findall(text):
+            ret, name, params = _SPEC_RE.match(spec).groups()
+            if "samplerExternalOES" in params or "Buffer" in params or "1D" in params:
+                continue
+            cap = name[0].upper() + name[1:]
+            if name in _SPARSE_BASES:
+                lines.append(f"int sparse{cap}ARB({_with_extra(params, 'out ' + ret)})")
+            if name in _CLAMP_BASES:
+                lines.append(f"{ret} {name}ClampARB({_with_extra(params, 'float')})")
+                lines.append(f"int sparse{cap}ClampARB({_with_extra(params, 'float, out ' + ret)})")
+        out.append((category, flags, "\n".join(lines)))
+    return out
+
+
 
 def _build() -> dict[str, list[BuiltinFunction]]:
     table: dict[str, list[BuiltinFunction]] = {}
     seen: set[tuple[str, tuple[Type, ...]]] = set()
-    for category, flags, text in _SPECS + _image_specs() + _VULKAN_SPECS:
+    for category, flags, text in _SPECS + _image_specs() + _VULKAN_SPECS + _sparse_specs():
         for spec in _SPLIT_RE.findall(text):
             for f in _expand(spec, category, "d" in flags, "s" in flags, "l" in flags):
                 # genType specs overlap at size 1 (mod(genType, float) and mod(genType, genType))
