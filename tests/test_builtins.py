@@ -66,7 +66,9 @@ def test_swizzles():
 # ----------------------------------------------------------------------------- function families
 
 def test_gentype_expansion_shares_one_size():
-    assert sigs("sin") == {"sin(float)", "sin(vec2)", "sin(vec3)", "sin(vec4)"}
+    assert sigs("sin") == {"sin(float)", "sin(vec2)", "sin(vec3)", "sin(vec4)",
+                           # explicit half floats (GL_AMD_gpu_shader_half_float)
+                           "sin(float16_t)", "sin(f16vec2)", "sin(f16vec3)", "sin(f16vec4)"}
     assert "mix(vec3, vec3, float)" in sigs("mix")
     assert "mix(vec3, vec3, bvec3)" in sigs("mix")
     assert "mix(vec3, vec2, float)" not in sigs("mix")

@@ -269,3 +269,56 @@ def test_sparse_lookup_needs_its_out_texel():
             out vec4 color;
             void main() { color = vec4(sparseTextureARB(tex, vec2(0.5))); }
         """)
+
+
+# ----------------------------------------------------------------- explicit arithmetic types
+
+def test_int64_types_literals_conversions_and_builtins():
+    unit = accepted("""
+        #version 450
+        #extension GL_ARB_gpu_shader_int64 : enable
+        uniform ivec2 iv;
+        out vec4 color;
+        void main() {
+            int64_t big = 0x7FFFFFFFFFFFFFFFl - 1l;
+            uint64_t ubig = 18446744073709551615ul;
+            i64vec2 v = iv;                        // int -> int64 implicitly
+            u64vec2 u = v;                         // int64 -> uint64 implicitly
+            v = max(v, i64vec2(-1)) + abs(v);
+            bool less = lessThan(u, u64vec2(ubig)).x;
+            double d = int64BitsToDouble(big) + double(u.y);
+            ivec2 halves = unpackInt2x32(packInt2x32(iv));
+            color = vec4(float(d), less ? 1.0 : 0.0, vec2(halves));
+        }
+    """)
+    assert calls(unit, "packInt2x32")[0].type == Type("int64_t")
+    assert calls(unit, "max")[0].type == Type("int64_t", 2)
+
+
+def test_float16_types_literals_and_builtins():
+    unit = accepted("""
+        #version 450
+        #extension GL_AMD_gpu_shader_half_float : enable
+        in f16vec3 n;
+        out vec4 color;
+        void main() {
+            const float16_t h = 0.5hf;
+            f16vec3 m = normalize(n) * h + f16vec3(0.25HF);
+            f16mat3 r = f16mat3(1.0hf);
+            float l = length(r * m) + dFdx(m.x);   // float16_t -> float implicitly
+            color = vec4(l, vec3(m));
+        }
+    """)
+    assert calls(unit, "normalize")[0].type == Type("float16_t", 3)
+    assert calls(unit, "dFdx")[0].target.derivative
+
+
+@pytest.mark.parametrize("src, message", [
+    ("int a = 4294967296;", "does not fit in 32 bits"),
+    ("int64_t a = 18446744073709551616l;", "does not fit in 64 bits"),
+    ("int a = 1l;", "cannot initialize 'a' of type 'int' with a value of type 'int64_t'"),
+    ("float16_t h = 1.0;", "cannot initialize 'h' of type 'float16_t'"),
+])
+def test_explicit_types_are_not_narrowed_implicitly(src, message):
+    with pytest.raises(GLSLError, match=message):
+        accepted(f"#version 450\nvoid main() {{ {src} }}")

@@ -13,7 +13,7 @@ the front-end converts them). Each signature records whether it needs screen-spa
 (atomics, image stores, memory barriers, ``out`` parameters); the analysis relies on both.
 
 >>> [str(f) for f in lookup("cross")]
-['vec3 cross(vec3, vec3)', 'dvec3 cross(dvec3, dvec3)']
+['vec3 cross(vec3, vec3)', 'dvec3 cross(dvec3, dvec3)', 'f16vec3 cross(f16vec3, f16vec3)']
 >>> lookup("texture2D")[0].derivative
 True
 >>> BUILTIN_VARIABLES["gl_FragCoord"].read_only
@@ -81,7 +81,8 @@ class BuiltinVariable:
 # ----------------------------------------------------------------------------- spec expansion
 
 _GEN = {"genType": "float", "genDType": "double", "genIType": "int", "genUType": "uint",
-        "genBType": "bool"}
+        "genBType": "bool", "genF16Type": "float16_t", "genI64Type": "int64_t",
+        "genU64Type": "uint64_t"}
 _VEC = {"vec": "float", "dvec": "double", "ivec": "int", "uvec": "uint", "bvec": "bool"}
 _SPEC_RE = re.compile(r"^\s*(\S+)\s+(\w+)\s*\((.*)\)\s*$")
 _MAT_SHAPES = [(c, r) for c in (2, 3, 4) for r in (2, 3, 4)]
@@ -585,6 +586,13 @@ def _image_specs() -> list[tuple[str, str, str]]:
 _VULKAN_SPECS = [("texture", "", """
         gvec4 subpassLoad(gsubpassInput)  gvec4 subpassLoad(gsubpassInputMS, int)
 """), ("common", "", """
+        genI64Type doubleBitsToInt64(genDType)  genU64Type doubleBitsToUint64(genDType)
+        genDType int64BitsToDouble(genI64Type)  genDType uint64BitsToDouble(genU64Type)
+"""), ("packing", "", """
+        int64_t packInt2x32(ivec2)  ivec2 unpackInt2x32(int64_t)
+        uint64_t packUint2x32(uvec2)  uvec2 unpackUint2x32(uint64_t)
+        uint packFloat2x16(f16vec2)  f16vec2 unpackFloat2x16(uint)
+"""), ("common", "", """
         genType nonuniformEXT(genType)  genIType nonuniformEXT(genIType)
         genUType nonuniformEXT(genUType)  genBType nonuniformEXT(genBType)
         genDType nonuniformEXT(genDType)
@@ -629,6 +637,55 @@ def _sparse_specs() -> list[tuple[str, str, str]]:
 
 
 
+# Explicit arithmetic types: the float built-ins also take float16_t values, and the integer
+# arithmetic and comparisons 64-bit integers (GL_AMD_gpu_shader_half_float,
+# GL_ARB_gpu_shader_int64, GL_EXT_shader_explicit_arithmetic_types). Derived from the float and
+# int overloads; interpolateAtOffset keeps its vec2 offset.
+_FLOAT16_CATEGORIES = frozenset({"trig", "exponential", "common", "geometric", "matrix",
+                                 "relational", "derivative", "interpolation"})
+_INT64_NAMES = frozenset({"abs", "sign", "min", "max", "clamp", "mix", "lessThan",
+                          "lessThanEqual", "greaterThan", "greaterThanEqual", "equal",
+                          "notEqual", "nonuniformEXT"})
+_FLOAT16_BASES = {"float": "float16_t"}
+_INT64_BASES = {"int": "int64_t", "uint": "uint64_t"}
+
+
+def _rebase(t: Type, bases: dict[str, str]) -> Type:
+    if t.base not in bases:
+        return t
+    return Type(bases[t.base], t.size, t.cols, t.rows, t.dims)
+
+
+def _retyped(f: BuiltinFunction, bases: dict[str, str]) -> Optional[BuiltinFunction]:
+    """``f`` with the base types in ``bases`` replaced, or None when nothing changes."""
+    keep = (1,) if f.name == "interpolateAtOffset" else ()
+    params = tuple(p if i in keep else _rebase(p, bases) for i, p in enumerate(f.params))
+    if params == f.params or any(p.is_opaque for p in params):
+        return None
+    return BuiltinFunction(f.name, _rebase(f.return_type, bases), params, f.qualifiers,
+                           f.category, f.derivative, f.side_effects, f.legacy)
+
+
+def _retyped_all(overloads: list[BuiltinFunction], bases: dict[str, str]
+                 ) -> list[BuiltinFunction]:
+    out = [_retyped(f, bases) for f in overloads]
+    return [f for f in out if f is not None]
+
+
+def _add_explicit_type_overloads(table: dict[str, list[BuiltinFunction]],
+                                 seen: set[tuple[str, tuple[Type, ...]]]) -> None:
+    for name, overloads in list(table.items()):
+        derived: list[BuiltinFunction] = []
+        if name in _INT64_NAMES:
+            derived += _retyped_all(overloads, _INT64_BASES)
+        derived += _retyped_all([f for f in overloads if f.category in _FLOAT16_CATEGORIES],
+                                _FLOAT16_BASES)
+        for f in derived:
+            if (f.name, f.params) not in seen:
+                seen.add((f.name, f.params))
+                overloads.append(f)
+
+
 def _build() -> dict[str, list[BuiltinFunction]]:
     table: dict[str, list[BuiltinFunction]] = {}
     seen: set[tuple[str, tuple[Type, ...]]] = set()
@@ -647,6 +704,7 @@ def _build() -> dict[str, list[BuiltinFunction]]:
                 "outerProduct", mat, (Type(base, r), Type(base, c)), ("in", "in"), "matrix"))
             table.setdefault("transpose", []).append(BuiltinFunction(
                 "transpose", Type(base, 1, r, c), (mat,), ("in",), "matrix"))
+    _add_explicit_type_overloads(table, {(f.name, f.params) for fs in table.values() for f in fs})
     return table
 
 
@@ -656,8 +714,8 @@ BUILTIN_FUNCTIONS: dict[str, list[BuiltinFunction]] = _build()
 def lookup(name: str) -> list[BuiltinFunction]:
     """Every overload of built-in function ``name`` (empty when there is none).
 
-    >>> len(lookup("sin")), len(lookup("no_such_function"))
-    (4, 0)
+    >>> len(lookup("sin")), len(lookup("no_such_function"))  # float and float16_t, sizes 1-4
+    (8, 0)
     """
     return BUILTIN_FUNCTIONS.get(name, [])
 

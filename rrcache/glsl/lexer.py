@@ -48,6 +48,10 @@ TYPE_NAMES: frozenset[str] = frozenset(
         "sampler2DRectShadow", "samplerCubeShadow", "samplerCubeArrayShadow",
     }
     | _expand(",i,u", " ".join("image" + s for s in _SAMPLER_STEMS.split()))
+    # explicit arithmetic types (GL_ARB_gpu_shader_int64, GL_AMD_gpu_shader_half_float...)
+    | {"float16_t", "int64_t", "uint64_t"}
+    | _expand("f16,i64,u64", "vec2 vec3 vec4")
+    | _expand("f16", "mat2 mat3 mat4 mat2x2 mat2x3 mat2x4 mat3x2 mat3x3 mat3x4 mat4x2 mat4x3 mat4x4")
 )
 
 #: Qualifier words.
@@ -100,10 +104,10 @@ _ES_SINCE = {
     "layout": 300, "uint": 300, "uvec2": 300, "uvec3": 300, "uvec4": 300, "case": 300,
 }
 
-_INT_RE = re.compile(r"(?:0[xX](?P<hex>[0-9a-fA-F]+)|(?P<dec>[0-9]+))(?P<u>[uU]?)\Z")
+_INT_RE = re.compile(r"(?:0[xX](?P<hex>[0-9a-fA-F]+)|(?P<dec>[0-9]+))(?P<u>[uU]?)(?P<l>[lL]?)\Z")
 _FLOAT_RE = re.compile(
     r"(?P<num>(?:[0-9]+\.[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[0-9]+[eE][+-]?[0-9]+)"
-    r"(?P<suffix>f|F|lf|LF)?\Z"
+    r"(?P<suffix>f|F|lf|LF|hf|HF)?\Z"
 )
 
 _PUNCTUATORS = frozenset(
@@ -153,9 +157,10 @@ def _number(tok: Any) -> Token:
                 value = int(digits, 8)
             else:
                 value = int(digits)
-        if value > 0xFFFFFFFF:
+        bits = 64 if m.group("l") else 32  # 1l, 2ul: 64-bit (GL_ARB_gpu_shader_int64)
+        if value >= 1 << bits:
             raise ParseError(
-                f"integer literal '{text}' does not fit in 32 bits", tok.loc,
+                f"integer literal '{text}' does not fit in {bits} bits", tok.loc,
                 "use a float literal or a smaller value",
             )
         return Token("uint" if m.group("u") else "int", text, value, tok.loc)

@@ -41,9 +41,9 @@ def _literal_ok(text: Optional[str], value, is_float: bool) -> bool:
         return False
     try:
         if is_float:
-            stripped = text.rstrip("fFlL")
+            stripped = text.rstrip("fFlLhH")
             return float(stripped) == value
-        stripped = text.rstrip("uU")
+        stripped = text.rstrip("uUlL")
         if stripped[:2].lower() == "0x":
             return int(stripped, 16) == value
         if len(stripped) > 1 and stripped[0] == "0":
@@ -96,7 +96,7 @@ def _expr(e: A.Expr) -> str:
     if isinstance(e, A.Ident):
         return e.name
     if isinstance(e, A.IntLit):
-        if _literal_ok(e.text, e.value, False) and (e.text[-1] in "uU") == e.unsigned:
+        if _literal_ok(e.text, e.value, False) and ("u" in e.text[-2:].lower()) == e.unsigned:
             return e.text
         return f"{e.value}{'u' if e.unsigned else ''}"
     if isinstance(e, A.FloatLit):

@@ -27,7 +27,8 @@ from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import BUILTIN_VARIABLES, BuiltinFunction
 from rrcache.glsl.builtins import lookup as builtin_lookup
 from rrcache.glsl.constfold import const_value
-from rrcache.glsl.types import BOOL, INT, UINT, FLOAT, DOUBLE, VOID, SOFT_TYPE_NAMES, Type, swizzle
+from rrcache.glsl.types import (BOOL, DOUBLE, FLOAT, FLOAT16, INT, INT64, INTEGER_BASES,
+                                SOFT_TYPE_NAMES, UINT, UINT64, VOID, Type, swizzle)
 
 __all__ = ["Symbol", "UserFunction", "SemanticInfo", "check", "implicit_conversions"]
 
@@ -123,7 +124,11 @@ class SemanticInfo:
 
 _CONV_130 = {("int", "float"): 2, ("uint", "float"): 2}
 _CONV_400 = {("int", "uint"): 2, ("int", "float"): 2, ("uint", "float"): 2,
-             ("float", "double"): 1, ("int", "double"): 3, ("uint", "double"): 3}
+             ("float", "double"): 1, ("int", "double"): 3, ("uint", "double"): 3,
+             # explicit arithmetic types (GL_ARB_gpu_shader_int64, half floats)
+             ("int", "int64_t"): 1, ("uint", "uint64_t"): 1, ("int", "uint64_t"): 2,
+             ("int64_t", "uint64_t"): 2, ("int64_t", "double"): 3, ("uint64_t", "double"): 3,
+             ("float16_t", "float"): 1, ("float16_t", "double"): 2}
 
 
 def implicit_conversions(version: int, es: bool) -> dict[tuple[str, str], int]:
@@ -740,9 +745,13 @@ class _Checker:
         return t
 
     def _intlit(self, e: A.IntLit) -> Type:
+        if e.text and e.text[-1] in "lL":  # 64-bit literal: 1l, 2ul
+            return UINT64 if e.unsigned else INT64
         return UINT if e.unsigned else INT
 
     def _floatlit(self, e: A.FloatLit) -> Type:
+        if e.text and e.text[-2:] in ("hf", "HF"):  # half-float literal
+            return FLOAT16
         return DOUBLE if e.double else FLOAT
 
     def _boollit(self, e: A.BoolLit) -> Type:
@@ -838,7 +847,7 @@ class _Checker:
         if base is None:
             raise _err(f"'{op}' cannot be applied to '{lt}' and '{rt}'", node,
                        self._conversion_hint(lt, rt))
-        if op in ("%", "&", "|", "^") and base not in ("int", "uint"):
+        if op in ("%", "&", "|", "^") and base not in INTEGER_BASES:
             raise _err(f"'{op}' needs integer operands, not '{lt}' and '{rt}'", node)
         l = lt.with_base(base) if lt.base != base else lt
         r = rt.with_base(base) if rt.base != base else rt

@@ -18,8 +18,14 @@ from typing import Optional
 
 from rrcache.errors import SemanticError, SourceLoc
 
-SCALAR_BASES = ("float", "double", "int", "uint", "bool")
-_VEC_PREFIX = {"float": "vec", "double": "dvec", "int": "ivec", "uint": "uvec", "bool": "bvec"}
+# The last three are the explicit arithmetic types of GL_ARB_gpu_shader_int64,
+# GL_AMD_gpu_shader_half_float and GL_EXT_shader_explicit_arithmetic_types.
+SCALAR_BASES = ("float", "double", "int", "uint", "bool", "float16_t", "int64_t", "uint64_t")
+FLOAT_BASES = frozenset({"float", "double", "float16_t"})
+INTEGER_BASES = frozenset({"int", "uint", "int64_t", "uint64_t"})
+_VEC_PREFIX = {"float": "vec", "double": "dvec", "int": "ivec", "uint": "uvec", "bool": "bvec",
+               "float16_t": "f16vec", "int64_t": "i64vec", "uint64_t": "u64vec"}
+_MAT_PREFIX = {"float": "mat", "double": "dmat", "float16_t": "f16mat"}
 _PREFIX_BASE = {v: k for k, v in _VEC_PREFIX.items()}
 
 # Opaque types: samplers and images in their float/int/uint flavours, plus atomic counters.
@@ -170,17 +176,17 @@ class Type:
     @property
     def is_numeric(self) -> bool:
         """Scalar, vector or matrix of a non-bool base (not an array)."""
-        return self.base in ("float", "double", "int", "uint") and not self.dims
+        return (self.base in FLOAT_BASES or self.base in INTEGER_BASES) and not self.dims
 
     @property
     def is_float(self) -> bool:
-        """Base ``float`` or ``double`` (scalar, vector or matrix; not an array)."""
-        return self.base in ("float", "double") and not self.dims
+        """Base ``float``, ``double`` or ``float16_t`` (scalar, vector or matrix; not an array)."""
+        return self.base in FLOAT_BASES and not self.dims
 
     @property
     def is_integer(self) -> bool:
-        """Base ``int`` or ``uint`` (scalar or vector; not an array)."""
-        return self.base in ("int", "uint") and not self.dims
+        """Base ``int``, ``uint`` or a 64-bit integer (scalar or vector; not an array)."""
+        return self.base in INTEGER_BASES and not self.dims
 
     @property
     def is_bool(self) -> bool:
@@ -233,7 +239,7 @@ class Type:
         if self.base == "struct":
             head = self.struct_name or "<anonymous struct>"
         elif self.cols:
-            head = ("d" if self.base == "double" else "") + f"mat{self.cols}x{self.rows}"
+            head = f"{_MAT_PREFIX[self.base]}{self.cols}x{self.rows}"
         elif self.size > 1:
             head = f"{_VEC_PREFIX[self.base]}{self.size}"
         else:
@@ -242,8 +248,8 @@ class Type:
 
     def short_name(self) -> str:
         """Like :meth:`glsl_name` but square matrices as ``mat3`` (for messages)."""
-        if self.cols and self.cols == self.rows and self.base in ("float", "double"):
-            head = ("d" if self.base == "double" else "") + f"mat{self.cols}"
+        if self.cols and self.cols == self.rows and self.base in _MAT_PREFIX:
+            head = f"{_MAT_PREFIX[self.base]}{self.cols}"
             return head + "".join(f"[{'' if d is None else d}]" for d in self.dims)
         return self.glsl_name()
 
@@ -260,7 +266,7 @@ def _build_type_table() -> dict[str, Type]:
     for base, prefix in _VEC_PREFIX.items():
         for n in (2, 3, 4):
             table[f"{prefix}{n}"] = Type(base, n)
-    for base, prefix in (("float", "mat"), ("double", "dmat")):
+    for base, prefix in _MAT_PREFIX.items():
         for c in (2, 3, 4):
             table[f"{prefix}{c}"] = Type(base, 1, c, c)
             for r in (2, 3, 4):
@@ -274,7 +280,8 @@ _BUILTIN_TYPES = _build_type_table()
 BUILTIN_TYPE_NAMES = frozenset(_BUILTIN_TYPES)
 
 VOID = Type("void")
-FLOAT, DOUBLE, INT, UINT, BOOL = (Type(b) for b in SCALAR_BASES)
+FLOAT, DOUBLE, INT, UINT, BOOL = (Type(b) for b in ("float", "double", "int", "uint", "bool"))
+FLOAT16, INT64, UINT64 = Type("float16_t"), Type("int64_t"), Type("uint64_t")
 VEC2, VEC3, VEC4 = (Type("float", n) for n in (2, 3, 4))
 DVEC2, DVEC3, DVEC4 = (Type("double", n) for n in (2, 3, 4))
 IVEC2, IVEC3, IVEC4 = (Type("int", n) for n in (2, 3, 4))
