@@ -322,3 +322,16 @@ def test_float16_types_literals_and_builtins():
 def test_explicit_types_are_not_narrowed_implicitly(src, message):
     with pytest.raises(GLSLError, match=message):
         accepted(f"#version 450\nvoid main() {{ {src} }}")
+
+
+# ----------------------------------------------------------------- version-dependent type words
+
+def test_uint_is_an_ordinary_name_before_it_became_a_type():
+    accepted("""
+        #version 100
+        precision mediump float;
+        int uint;
+        void main() { uint = 2; gl_FragColor = vec4(float(uint)); }
+    """)
+    with pytest.raises(GLSLError, match="keyword"):
+        accepted("#version 300 es\nprecision mediump float;\nint uint;\nvoid main() {}")

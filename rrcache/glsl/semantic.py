@@ -27,6 +27,7 @@ from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import BUILTIN_VARIABLES, BuiltinFunction
 from rrcache.glsl.builtins import lookup as builtin_lookup
 from rrcache.glsl.constfold import const_value
+from rrcache.glsl.lexer import is_keyword
 from rrcache.glsl.types import (BOOL, DOUBLE, FLOAT, FLOAT16, INT, INT64, INTEGER_BASES,
                                 SOFT_TYPE_NAMES, UINT, UINT64, VOID, Type, swizzle)
 
@@ -243,7 +244,10 @@ class _Checker:
         if name.startswith("gl_") and name not in BUILTIN_VARIABLES:
             raise _err(f"identifier '{name}' is reserved", node,
                        "names starting with 'gl_' belong to GLSL; choose another name")
-        if Type.is_type_name(name) and name not in SOFT_TYPE_NAMES:
+        if Type.is_type_name(name) and name not in SOFT_TYPE_NAMES and is_keyword(
+                name, self.info.version, "es" if self.info.es else self.info.profile):
+            # (a type word that is not a keyword in this version, such as 'uint' in GLSL ES
+            # 1.00, is an ordinary name there)
             raise _err(f"'{name}' is a type name and cannot be declared as a {what}", node)
 
     def _sizes_unsized_array(self, sym: Symbol) -> bool:
