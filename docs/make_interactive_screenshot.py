@@ -81,8 +81,13 @@ def main() -> None:
             browser.evaluate("window.jupyterapp.commands.execute('notebook:run-all-cells')")
             _wait(browser, "document.querySelectorAll('.widget-slider').length > 0 &&"
                            " document.querySelectorAll('.jp-OutputArea-output img').length >= 4", 300, "the widget")
-            _wait(browser, "" + panel + ".sessionContext.session.kernel.status === 'idle'",
-                  300, "the kernel to finish")
+            # the slider snaps a value set from code to its step and sends it back: the kernel then
+            # re-selects once more; wait until that is drawn too
+            for _ in range(2):
+                _wait(browser, f"{panel}.sessionContext.session.kernel.status === 'idle' &&"
+                               " !document.body.innerText.includes('rendering and measuring')", 300,
+                      "the kernel to finish")
+                time.sleep(3)
             browser.evaluate("Array.from(document.querySelectorAll('.jp-toast-button, .Toastify button'))"
                              ".filter(function (b) { return b.textContent.trim() === 'No'; })"
                              ".forEach(function (b) { b.click(); })")

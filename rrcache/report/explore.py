@@ -18,14 +18,17 @@ payload and the hit/miss map; a button writes the chosen shader files.
 """
 from __future__ import annotations
 
+import asyncio
 import html
 import math
+import threading
 import time
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
 
+from rrcache.errors import RRCacheError
 from rrcache.report.data import read_source, selection_timing  # noqa: F401 (selection_timing re-exported)
 from rrcache.report.images import CAPTIONS, FrameShots  # noqa: F401 (FrameShots re-exported)
 
@@ -270,14 +273,45 @@ class Explorer:
         self.widget = w.VBox([w.HBox([self.slider, self.button]), self.summary, self.frames, self.source,
                               self.status])
         self.choice = None
+        self.error: Optional[BaseException] = None
         self.images = None
         self.render_ms: Optional[float] = None
         self.select_ms: Optional[float] = None
         self.measured: Optional[dict] = None
         self.written: list = []
-        self.slider.observe(lambda change: self.update(change["new"]), names="value")
-        self.button.on_click(lambda _: self.write_files())
+        # GL work must run on the thread that holds the GL context (the one building the widget);
+        # a frontend may deliver widget events on another thread (JupyterLab's kernel subshells)
+        self._thread = threading.current_thread()
+        try:
+            self._loop = asyncio.get_running_loop()  # the kernel's loop, when built in a notebook cell
+        except RuntimeError:
+            self._loop = None
+        self.slider.observe(lambda change: self._on_gl_thread(self.update, change["new"]), names="value")
+        self.button.on_click(lambda _: self._on_gl_thread(self.write_files))
         self.update(self.slider.value)
+
+    def _on_gl_thread(self, action, *args) -> None:
+        """Run a widget callback on the widget's own thread (handed to its event loop when the event
+        arrives on another thread)."""
+        if threading.current_thread() is self._thread or self._loop is None:
+            self._guarded(action, *args)
+        else:
+            self._loop.call_soon_threadsafe(self._guarded, action, *args)
+
+    def _guarded(self, action, *args):
+        """Run a widget callback; an error shows in the widget (a callback's traceback would
+        otherwise go only to the kernel's log) and the widget keeps working."""
+        try:
+            return action(*args)
+        except Exception as err:  # shown to the user in the widget, not lost in the log
+            import traceback
+
+            self.error = err
+            detail = "" if isinstance(err, RRCacheError) else f"<pre>{html.escape(traceback.format_exc())}</pre>"
+            self.status.value = (f'<span style="color:#b00020">[{html.escape(threading.current_thread().name)}] '
+                                 f'{html.escape(type(err).__name__)}: '
+                                 f"{html.escape(str(err))}</span>{detail}")
+            return None
 
     def update(self, max_error: float):
         """Re-select for ``max_error`` and refresh the view (renders only when the choice changes)."""
