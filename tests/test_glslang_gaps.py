@@ -335,3 +335,38 @@ def test_uint_is_an_ordinary_name_before_it_became_a_type():
     """)
     with pytest.raises(GLSLError, match="keyword"):
         accepted("#version 300 es\nprecision mediump float;\nint uint;\nvoid main() {}")
+
+
+# ----------------------------------------------------------------- the measuring tool
+
+def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
+    import importlib.util
+    import json
+    from pathlib import Path
+    tool = Path(__file__).resolve().parent.parent / "tools" / "glsl_conformance.py"
+    spec = importlib.util.spec_from_file_location("glsl_conformance", tool)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    shaders = {
+        "plain.frag": "void main() { gl_FragColor = vec4(1.0); }",
+        "spv.sep.frag": VULKAN,
+        "ext.frag": BINDLESS,
+        "bad.frag": "void main() { undeclared = 1.0; }",
+        "hlsl.skip.frag": "float4 main() : SV_Target { return 1; }",
+    }
+    for name, text in shaders.items():
+        (tmp_path / name).write_text(text)
+    (tmp_path / "verdicts.tsv").write_text(
+        "plain.frag\tvalid\tsuite\nspv.sep.frag\tvalid\tsuite\next.frag\tvalid\tsuite\n"
+        "bad.frag\tinvalid\tcomment\n")
+    report = tmp_path / "report.json"
+    rc = mod.main([str(tmp_path), "--frontend-only", "--exclude", "hlsl.*",
+                   "--verdicts", str(tmp_path / "verdicts.tsv"), "--json", str(report)])
+    out = capsys.readouterr().out
+    assert rc == 0
+    assert "valid shaders accepted: 3/3" in out and "invalid shaders also rejected: 1/1" in out
+    rows = {r["file"]: r for r in json.loads(report.read_text())["results"]}
+    assert set(rows) == {"plain.frag", "spv.sep.frag", "ext.frag", "bad.frag"}
+    assert {n: r["category"] for n, r in rows.items() if n != "bad.frag"} == {
+        "plain.frag": "core", "spv.sep.frag": "vulkan", "ext.frag": "extension"}
+    assert rows["bad.frag"]["outcome"] == "rejected"

@@ -19,17 +19,27 @@ type-check, and rrcache's fragment-only restrictions) and classified as
 With ``--frontend-only`` the fragment-only product checks of ``parse_shader`` (one colour output,
 no other stage) are skipped: preprocess → parse → check, which measures the language coverage.
 
+``--exclude`` leaves files out by glob (``--exclude 'hlsl.*'`` for glslang's HLSL tests);
+``--verdicts FILE`` takes the expected verdicts from a list of ``NAME<TAB>valid|invalid`` lines
+instead of ``.out`` files. Valid shaders are also counted per category: ``vulkan`` (glslang's
+``spv.*``/``vulkan*`` tests, compiled with Vulkan semantics), ``extension`` (other files with an
+``#extension`` directive) and ``core`` (GLSL 1.10–4.60, ES, compatibility, no extension).
+
 Nothing here needs network access. Usage::
 
     python tools/glsl_conformance.py /tmp/glslang_tests
     python tools/glsl_conformance.py /tmp/glslang_tests --json report.json -v
+    python tools/glsl_conformance.py glslang/Test --results glslang/Test/baseResults \
+        --exclude 'hlsl.*' --frontend-only
 """
 from __future__ import annotations
 
 import argparse
+import fnmatch
 import glob
 import json
 import os
+import re
 import sys
 import traceback
 from collections import Counter
@@ -58,6 +68,27 @@ def expected_validity(frag_path: str, results_dir: str | None) -> str:
                         return "invalid"
             return "valid"
     return "unknown"
+
+
+def category(path: str) -> str:
+    """``vulkan``, ``extension`` or ``core`` (see the module docstring)."""
+    name = os.path.basename(path)
+    if name.startswith(("spv.", "vulkan")):
+        return "vulkan"
+    with open(path, encoding="utf-8-sig", errors="replace") as f:
+        text = f.read()
+    return "extension" if re.search(r"^\s*#\s*extension\b", text, re.M) else "core"
+
+
+def read_verdicts(path: str) -> dict[str, str]:
+    """``NAME<TAB>valid|invalid[<TAB>how it was decided]`` lines -> {name: verdict}."""
+    verdicts = {}
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            parts = line.rstrip("\n").split("\t")
+            if len(parts) >= 2 and parts[1] in ("valid", "invalid"):
+                verdicts[parts[0]] = parts[1]
+    return verdicts
 
 
 def run_one(path: str, frontend_only: bool = False) -> tuple[str, str]:
@@ -89,22 +120,28 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("directory", help="folder holding *.frag files (and *.frag.out verdicts)")
     ap.add_argument("--results", help="folder of NAME.frag.out files (glslang baseResults)")
     ap.add_argument("--pattern", default="*.frag", help="file glob (default *.frag)")
+    ap.add_argument("--exclude", action="append", default=[], metavar="GLOB",
+                    help="leave out files matching GLOB (repeatable), e.g. 'hlsl.*'")
+    ap.add_argument("--verdicts", metavar="FILE",
+                    help="expected verdicts as NAME<TAB>valid|invalid lines (instead of .out)")
     ap.add_argument("--frontend-only", action="store_true",
                     help="skip parse_shader's fragment-only product checks")
     ap.add_argument("--json", metavar="FILE", help="also write the per-file results as JSON")
     ap.add_argument("-v", "--verbose", action="store_true", help="list every non-ok result")
     args = ap.parse_args(argv)
 
-    files = sorted(glob.glob(os.path.join(args.directory, args.pattern)))
+    files = sorted(p for p in glob.glob(os.path.join(args.directory, args.pattern))
+                   if not any(fnmatch.fnmatch(os.path.basename(p), g) for g in args.exclude))
+    verdicts = read_verdicts(args.verdicts) if args.verdicts else {}
     if not files:
         print(f"no files matching {args.pattern} in {args.directory}", file=sys.stderr)
         return 2
     rows = []
     for path in files:
-        validity = expected_validity(path, args.results)
+        validity = verdicts.get(os.path.basename(path)) or expected_validity(path, args.results)
         outcome, message = run_one(path, args.frontend_only)
         rows.append({"file": os.path.basename(path), "expected": validity, "outcome": outcome,
-                     "message": message})
+                     "category": category(path), "message": message})
 
     table = Counter((r["expected"], r["outcome"]) for r in rows)
     outcomes = ["ok", "unsupported", "rejected", "crash"]
@@ -120,6 +157,10 @@ def main(argv: list[str] | None = None) -> int:
     if valid:
         ok = sum(r["outcome"] == "ok" for r in valid)
         print(f"\nvalid shaders accepted: {ok}/{len(valid)}")
+        for cat in ("core", "vulkan", "extension"):
+            in_cat = [r for r in valid if r["category"] == cat]
+            if in_cat:
+                print(f"  {cat:<10} {sum(r['outcome'] == 'ok' for r in in_cat)}/{len(in_cat)}")
     if invalid:
         rej = sum(r["outcome"] in ("rejected", "unsupported") for r in invalid)
         print(f"invalid shaders also rejected: {rej}/{len(invalid)}")
