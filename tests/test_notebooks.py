@@ -77,3 +77,42 @@ def test_interactive_reselects_and_writes_files(executed):
     assert f"node={expected.node!r}" in moved and f"period={expected.period!r}" in moved
     assert float(moved.rsplit("'", 2)[-2].split()[0]) < 5.0  # that re-selection's milliseconds
     assert (folder / "demo.rrprofile" / "chosen" / "manifest.json").exists()
+
+
+def test_widget_events_from_another_thread_run_on_the_gl_thread(executed):
+    """A frontend may deliver slider moves on another thread (JupyterLab's kernel subshells),
+    where the GL context is not current: the Explorer hands them to its own loop's thread."""
+    import asyncio
+    import threading
+
+    from rrcache.profile import load_profile
+    from rrcache.report.explore import Explorer
+
+    folder, _, _ = executed
+    prof = load_profile(folder / "demo.rrprofile")
+    target = prof.selections[-1].max_error
+    seen = {}
+
+    async def main():
+        ui = Explorer(prof, value=prof.selections[0].max_error, measure=False)
+        original_update = ui.update
+
+        def update(value):
+            seen["thread"] = threading.current_thread()
+            return original_update(value)
+
+        ui.update = update
+        mover = threading.Thread(target=lambda: setattr(ui.slider, "value", target))
+        mover.start()
+        mover.join()
+        for _ in range(200):
+            if "thread" in seen and ui.choice is not None and ui.images is not None:
+                break
+            await asyncio.sleep(0.02)
+        return ui
+
+    ui = asyncio.run(main())
+    assert seen["thread"] is threading.main_thread() and ui.error is None
+    expected = prof.select(ui.slider.value)
+    assert (ui.choice.node, ui.choice.period) == (expected.node, expected.period)
+    assert (ui.images.node, ui.images.period) == (expected.node, expected.period)
