@@ -10,7 +10,9 @@ against 0.0081 for the whole frame, at about half the time.
 
 The window's area is chosen from the original's measured frame time (the fastest of the timing
 frames: other work on a shared machine only ever adds time) so that the original costs
-about :data:`ERROR_TARGET_MS` inside it (at most a quarter of the frame, at least 1/64), and it is
+about :data:`ERROR_TARGET_MS` inside it (at most a quarter of the frame, at least
+:data:`MIN_ERROR_FRACTION`: on chess a 1/64 window, 80×64 pixels of flat board, measured errors
+5–25× below what the selections showed over the frame), and it is
 placed where the session's objects cover the most pixels over the training frames. Shaders so
 expensive that one full frame costs more than :data:`TIMING_TARGET_MS` (chess ambient occlusion:
 1.4 s; Marble costs 45 ms) are timed and validated in a window as well, sized to cost about that much; the per-pixel
@@ -20,8 +22,8 @@ whole frame's covered pixels.
 The decision depends on a timing, so it is made once and kept in the profile store
 (:meth:`~rrcache.profile.store.ProfileStore.plan`): a resumed run uses the same windows.
 
->>> fraction_for(45.0, ERROR_TARGET_MS, 0.25), fraction_for(1400.0, ERROR_TARGET_MS, 0.25)
-(0.25, 0.015625)
+>>> fraction_for(45.0, ERROR_TARGET_MS, 0.25), fraction_for(1400.0, ERROR_TARGET_MS, 0.25, MIN_ERROR_FRACTION)
+(0.25, 0.0625)
 >>> cov = np.zeros((6, 8)); cov[3:6, 4:8] = 1
 >>> place_window(cov, (64, 48), 0.25)
 (32, 0, 32, 24)
@@ -40,8 +42,10 @@ from rrcache.gl.window import Window
 ERROR_TARGET_MS = 15.0
 #: a full frame costing more than this is timed and validated in a window of about this cost
 TIMING_TARGET_MS = 150.0
-#: the largest error window (a quarter of the frame) and the smallest window of any kind
+#: the largest error window (a quarter of the frame), the smallest, and the smallest window of
+#: any kind
 MAX_ERROR_FRACTION = 0.25
+MIN_ERROR_FRACTION = 1.0 / 16.0
 MIN_FRACTION = 1.0 / 64.0
 #: the coverage map is rendered at the session's resolution divided by this
 COVERAGE_SCALE = 8
@@ -71,11 +75,11 @@ class Plan:
                    float(data.get("original_ms", float("nan"))))
 
 
-def fraction_for(original_ms: float, target_ms: float, cap: float) -> float:
-    """The share of the frame's area that costs about ``target_ms``, within [1/64, ``cap``]."""
+def fraction_for(original_ms: float, target_ms: float, cap: float, floor: float = MIN_FRACTION) -> float:
+    """The share of the frame's area that costs about ``target_ms``, within [``floor``, ``cap``]."""
     if not math.isfinite(original_ms) or original_ms <= 0:
         return cap
-    return float(min(cap, max(MIN_FRACTION, target_ms / original_ms)))
+    return float(min(cap, max(floor, target_ms / original_ms)))
 
 
 def place_window(coverage: np.ndarray, size: tuple[int, int], fraction: float) -> Optional[Window]:

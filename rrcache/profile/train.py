@@ -54,7 +54,8 @@ from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
 from rrcache.profile.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                    shader_inputs, signature)
-from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, TIMING_TARGET_MS, Plan, coverage_map,
+from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
+                                  coverage_map,
                                   fraction_for, place_window)
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
@@ -143,7 +144,7 @@ def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms
     full = tuple(int(v) for v in session.resolution)
     at_full = tuple(settings.resolution) == full
     error_fraction = settings.error_window if settings.error_window is not None else \
-        fraction_for(original_ms, ERROR_TARGET_MS, MAX_ERROR_FRACTION)
+        fraction_for(original_ms, ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION)
     timing_fraction = 1.0 if original_ms <= TIMING_TARGET_MS else fraction_for(original_ms, TIMING_TARGET_MS, 1.0)
     need = (at_full and error_fraction < 1.0) or timing_fraction < 1.0
     coverage = coverage_map(work.prepared, session, frames[::max(1, len(frames) // 16)], Renderer) if need else None
