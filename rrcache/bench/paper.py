@@ -47,6 +47,7 @@ import numpy as np
 
 from rrcache.bench.scenes import Scene, scaled_session
 from rrcache.errors import RRCacheError
+from rrcache.jsonable import finite_json as _finite
 
 ProgressFn = Callable[[str, Optional[int], Optional[int]], None]
 PSNR_CAP = 100.0
@@ -174,18 +175,6 @@ class SceneResult:
 
     def to_json(self) -> dict:
         return _finite(asdict(self))
-
-
-def _finite(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    if isinstance(value, np.generic):
-        return _finite(value.item())
-    return value
 
 
 def _cap(psnr: float) -> float:

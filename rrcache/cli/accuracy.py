@@ -11,26 +11,16 @@ the error model's R² over the held-out points (``--json``: the whole report).
 from __future__ import annotations
 
 import json
-import math
 
 import click
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from rrcache.jsonable import finite_json
 from rrcache.profile.accuracy import DEFAULT_PERIODS, held_out
 from rrcache.profile.profile import load_profile
 from rrcache.profile.settings import parse_periods
-
-
-def _clean(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_clean(v) for v in value]
-    return value
 
 
 @click.command("accuracy")
@@ -53,7 +43,7 @@ def command(profile_path, periods, nodes, as_json):
 
         report = held_out(prof, parse_periods(periods, "--periods"), chosen, progress)
     if as_json:
-        click.echo(json.dumps(_clean(report.to_json()), indent=2))
+        click.echo(json.dumps(finite_json(report.to_json()), indent=2))
         return
     table = Table(title=f"held-out periods {report.periods} ({report.chosen_by})")
     for col in ("node", "Δn", "predicted error", "measured error", "predicted ms", "measured ms", "time error", "hit rate"):

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.jsonable import finite_json as _finite
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ProfileStore, StoreKey
 from rrcache.profile.train import ProgressFn, TrainingResult, train
@@ -92,19 +93,6 @@ class SelectionReport:
     hit_rate: Optional[float] = None
     frames: int = 0
     files: Optional[str] = None
-
-
-def _finite(value):
-    """JSON cannot hold NaN or infinity: they become None."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    if hasattr(value, "item") and not isinstance(value, (str, bytes)):  # numpy scalars
-        return _finite(value.item())
-    return value
 
 
 def _fit_json(fit) -> dict:
