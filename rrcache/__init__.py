@@ -48,6 +48,7 @@ _LAZY = {
     "load_profile": "rrcache.profile",
     "select": "rrcache.profile",
     "TrainingSettings": "rrcache.profile",
+    "held_out": "rrcache.profile.accuracy",
     "get_context": "rrcache.gl",
 }
 
