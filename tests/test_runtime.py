@@ -18,7 +18,7 @@ import moderngl  # noqa: E402
 from rrcache.gl.context import get_context  # noqa: E402
 from rrcache.runtime import CacheRuntime  # noqa: E402
 from rrcache.runtime import glsl as G  # noqa: E402
-from rrcache.runtime.refresh import refresh_mask, refresh_offsets  # noqa: E402
+from rrcache.runtime.refresh import refresh_mask, refresh_phases  # noqa: E402
 from masks import dilate, erode  # noqa: E402
 
 W, H = 64, 64
@@ -154,6 +154,39 @@ def _frame_with_hits(rt, scene):
     return stats, hits["map"]
 
 
+@pytest.mark.parametrize("mode, block, seed, period", [("random", 1, 3, 7), ("random", 2, 0, 16), ("random", 8, 5, 4),
+                                                     ("tiled", 4, 0, 10), ("tiled", 1, 0, 3)])
+def test_refresh_rule_in_the_shader_matches_refresh_mask(scene, mode, block, seed, period):
+    """The shader's refresh rule (a hash of the block coordinates, no texture) refreshes exactly
+    the pixels :func:`refresh_mask` predicts, for every mode and block size, frame after frame."""
+    scene.occluder_x = [None, None]
+    covered = scene.render_original()[..., 3] > 0
+    rt = scene.runtime(period=period, block=block, refresh=mode, seed=seed)
+    try:
+        _frame_with_hits(rt, scene)
+        for _ in range(period + 1):
+            clock = rt.clock
+            _stats, hit_map = _frame_with_hits(rt, scene)
+            refreshed = refresh_mask((W, H), block, mode, seed, period, clock)[::-1]
+            np.testing.assert_array_equal(hit_map, covered & ~refreshed)
+    finally:
+        rt.release()
+
+
+def test_random_phases_are_uniform_and_seeded():
+    """Every phase in [0, Δn) gets about 1/Δn of the blocks; another seed gives another pattern;
+    tiled phases run in raster order."""
+    for period in (2, 16, 50):
+        phases = refresh_phases((640, 480), 4, "random", 0, period)
+        counts = np.bincount(phases.ravel(), minlength=period)
+        assert counts.size == period
+        expected = phases.size / period
+        assert np.all(np.abs(counts - expected) < 5 * np.sqrt(expected)), counts
+    assert (refresh_phases((640, 480), 4, "random", 1, 16) != refresh_phases((640, 480), 4, "random", 0, 16)).mean() > 0.9
+    tiled = refresh_phases((64, 48), 4, "tiled", 0, 6).ravel()
+    assert np.all(np.diff(tiled) >= 0) and set(tiled.tolist()) == set(range(6))
+
+
 def test_period_one_reproduces_the_original(scene):
     scene.occluder_x = [0.0, 0.3]
     reference = scene.render_original()
@@ -180,7 +213,7 @@ def test_static_scene_hit_rate_matches_refresh_rule(scene):
         for _ in range(8):
             clock = rt.clock
             stats, hit_map = _frame_with_hits(rt, scene)
-            refreshed = refresh_mask(refresh_offsets((W, H), 4, "random", 0), (W, H), 4, period, clock)[::-1]
+            refreshed = refresh_mask((W, H), 4, "random", 0, period, clock)[::-1]
             # exactly the covered pixels that are not refreshed hit
             np.testing.assert_array_equal(hit_map, covered & ~refreshed)
             rates.append(hit_map.sum() / covered.sum())

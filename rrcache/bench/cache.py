@@ -23,6 +23,10 @@ from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
 
 
+#: a refresh period longer than any session: no pixel is refreshed, only disocclusions miss
+NO_REFRESH = 2 ** 30
+
+
 @dataclass
 class BenchRow:
     label: str
@@ -45,11 +49,15 @@ class CacheBench:
     node_text: str
     resolution: tuple[int, int]
     frames: int
+    compare_period: int = 16
     periods: list[BenchRow] = field(default_factory=list)
     algorithms: list[BenchRow] = field(default_factory=list)
     blocks: list[BenchRow] = field(default_factory=list)
     limit_ms: float = float("nan")
     limit_original_ms: float = float("nan")
+    #: the node at the compared period with refresh turned off: only disocclusions miss (the
+    #: gap between this row and the limit is what disocclusions cost, the rest is the refresh)
+    no_refresh: Optional[BenchRow] = None
 
     @property
     def limit_fraction(self) -> float:
@@ -82,6 +90,13 @@ class CacheBench:
             lines.append("")
         lines.append(f"Limit (every pixel hits): {self.limit_ms:.1f} ms against {self.limit_original_ms:.1f} ms, "
                      f"{100 * self.limit_fraction:.0f}% of the original: at most {self.limit_speedup:.2f}×.")
+        compared = next((r for r in self.periods if r.period == self.compare_period), None)
+        if self.no_refresh is not None and compared is not None:
+            r = self.no_refresh
+            lines += ["", f"Where the time between the limit and Δn={compared.period} goes (three-pass, k={compared.block}): "
+                      f"with refresh off only disocclusions miss (hit rate {r.hit_rate:.3f}): {r.speedup:.2f}×, "
+                      f"{100 * r.speedup / self.limit_speedup:.0f}% of the limit; with refresh every Δn={compared.period} "
+                      f"frames: {compared.speedup:.2f}×, {100 * compared.speedup / self.limit_speedup:.0f}% of the limit."]
         return "\n".join(lines)
 
 
@@ -96,12 +111,14 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
-    bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices))
+    bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices),
+                       compare_period=compare_period)
 
-    def row(label, algorithm, period, block):
+    def row(label, algorithm, period, block, run_period=None):
         say(f"{label}: {algorithm}, Δn={period}, k={block}")
         variant = variant_for(work, node_id, period, algorithm)
-        c = compare(variant, session, work.prepared, indices, period=period, resolution=resolution, block=block)
+        c = compare(variant, session, work.prepared, indices, period=run_period or period, resolution=resolution,
+                    block=block)
         return BenchRow(label, algorithm, period, block, c.speedup, c.hit_rate, c.mean_error, c.psnr,
                         c.ms_per_frame, c.original_ms_per_frame)
 
@@ -112,6 +129,8 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     for block in blocks:
         bench.blocks.append(row(f"k={block}", "three-pass", compare_period, block))
 
+    if periods:
+        bench.no_refresh = row("no refresh", "three-pass", compare_period, 4, run_period=NO_REFRESH)
     say("limit: every pixel hits")
     probe = list(indices)[:: max(1, len(indices) // 5)][:5]
     variant = variant_for(work, node_id, compare_period)

@@ -1,7 +1,8 @@
 """`CacheRuntime`: runs a cached shader variant inside any moderngl render loop.
 
 The runtime owns everything the cache needs on the GL side: the double-buffered payload and
-inverse-depth textures, the depth buffer the passes share, the refresh-offset texture, the clock
+inverse-depth textures, the depth buffer the passes share, the refresh pattern (block size, mode,
+seed: uniforms of the rule in :mod:`rrcache.runtime.refresh`; no texture), the clock
 and the occlusion queries that count shaded fragments. The application owns its geometry: each
 frame it hands the runtime a ``draw(program, pass_name)`` callback that sets its own uniforms on
 ``program`` (including ``u_prevModelViewProjectionMatrix`` per object, for reprojection) and
@@ -54,7 +55,7 @@ from rrcache.gl.context import bind_default_framebuffer
 from rrcache.gl.limits import check_target_size
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
-from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_offsets
+from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_uniforms
 
 ALGORITHMS = {
     "three-pass": ("reproject", "payload", "shade"),
@@ -66,7 +67,7 @@ PAYLOAD_DTYPES = ("f2", "f4")
 
 DrawCallback = Callable[[moderngl.Program, str], None]
 
-_UNIT_PREV_PAYLOAD, _UNIT_PREV_INVDEPTH, _UNIT_REFRESH, _UNIT_CUR_PAYLOAD = 12, 13, 14, 15
+_UNIT_PREV_PAYLOAD, _UNIT_PREV_INVDEPTH, _UNIT_CUR_PAYLOAD = 12, 13, 15
 
 
 @dataclass
@@ -149,7 +150,6 @@ class CacheRuntime:
         self._valid = False
         self._resources: list = []
         self._query = ctx.query(samples=True)
-        self._refresh_tex: Optional[moderngl.Texture] = None
         self.size = (0, 0)
         self.window: Optional[tuple[int, int, int, int]] = None
         self.resize(size)
@@ -179,7 +179,6 @@ class CacheRuntime:
             self._block = block
         if seed is not None:
             self.seed = seed
-        self._make_refresh_texture()
 
     # ------------------------------------------------------------------ resources
 
@@ -213,7 +212,6 @@ class CacheRuntime:
         self._color_only_fbo = ctx.framebuffer([self.color])
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
-        self._make_refresh_texture()
         if self.window is not None:
             try:
                 check_window(self.window, self.size)
@@ -246,14 +244,6 @@ class CacheRuntime:
         payload = self.payload_components * (4 if self.payload_dtype == "f4" else 2)
         return 4 + 16 + 2 * payload + 2 * 4 + 41
 
-    def _make_refresh_texture(self) -> None:
-        if self._refresh_tex is not None:
-            self._refresh_tex.release()
-        data = refresh_offsets(self.size, self._block, self._refresh_mode, self.seed)
-        rows, cols = data.shape
-        self._refresh_tex = self.ctx.texture((cols, rows), 1, data=np.ascontiguousarray(data).tobytes(), dtype="f4")
-        self._refresh_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-
     def reset(self) -> None:
         """Forget the cache: the next frame misses everywhere (as after a camera cut)."""
         self._valid = False
@@ -270,9 +260,6 @@ class CacheRuntime:
     def release(self) -> None:
         """Release every GL object the runtime made (not the programs, which the caller owns)."""
         self._release_targets()
-        if self._refresh_tex is not None:
-            self._refresh_tex.release()
-            self._refresh_tex = None
         self._query = None
 
     # ------------------------------------------------------------------ the frame
@@ -285,16 +272,14 @@ class CacheRuntime:
         prev = 1 - self._index
         self._payload[prev].use(_UNIT_PREV_PAYLOAD)
         self._invdepth[prev].use(_UNIT_PREV_INVDEPTH)
-        self._refresh_tex.use(_UNIT_REFRESH)
         if self.algorithm == "three-pass":
             self._payload[self._index].use(_UNIT_CUR_PAYLOAD)
         self._set(program, G.PREV_PAYLOAD, _UNIT_PREV_PAYLOAD)
         self._set(program, G.PREV_INVDEPTH, _UNIT_PREV_INVDEPTH)
-        self._set(program, G.REFRESH, _UNIT_REFRESH)
         self._set(program, G.CUR_PAYLOAD, _UNIT_CUR_PAYLOAD)
-        self._set(program, "rr_period", self._period)
-        self._set(program, "rr_clock", self.clock)
-        self._set(program, "rr_blockSize", self._block)
+        for name, value in refresh_uniforms(self.size, self._block, self._refresh_mode, self.seed,
+                                            self._period, self.clock).items():
+            self._set(program, name, value)
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
 

@@ -15,7 +15,8 @@ Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (D
     expected = 1 / rr_prevClip.w;  uv = rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5
     hit = rr_valid && uv inside [0,1]² && |bilinear(prevInvDepth, uv) - expected| <= ε · expected
 
-and the pixel is refreshed by the rule in :mod:`rrcache.runtime.refresh`.
+and the pixel is refreshed by the rule in :mod:`rrcache.runtime.refresh` (arithmetic on the
+block coordinates, no texture).
 
 Payload reconstruction filters: ``nearest``, ``bilinear`` (hardware), and ``catmull-rom`` (a
 16-tap bicubic that blurs less under repeated resampling; its result is clamped to the range of
@@ -24,13 +25,14 @@ from across an edge).
 """
 from __future__ import annotations
 
+from rrcache.runtime.refresh import REFRESH_GLSL
+
 FILTERS = ("nearest", "bilinear", "catmull-rom")
 
 # Names the runtime binds. Kept in one place so the compiler and the runtime agree.
 PREV_PAYLOAD = "rr_prevPayload"
 PREV_INVDEPTH = "rr_prevInvDepth"
 CUR_PAYLOAD = "rr_curPayload"
-REFRESH = "rr_refresh"
 PREV_CLIP = "rr_prevClip"
 OUT_PAYLOAD = "rr_outPayload"
 OUT_INVDEPTH = "rr_outInvDepth"
@@ -41,18 +43,10 @@ _COMMON = """\
 in vec4 rr_prevClip;
 uniform sampler2D rr_prevPayload;
 uniform sampler2D rr_prevInvDepth;
-uniform sampler2D rr_refresh;
-uniform int rr_period;
-uniform int rr_clock;
-uniform int rr_blockSize;
 uniform bool rr_valid;
 uniform float rr_depthEpsilon;
 vec2 rr_uv;
-
-bool rr_refreshNow() {
-    float h = texelFetch(rr_refresh, ivec2(gl_FragCoord.xy) / rr_blockSize, 0).r;
-    return (int(h * float(rr_period)) + rr_clock) % rr_period == 0;
-}
+""" + REFRESH_GLSL + """
 
 bool rr_hit() {
     if (!rr_valid || rr_prevClip.w <= 0.0) return false;
