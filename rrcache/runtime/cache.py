@@ -149,7 +149,10 @@ class CacheRuntime:
         self._index = 0
         self._valid = False
         self._resources: list = []
-        self._query = ctx.query(samples=True)
+        # one query per counted pass, read after the whole frame is submitted: reading a
+        # result right after its pass waits for that pass and stalls the next one's set-up
+        # (about 0.2 ms of Marble's ~17 ms cached frame at 640x480, measured side by side)
+        self._queries = [ctx.query(samples=True), ctx.query(samples=True)]
         self.size = (0, 0)
         self.window: Optional[tuple[int, int, int, int]] = None
         self.resize(size)
@@ -260,7 +263,7 @@ class CacheRuntime:
     def release(self) -> None:
         """Release every GL object the runtime made (not the programs, which the caller owns)."""
         self._release_targets()
-        self._query = None
+        self._queries = []
 
     # ------------------------------------------------------------------ the frame
 
@@ -283,15 +286,14 @@ class CacheRuntime:
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
 
-    def _run(self, pass_name: str, draw: DrawCallback, count: bool) -> Optional[int]:
+    def _run(self, pass_name: str, draw: DrawCallback, query: Optional[moderngl.Query] = None) -> None:
         program = self.programs[pass_name]
         self._bind_cache_uniforms(program)
-        if not count:
+        if query is None:
             draw(program, pass_name)
-            return None
-        with self._query:
+            return
+        with query:
             draw(program, pass_name)
-        return int(self._query.samples)
 
     def frame(self, draw: DrawCallback, count: bool = True, after_first_pass: Optional[Callable[[], None]] = None) -> FrameStats:
         """Render one frame with the cache and advance the clock.
@@ -315,27 +317,32 @@ class CacheRuntime:
         cache_fbo.depth_mask = True
         cache_fbo.use()
         ctx.depth_func = "<"
+        first, second = self._queries if count else (None, None)
         covered = misses = None
         if self.algorithm == "three-pass":
-            self._run("reproject", draw, count=False)
+            self._run("reproject", draw)
             if after_first_pass:
                 after_first_pass()
                 cache_fbo.use()
-            misses = self._run("payload", draw, count)
+            self._run("payload", draw, first)
             self._out_fbo.depth_mask = False
             self._out_fbo.use()
             ctx.depth_func = "=="
-            covered = self._run("shade", draw, count)
+            self._run("shade", draw, second)
             self._out_fbo.depth_mask = True
+            if count:
+                misses, covered = int(first.samples), int(second.samples)
         elif self.algorithm == "two-pass":
-            hits = self._run("hit", draw, count)
+            self._run("hit", draw, first)
             if after_first_pass:
                 after_first_pass()
                 cache_fbo.use()
-            misses = self._run("miss", draw, count)
-            covered = None if hits is None else hits + misses
+            self._run("miss", draw, second)
+            if count:
+                misses = int(second.samples)
+                covered = int(first.samples) + misses
         else:
-            self._run("single", draw, count=False)
+            self._run("single", draw)
         ctx.depth_func = "<"
         stats = FrameStats(self.clock, covered, misses)
         self._index = 1 - self._index
