@@ -171,3 +171,25 @@ def test_instance_writes_every_pass_and_a_manifest(files, tmp_path, capsys):
         assert (out / f"{name}.frag").read_text().startswith("#version 330")
         assert (out / f"{name}.vert").exists()
     assert "u_gain" in manifest["uniforms"]
+
+
+def test_bench_cache_measures_every_configuration(files, capsys):
+    """``rrcache bench-cache`` on a tiny scene: every configuration measured ``--repeats``
+    times (the row is the median repeat, its range around it), the no-refresh row hits at
+    least as often as the refreshed one, and the all-hit limit is there."""
+    shader, session = files
+    node = _final_node(shader, session, capsys)
+    main(["bench-cache", str(shader), str(session), "--node", node, "--frames", "3", "--periods", "2",
+          "--compare-period", "2", "--repeats", "2", "--resolution", "32x24", "--json"])
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)
+    assert [r["label"] for r in doc["periods"]] == ["Δn=2"]
+    assert [r["algorithm"] for r in doc["algorithms"]] == ["three-pass", "two-pass", "one-pass"]
+    assert [r["block"] for r in doc["blocks"]] == [1, 2, 4]
+    for row in doc["periods"] + doc["algorithms"] + doc["blocks"] + [doc["no_refresh"]]:
+        lo, hi = row["speedup_range"]
+        assert 0 < lo <= row["speedup"] <= hi
+        assert row["ms_per_frame"] > 0 and row["original_ms_per_frame"] > 0
+    assert doc["no_refresh"]["hit_rate"] >= doc["periods"][0]["hit_rate"]
+    assert doc["limit_speedup"] > 0 and doc["limit_ms"] > 0
+    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1

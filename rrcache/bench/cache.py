@@ -6,10 +6,18 @@ original in one run (issue 4; Sitthi-amorn 2008a Figs. 8–9).
 - the three algorithms at one period;
 - refresh block sizes k = 1, 2, 4 at that period;
 - the limit: the cached pipeline's frame time when every pixel hits (the frame shown again with
-  nothing moving and no refresh), as a fraction of the original's, and the speed-up that bounds.
+  nothing moving and no refresh), as a fraction of the original's, and the speed-up that bounds;
+  measured like the rows, alternating with the original frame by frame;
+- the node at the compared period with refresh off: what disocclusions alone cost.
 
 Every speed-up is a ratio of median frame times measured in the same run, the original and the
-variant rendered alternately frame by frame (:func:`rrcache.harness.cached.compare`).
+variant rendered alternately frame by frame (:func:`rrcache.harness.cached.compare`). Each
+configuration is measured ``repeats`` times, the repeats going round all configurations so that
+the machine's drift spreads over them; a row shows the median run and the range of the
+repeats' speed-ups. (Rendering every configuration in one interleaved loop was tried: the
+working sets of ten renderers thrashed the CPU caches and made the original 25% slower than it
+runs alone, so it measured a different machine.) The three tables share a configuration (Δn =
+16, three-pass, k = 4), measured as three rows: their spread is the run's noise too.
 """
 from __future__ import annotations
 
@@ -21,6 +29,11 @@ from rrcache.harness.cached import CachedRenderer, compare
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
+
+
+def _range(row: "BenchRow") -> str:
+    lo, hi = row.speedup_range
+    return "n/a" if lo != lo else f"{lo:.2f}–{hi:.2f}"
 
 
 #: a refresh period longer than any session: no pixel is refreshed, only disocclusions miss
@@ -39,6 +52,8 @@ class BenchRow:
     psnr: float
     ms_per_frame: float
     original_ms_per_frame: float
+    #: the lowest and highest speed-up of the repeats (the row is the median repeat)
+    speedup_range: tuple[float, float] = (float("nan"), float("nan"))
 
 
 @dataclass
@@ -78,13 +93,13 @@ class CacheBench:
         """The tables as Markdown (for the README)."""
         lines = [f"`{self.shader}` × `{self.session}`, caching `{self.node}` (`{self.node_text}`), "
                  f"{self.resolution[0]}×{self.resolution[1]}, {self.frames} frames", ""]
-        header = "| | algorithm | Δn | k | speed-up | hit rate | mean error | PSNR dB | ms | original ms |"
+        header = "| | algorithm | Δn | k | speed-up (repeats) | hit rate | mean error | PSNR dB | ms | original ms |"
         rule = "|---|---|---|---|---|---|---|---|---|---|"
         for title, rows in (("refresh period", self.periods), ("algorithm", self.algorithms),
                             ("refresh block", self.blocks)):
             lines += [f"**{title}**", "", header, rule]
             for r in rows:
-                lines.append(f"| {r.label} | {r.algorithm} | {r.period} | {r.block} | {r.speedup:.2f}× | "
+                lines.append(f"| {r.label} | {r.algorithm} | {r.period} | {r.block} | {r.speedup:.2f}× ({_range(r)}) | "
                              f"{'n/a' if r.hit_rate != r.hit_rate else format(r.hit_rate, '.3f')} | {r.mean_error:.4f} | {r.psnr:.1f} | {r.ms_per_frame:.1f} | "
                              f"{r.original_ms_per_frame:.1f} |")
             lines.append("")
@@ -102,7 +117,7 @@ class CacheBench:
 
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
-        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4)) -> CacheBench:
+        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out)."""
     say = progress or (lambda _msg: None)
@@ -114,23 +129,32 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices),
                        compare_period=compare_period)
 
-    def row(label, algorithm, period, block, run_period=None):
-        say(f"{label}: {algorithm}, Δn={period}, k={block}")
-        variant = variant_for(work, node_id, period, algorithm)
-        c = compare(variant, session, work.prepared, indices, period=run_period or period, resolution=resolution,
-                    block=block)
-        return BenchRow(label, algorithm, period, block, c.speedup, c.hit_rate, c.mean_error, c.psnr,
-                        c.ms_per_frame, c.original_ms_per_frame)
-
-    for period in periods:
-        bench.periods.append(row(f"Δn={period}", "three-pass", period, 4))
-    for algorithm in ("three-pass", "two-pass", "one-pass"):
-        bench.algorithms.append(row(algorithm, algorithm, compare_period, 4))
-    for block in blocks:
-        bench.blocks.append(row(f"k={block}", "three-pass", compare_period, block))
-
+    plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
+    plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period)
+             for algorithm in ("three-pass", "two-pass", "one-pass")]
+    plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period) for block in blocks]
     if periods:
-        bench.no_refresh = row("no refresh", "three-pass", compare_period, 4, run_period=NO_REFRESH)
+        plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH))
+    variants = {}
+    for _group, _label, algorithm, period, _block, _run in plan:
+        if algorithm not in variants:
+            variants[algorithm] = variant_for(work, node_id, period, algorithm)
+    runs: list[list] = [[] for _ in plan]
+    for repeat in range(repeats):
+        for i, (_group, label, algorithm, period, block, run_period) in enumerate(plan):
+            say(f"[{repeat + 1}/{repeats}] {label}: {algorithm}, Δn={period}, k={block}")
+            runs[i].append(compare(variants[algorithm], session, work.prepared, indices, period=run_period,
+                                   resolution=resolution, block=block))
+    for (group, label, algorithm, period, block, _run), repeated in zip(plan, runs):
+        speedups = sorted(c.speedup for c in repeated)
+        c = sorted(repeated, key=lambda c: c.speedup)[len(repeated) // 2]  # the median run
+        row = BenchRow(label, algorithm, period, block, c.speedup, c.hit_rate, c.mean_error, c.psnr,
+                       c.ms_per_frame, c.original_ms_per_frame, (speedups[0], speedups[-1]))
+        if group == "no_refresh":
+            bench.no_refresh = row
+        else:
+            getattr(bench, group).append(row)
+
     say("limit: every pixel hits")
     probe = list(indices)[:: max(1, len(indices) // 5)][:5]
     variant = variant_for(work, node_id, compare_period)
@@ -138,9 +162,11 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     with Renderer(work.prepared, session, resolution) as original, \
             CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:
         for index in probe:
-            original.render_frame(index)
-            original_ms.append(statistics.median(original.render_frame(index).ms for _ in range(5)))
-            cached_ms.append(cached.render_static(index, repeats=5))
+            # alternating with the original frame by frame, as every other row is measured
+            times: list[float] = []
+            cached_ms.append(cached.render_static(
+                index, repeats=5, between=lambda: times.append(original.render_frame(index).ms)))
+            original_ms.append(statistics.median(times[2:]))
     bench.limit_ms = statistics.median(cached_ms)
     bench.limit_original_ms = statistics.median(original_ms)
     return bench

@@ -18,10 +18,12 @@ from rrcache.cli.options import resolution_option as _resolution
 @click.option("--periods", default="8,16,32", show_default=True, help="Refresh periods to compare.")
 @click.option("--compare-period", default=16, show_default=True, help="Δn for the algorithm and block comparisons.")
 @click.option("--frames", default=60, show_default=True, help="Consecutive frames per configuration.")
+@click.option("--repeats", default=3, show_default=True, type=click.IntRange(1, 50),
+              help="Measurements of each configuration (rows show the median and the range).")
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
-def command(shader, session, node, periods, compare_period, frames, resolution, as_json, markdown):
+def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import run
 
@@ -30,7 +32,7 @@ def command(shader, session, node, periods, compare_period, frames, resolution, 
         period_list = [int(p) for p in periods.split(",") if p.strip()]
     except ValueError:
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
-    bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution,
+    bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution, repeats=repeats,
                 progress=lambda msg: err.print(f"[dim]{msg}[/dim]"))
     if as_json:
         click.echo(json.dumps(bench.to_json()))

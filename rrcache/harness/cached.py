@@ -173,11 +173,16 @@ class CachedRenderer:
         payload = self.runtime.read_payload() if self.keep_payload else None
         return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
 
-    def render_static(self, index: int, repeats: int = 5) -> float:
+    def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None) -> float:
         """The cached pipeline's best case: frame ``index`` shown again and again with nothing
         moving and no refresh, so every covered pixel hits after the first showing. Returns the
         median ms of the ``repeats`` hitting frames (the speed-up limit's denominator). The cache
-        is reset afterwards and the period restored."""
+        is reset afterwards and the period restored.
+
+        Each frame is read back as :meth:`render_frame` does, and ``between()`` (if given) runs
+        before each frame: :func:`compare` renders the original between two cached frames, and
+        a limit measured back to back, with the CPU caches warm from the frame before, came out
+        ~25% faster than the same all-hit frame measured that way (Marble, 640×480)."""
         index = check_frame_index(self.session, index)
         if self._check_half:  # decide the payload precision first, on an untimed frame
             self.render_frame(index)
@@ -188,12 +193,16 @@ class CachedRenderer:
         times = []
         try:
             for i in range(repeats + 2):
+                if between is not None:
+                    between()
                 self.ctx.finish()
                 start = time.perf_counter()
                 stats = self.runtime.frame(self.drawer.draw)
                 self.ctx.finish()
                 if i >= 2:
                     times.append((time.perf_counter() - start) * 1000.0)
+                self.runtime.read_color()
+                self.runtime.read_depth()
             self.last_static_stats = stats
         finally:
             self.runtime.period = saved
