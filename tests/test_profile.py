@@ -23,6 +23,7 @@ import pytest
 
 from rrcache.errors import RRCacheError
 from rrcache.profile import TrainingSettings, load_profile, profile, read_store, select
+from rrcache.profile.profile import algorithm_line
 
 SHADER = """#version 330
 in vec4 v_position;
@@ -122,6 +123,24 @@ def test_profile_json_schema(trained):
         assert (folder / "out" / sel["files"] / "manifest.json").exists()
     # nothing non-finite leaks into the JSON
     assert "NaN" not in (folder / "out" / "profile.json").read_text()
+
+
+def test_auto_algorithm_keeps_the_faster_variant(trained):
+    """The default ``algorithm="auto"`` timed three-pass and two-pass beside the original, kept
+    the faster for the profile, and wrote the selections' shaders with it."""
+    prof, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    assert data["settings"]["algorithm"] == "auto"
+    times = data["plan"]["algorithm_times"]
+    assert set(times) == {"three-pass", "two-pass"} and all(0 < t < 100 for t in times.values())
+    assert prof.algorithm == data["plan"]["algorithm"] == min(times, key=times.get)
+    # this tiny scene's selections are all the original (its variants cost more than it), so
+    # write a trained node's variant the way selections are written
+    from types import SimpleNamespace
+    node = prof.trained_nodes[0].id
+    prof.write_variant(SimpleNamespace(node=node, period=8), folder / "chosen")
+    assert json.loads((folder / "chosen" / "manifest.json").read_text())["algorithm"] == prof.algorithm
+    assert prof.algorithm in algorithm_line(prof) and "auto:" in algorithm_line(prof)
 
 
 def test_progress_events_count_to_their_plan(trained):

@@ -224,7 +224,7 @@ def _measure_selections(prof, work, session, frames, settings: BenchSettings, pr
         row = SelectionRow(sel.label, sel.max_error, sel.node, sel.text, sel.period, 1.0, 0.0, PSNR_CAP,
                            predicted_speedup=sel.predicted_speedup, predicted_error=sel.predicted_error)
         if sel.node is not None:
-            variant = variant_for(work, sel.node, int(sel.period), ps.algorithm)
+            variant = variant_for(work, sel.node, int(sel.period), prof.algorithm)
             runs = []
             for _ in range(settings.repeats):
                 runs.append(compare(variant, session, work.prepared, frames, period=int(sel.period), block=ps.block,
@@ -390,7 +390,7 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
 
     _say(progress, f"algorithms and limit on {medium.node_id}")
     bench = cache_bench.run(scene.shader, session_path, medium.node_id, periods=(), compare_period=int(medium.period),
-                            frames=len(frames), blocks=(),
+                            frames=len(frames), blocks=(), repeats=1,
                             progress=lambda msg: _say(progress, f"algorithms: {msg}"))
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
                                    r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]

@@ -23,9 +23,8 @@ from rich.table import Table
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
 from rrcache.errors import RRCacheError
-from rrcache.profile.profile import STORE_NAME, default_out_dir, profile
-from rrcache.profile.settings import DEFAULT_PERIODS, TrainingSettings, parse_periods
-from rrcache.runtime import ALGORITHMS
+from rrcache.profile.profile import STORE_NAME, algorithm_line, default_out_dir, profile
+from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
 
 
 def _periods(ctx, param, value):
@@ -62,7 +61,8 @@ def _fmt(value, spec=".3g", none="–"):
               help=f"Frames L timed per node and timing period, at full resolution (default: {TrainingSettings.timing_frames}).")
 @click.option("--timing-periods", callback=_periods, default=None, metavar="LIST",
               help="Refresh periods at which each node is timed (default: 2,8,50).")
-@click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
+@click.option("--algorithm", type=click.Choice(ALGORITHM_CHOICES), default="auto", show_default=True,
+              help="auto: time three-pass and two-pass on the first node and keep the faster.")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
@@ -146,6 +146,7 @@ def _summary(prof, console: Console) -> None:
     console.print(f"μ = {_fmt(prof.mu)} ({prof.mu_quality}); overhead {_fmt(prof.overhead_ms, '.3f')} ms; "
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
+    console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
     table = Table(title="selections")
     for name in ("level", "max error", "node", "Δn", "speed-up pred.", "speed-up meas.", "error pred.",
                  "error meas.", "PSNR"):

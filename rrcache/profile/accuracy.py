@@ -162,7 +162,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
         for nid in nodes:
             node = profile.node(nid)
             report.training_r2[nid] = node.error_r2
-            variant = variant_for(work, nid, periods[0], settings.algorithm)
+            variant = variant_for(work, nid, periods[0], profile.algorithm)
             common = dict(block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon)
             measured = {}
             with CachedRenderer(variant, session, work.prepared, settings.resolution, period=periods[0],

@@ -62,17 +62,24 @@ class Plan:
     error_window: Optional[Window]
     timing_window: Optional[Window]
     original_ms: float
+    #: the cache algorithm of the profile (``auto`` settings: the faster one measured, see
+    #: :func:`rrcache.profile.train.choose_algorithm`), and the median time of each candidate
+    #: as a fraction of the original's
+    algorithm: Optional[str] = None
+    algorithm_times: Optional[dict] = None
 
     def to_json(self) -> dict:
         return {"error_window": list(self.error_window) if self.error_window else None,
                 "timing_window": list(self.timing_window) if self.timing_window else None,
-                "original_ms": self.original_ms}
+                "original_ms": self.original_ms, "algorithm": self.algorithm,
+                "algorithm_times": self.algorithm_times}
 
     @classmethod
     def from_json(cls, data: dict) -> "Plan":
         ew, tw = data.get("error_window"), data.get("timing_window")
         return cls(tuple(int(v) for v in ew) if ew else None, tuple(int(v) for v in tw) if tw else None,
-                   float(data.get("original_ms", float("nan"))))
+                   float(data.get("original_ms", float("nan"))), data.get("algorithm"),
+                   data.get("algorithm_times"))
 
 
 def fraction_for(original_ms: float, target_ms: float, cap: float, floor: float = MIN_FRACTION) -> float:

@@ -148,6 +148,15 @@ class Profile:
                                hint="run 'rrcache profile' again to rewrite it") from None
         self._table = None
 
+    @property
+    def algorithm(self) -> str:
+        """The cache algorithm the profile was trained and validated with (``auto`` settings:
+        the one its plan measured faster)."""
+        chosen = (self.data.get("plan") or {}).get("algorithm")
+        if chosen:
+            return chosen
+        return self.settings.algorithm if self.settings.algorithm != "auto" else "three-pass"
+
     # ------------------------------------------------------------------ models
     @property
     def trained_nodes(self) -> list[NodeProfile]:
@@ -220,7 +229,7 @@ class Profile:
         if work.shader.hash != self.data.get("shader_hash"):
             raise RRCacheError("the shader changed since it was profiled", str(self.shader),
                                hint="run 'rrcache profile' again")
-        variant = variant_for(work, choice.node, int(choice.period), self.settings.algorithm)
+        variant = variant_for(work, choice.node, int(choice.period), self.algorithm)
         return variant.write(out)
 
     def to_json(self) -> dict:
@@ -229,6 +238,16 @@ class Profile:
     def __repr__(self) -> str:
         return (f"Profile({self.shader!r}, {len(self.trained_nodes)}/{len(self.nodes)} nodes trained, "
                 f"original {self.original_ms:.2f} ms)" if isinstance(self.original_ms, float) else "Profile(...)")
+
+
+def algorithm_line(prof: Profile) -> str:
+    """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
+    0.377, three-pass 0.41 of the original's time)'."""
+    times = (prof.data.get("plan") or {}).get("algorithm_times") or {}
+    if prof.settings.algorithm != "auto" or not times:
+        return prof.algorithm
+    measured = ", ".join(f"{name} {value:.3f}" for name, value in sorted(times.items(), key=lambda kv: kv[1]))
+    return f"{prof.algorithm} (auto: {measured} of the original's time)"
 
 
 def load_profile(path) -> Profile:
@@ -384,7 +403,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         from rrcache.profile.validate import validate
 
         rows = validate(work, session, settings, store, prof.table, progress,
-                        window=result.plan.timing_window if result.plan is not None else None)
+                        window=result.plan.timing_window if result.plan is not None else None,
+                        algorithm=prof.algorithm)
         texts = {n.id: n.text for n in nodes}
         prof.selections = [SelectionReport(r.label, r.max_error, r.node, r.period, texts.get(r.node),
                                            r.predicted_error, r.predicted_ms, r.predicted_speedup, r.measured_error,
@@ -415,7 +435,7 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         if sel.node is None:
             prof.write_variant(sel, folder)
         else:
-            variant_for(work, sel.node, int(sel.period), prof.settings.algorithm).write(folder)
+            variant_for(work, sel.node, int(sel.period), prof.algorithm).write(folder)
         sel.files = str(folder.relative_to(out))
     prof.path = out
     prof._where = str(out / JSON_NAME)

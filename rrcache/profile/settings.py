@@ -36,6 +36,9 @@ from rrcache.errors import RRCacheError
 from rrcache.runtime import ALGORITHMS, REFRESH_MODES
 
 #: the paper's training periods (main paper §4.2)
+#: the cache algorithms a profile may use; ``auto`` measures which is faster on this machine
+ALGORITHM_CHOICES = ("auto",) + tuple(ALGORITHMS)
+
 DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
 #: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
 DEFAULT_TIMING_PERIODS = (2, 8, 50)
@@ -81,6 +84,9 @@ class TrainingSettings:
     - ``timing_frames``: L, the frames timed per node and timing period (spread evenly).
     - ``timing_periods``: the periods at which each node is timed.
     - ``algorithm``, ``block``, ``refresh``, ``depth_epsilon``: the cache's own settings.
+      ``algorithm="auto"`` (the default) times the three-pass and two-pass variants of the first
+      node to train side by side with the original and keeps the faster for the whole profile
+      (:func:`rrcache.profile.train.choose_algorithm`; the choice is kept in the plan).
     - ``validation_frames``: consecutive frames of each validation render; None: all.
     - ``budget_s``: node training starts no new node once this many seconds are spent.
     - ``validate``: render the four selections against the original after training.
@@ -94,7 +100,7 @@ class TrainingSettings:
     frames: Optional[int] = None
     timing_frames: int = 8
     timing_periods: tuple[int, ...] = DEFAULT_TIMING_PERIODS
-    algorithm: str = "three-pass"
+    algorithm: str = "auto"
     block: int = 4
     refresh: str = "random"
     depth_epsilon: float = 1e-3
@@ -121,8 +127,8 @@ class TrainingSettings:
                 continue
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise _fail(name, f"{value!r} is not a frame count", f"give a whole number >= {low}")
-        if self.algorithm not in ALGORITHMS:
-            raise _fail("algorithm", f"unknown algorithm {self.algorithm!r}", f"one of {', '.join(ALGORITHMS)}")
+        if self.algorithm not in ALGORITHM_CHOICES:
+            raise _fail("algorithm", f"unknown algorithm {self.algorithm!r}", f"one of {', '.join(ALGORITHM_CHOICES)}")
         if self.block not in BLOCK_SIZES:
             raise _fail("block", f"{self.block!r} is not a refresh block size", "one of 1, 2, 4, 8")
         if self.refresh not in REFRESH_MODES:

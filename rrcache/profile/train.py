@@ -6,7 +6,9 @@ holds, and fits the models from what is stored:
 0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profile.order`
    (too-cheap nodes skipped, the rest diversity first). The original is timed at full resolution
    on the timing frames, and from that time the windows of :mod:`rrcache.profile.plan` are
-   chosen (once; kept in the store).
+   chosen (once; kept in the store). With ``algorithm="auto"`` the three-pass and two-pass
+   variants of the first node are timed beside the original (:func:`choose_algorithm`) and the
+   faster serves the whole profile (kept in the plan too).
 1. **Reference frames.** The original shader over the training frames inside the error window
    (full pixel density), rendered once and kept in memory for the run.
 2. **Error runs.** Per node one :class:`~rrcache.harness.cached.CachedRenderer` inside the same
@@ -201,6 +203,33 @@ def _timing_run(cached: CachedRenderer, original: Renderer, node_id: str, period
     return out
 
 
+#: what ``algorithm="auto"`` chooses from: one-pass is left out (its dynamic branch runs in
+#: lock-step across SIMD lanes on llvmpipe: 1.1x on Marble, never the fastest), and the default
+#: when there is nothing to measure
+AUTO_CANDIDATES = ("three-pass", "two-pass")
+DEFAULT_ALGORITHM = "three-pass"
+
+
+def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node_id: str, original: Renderer,
+                     timing: list[int], window, meter: _Meter) -> tuple[str, dict]:
+    """Time the :data:`AUTO_CANDIDATES` variants of ``node_id`` on the timing frames at the
+    middle timing period, each frame beside the original as the timing runs are, and return the
+    faster and each one's median time as a fraction of the original's. The three-pass
+    algorithm is the paper's choice for GPUs, where a pass over the geometry is cheap and
+    multiple render targets are not; on llvmpipe the geometry is set up on one thread, and the
+    two-pass variant, one pass over the geometry fewer, measured 8-10% faster on Marble."""
+    period = settings.timing_periods[len(settings.timing_periods) // 2]
+    full = tuple(int(v) for v in session.resolution)
+    fractions = {}
+    for algorithm in AUTO_CANDIDATES:
+        variant = variant_for(work, node_id, period, algorithm)
+        with CachedRenderer(variant, session, work.prepared, full, period=period, block=settings.block,
+                            refresh=settings.refresh, depth_epsilon=settings.depth_epsilon, window=window) as cached:
+            frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
+        fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
+    return min(fractions, key=fractions.get), fractions
+
+
 def _node_complete(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
     return (all(store.has_error_run(node_id, p) for p in settings.periods)
             and all(store.has_timing_run(node_id, p) for p in settings.timing_periods))
@@ -265,6 +294,15 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             original.release()
             original = Renderer(work.prepared, session, full, window=plan.timing_window)
         timed_original = original
+        if plan.algorithm is None:
+            if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
+                meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
+                plan.algorithm, plan.algorithm_times = choose_algorithm(
+                    work, session, settings, order.nodes[0].id, timed_original, timing, plan.timing_window, meter)
+            else:
+                plan.algorithm = settings.algorithm if settings.algorithm != "auto" else DEFAULT_ALGORITHM
+            store.set_plan(plan.to_json())
+        algorithm = plan.algorithm
 
         refs = []
         if need_refs:
@@ -282,7 +320,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 budget_stopped = True
                 meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
                 continue
-            variant = variant_for(work, nid, settings.timing_periods[0], settings.algorithm)
+            variant = variant_for(work, nid, settings.timing_periods[0], algorithm)
             if todo_error[nid]:
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, settings.resolution, period=settings.periods[0],
@@ -314,7 +352,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         if i not in trained:
             notes[i] = "not reached within the training budget (--budget)"
     if trained and need_overhead:
-        _measure_overhead(work, session, settings, store, trained[0], timing, meter)
+        _measure_overhead(work, session, settings, store, trained[0], timing, meter, plan.algorithm)
 
     skipped_ids = [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
     result = TrainingResult(order=ids + skipped_ids, trained=trained,
@@ -327,8 +365,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     return result
 
 
-def _measure_overhead(work, session, settings, store, node_id, timing, meter) -> None:
-    variant = variant_for(work, node_id, settings.timing_periods[-1], settings.algorithm)
+def _measure_overhead(work, session, settings, store, node_id, timing, meter, algorithm: str) -> None:
+    variant = variant_for(work, node_id, settings.timing_periods[-1], algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
                         block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon) as cached:

@@ -27,9 +27,11 @@ LABELS = ("e1", "e2", "e3", "e4")
 
 
 def validate(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore, table,
-             progress: Optional[ProgressFn] = None, window=None) -> list[ValidationRow]:
+             progress: Optional[ProgressFn] = None, window=None, algorithm: Optional[str] = None) -> list[ValidationRow]:
     """Select at four thresholds of ``table`` (a ``rrcache.model.ModelTable``), measure each
-    selection (inside ``window`` when given), store and return the rows (in label order)."""
+    selection with ``algorithm`` (default: the settings'; the profile passes its plan's choice)
+    inside ``window`` when given, store and return the rows (in label order)."""
+    algorithm = algorithm or (settings.algorithm if settings.algorithm != "auto" else "three-pass")
     from rrcache.model import select, thresholds
 
     levels = [float(t) for t in thresholds(table, len(LABELS))]
@@ -54,7 +56,7 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
         else:
             key = (choice.node, int(choice.period))
             if key not in measured:
-                variant = variant_for(work, choice.node, int(choice.period), settings.algorithm)
+                variant = variant_for(work, choice.node, int(choice.period), algorithm)
 
                 def step(*_, detail=f"{label}: {choice.node} Δn={choice.period}"):
                     nonlocal done

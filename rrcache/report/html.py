@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.profile.profile import algorithm_line
 from rrcache.report import assets
 from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
 from rrcache.report.images import CAPTIONS, FrameShots, data_uri
@@ -165,7 +166,7 @@ def _plots(prof) -> str:
 
 def _settings(prof) -> str:
     rows = [(k, json.dumps(v)) for k, v in prof.settings.to_json().items()]
-    rows += [("shader", prof.shader), ("session", prof.session),
+    rows += [("algorithm used", algorithm_line(prof)), ("shader", prof.shader), ("session", prof.session),
              ("defines", json.dumps(prof.defines) if prof.defines else "–"),
              ("training time", _f(prof.training_wall_s, 4, " s")),
              ("budget stopped training", str(bool(prof.data.get("budget_stopped")))),

@@ -169,7 +169,7 @@ class FrameShots:
         if node not in self._variants:
             from rrcache.pipeline import variant_for
 
-            self._variants[node] = variant_for(self.work, node, None, self.profile.settings.algorithm)
+            self._variants[node] = variant_for(self.work, node, None, self.profile.algorithm)
         return self._variants[node]
 
     def frame_for(self, period: Optional[int]) -> int:
