@@ -119,9 +119,11 @@ class CacheBench:
 
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
-        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3) -> CacheBench:
+        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
+        limit_algorithm: str = "three-pass") -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
-    (``periods=()`` or ``blocks=()`` leave those rows out)."""
+    (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
+    ``limit_algorithm``."""
     say = progress or (lambda _msg: None)
     session = load_session(session_path)
     work = load_for_session(shader_path, session)
@@ -159,7 +161,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
 
     say("limit: every pixel hits")
     probe = list(indices)[:: max(1, len(indices) // 5)][:5]
-    variant = variant_for(work, node_id, compare_period)
+    variant = variant_for(work, node_id, compare_period, limit_algorithm)
     cached_ms, original_ms = [], []
     with Renderer(work.prepared, session, resolution) as original, \
             CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:

@@ -164,6 +164,7 @@ class SceneResult:
     limit_speedup: Optional[float] = None
     limit_ms: Optional[float] = None
     limit_original_ms: Optional[float] = None
+    limit_algorithm: Optional[str] = None
     medium: Optional[str] = None
     target_speedup: Optional[float] = None
     selections: list = field(default_factory=list)
@@ -390,13 +391,14 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
 
     _say(progress, f"algorithms and limit on {medium.node_id}")
     bench = cache_bench.run(scene.shader, session_path, medium.node_id, periods=(), compare_period=int(medium.period),
-                            frames=len(frames), blocks=(), repeats=1,
+                            frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
                             progress=lambda msg: _say(progress, f"algorithms: {msg}"))
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
                                    r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]
     originals += [r.original_ms for r in result.algorithms]
     result.limit_ms, result.limit_original_ms = bench.limit_ms, bench.limit_original_ms
     result.limit_speedup = bench.limit_speedup
+    result.limit_algorithm = prof.algorithm
 
     if medium.speedup > 1.0 + settings.tolerance:
         result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)

@@ -56,7 +56,8 @@ def scene_markdown(s) -> str:
     if s.algorithms:
         lines += _methods(s.algorithms, f"cache algorithms on the {s.medium} node")
     if s.limit_speedup is not None:
-        lines += [f"Limit (every pixel hits): {_f(s.limit_ms, '.2f')} ms against {_f(s.limit_original_ms, '.2f')} ms: "
+        which = f", {s.limit_algorithm}" if s.limit_algorithm else ""
+        lines += [f"Limit (every pixel hits{which}): {_f(s.limit_ms, '.2f')} ms against {_f(s.limit_original_ms, '.2f')} ms: "
                   f"at most {_f(s.limit_speedup, '.2f')}×.", ""]
     if s.equal_time:
         lines += _methods(s.equal_time, f"equal time: tuned to the {s.medium} speed-up {_f(s.target_speedup, '.2f')}×")
