@@ -152,10 +152,7 @@ class Profile:
     def algorithm(self) -> str:
         """The cache algorithm the profile was trained and validated with (``auto`` settings:
         the one its plan measured faster)."""
-        chosen = (self.data.get("plan") or {}).get("algorithm")
-        if chosen:
-            return chosen
-        return self.settings.algorithm if self.settings.algorithm != "auto" else "three-pass"
+        return (self.data.get("plan") or {}).get("algorithm") or self.settings.fixed_algorithm
 
     # ------------------------------------------------------------------ models
     @property

@@ -38,6 +38,8 @@ from rrcache.runtime import ALGORITHMS, REFRESH_MODES
 #: the paper's training periods (main paper §4.2)
 #: the cache algorithms a profile may use; ``auto`` measures which is faster on this machine
 ALGORITHM_CHOICES = ("auto",) + tuple(ALGORITHMS)
+#: what ``auto`` stands for when nothing was measured (no node to time)
+DEFAULT_ALGORITHM = "three-pass"
 
 DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
 #: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
@@ -108,6 +110,12 @@ class TrainingSettings:
     budget_s: float = 360.0
     validate: bool = True
     min_saving: float = 0.1
+
+    @property
+    def fixed_algorithm(self) -> str:
+        """The algorithm these settings name without measuring: ``algorithm``, or
+        :data:`DEFAULT_ALGORITHM` for ``auto``."""
+        return DEFAULT_ALGORITHM if self.algorithm == "auto" else self.algorithm
 
     def __post_init__(self):
         hint = "give whole numbers from 1 to 1000, e.g. 2,10,18,26,34,42,50"

@@ -204,10 +204,8 @@ def _timing_run(cached: CachedRenderer, original: Renderer, node_id: str, period
 
 
 #: what ``algorithm="auto"`` chooses from: one-pass is left out (its dynamic branch runs in
-#: lock-step across SIMD lanes on llvmpipe: 1.1x on Marble, never the fastest), and the default
-#: when there is nothing to measure
+#: lock-step across SIMD lanes on llvmpipe: 1.1x on Marble, never the fastest)
 AUTO_CANDIDATES = ("three-pass", "two-pass")
-DEFAULT_ALGORITHM = "three-pass"
 
 
 def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node_id: str, original: Renderer,
@@ -300,7 +298,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 plan.algorithm, plan.algorithm_times = choose_algorithm(
                     work, session, settings, order.nodes[0].id, timed_original, timing, plan.timing_window, meter)
             else:
-                plan.algorithm = settings.algorithm if settings.algorithm != "auto" else DEFAULT_ALGORITHM
+                plan.algorithm = settings.fixed_algorithm
             store.set_plan(plan.to_json())
         algorithm = plan.algorithm
 

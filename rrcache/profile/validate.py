@@ -31,7 +31,7 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
     """Select at four thresholds of ``table`` (a ``rrcache.model.ModelTable``), measure each
     selection with ``algorithm`` (default: the settings'; the profile passes its plan's choice)
     inside ``window`` when given, store and return the rows (in label order)."""
-    algorithm = algorithm or (settings.algorithm if settings.algorithm != "auto" else "three-pass")
+    algorithm = algorithm or settings.fixed_algorithm
     from rrcache.model import select, thresholds
 
     levels = [float(t) for t in thresholds(table, len(LABELS))]

@@ -280,8 +280,7 @@ class CacheRuntime:
         self._set(program, G.PREV_PAYLOAD, _UNIT_PREV_PAYLOAD)
         self._set(program, G.PREV_INVDEPTH, _UNIT_PREV_INVDEPTH)
         self._set(program, G.CUR_PAYLOAD, _UNIT_CUR_PAYLOAD)
-        for name, value in refresh_uniforms(self.size, self._block, self._refresh_mode, self.seed,
-                                            self._period, self.clock).items():
+        for name, value in self._refresh_values.items():
             self._set(program, name, value)
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
@@ -318,6 +317,9 @@ class CacheRuntime:
         cache_fbo.use()
         ctx.depth_func = "<"
         first, second = self._queries if count else (None, None)
+        # the refresh rule's uniforms, once per frame for every pass
+        self._refresh_values = refresh_uniforms(self.size, self._block, self._refresh_mode, self.seed,
+                                                self._period, self.clock)
         covered = misses = None
         if self.algorithm == "three-pass":
             self._run("reproject", draw)
