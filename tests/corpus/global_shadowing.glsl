@@ -1,0 +1,24 @@
+// Locals and parameters named like the globals a helper reads: after inlining, the helper's
+// `pos.y` and `vec3(uv, h)` must still mean the globals, not the caller's locals.
+#version 330
+in vec3 v_objectPosition;
+in vec3 v_normal;
+in vec2 v_texcoord;
+uniform vec3 u_light;
+out vec4 fragColor;
+
+vec3 pos = vec3(0.25, 0.5, 0.75);
+vec2 uv = vec2(0.3, 0.6);
+
+float height() { return pos.y * 2.0 + sin(v_objectPosition.y * 4.0); }
+
+vec3 tint(float h) { return vec3(uv, h); }
+
+float shade(vec3 uv) { return max(dot(normalize(v_normal), normalize(u_light - uv)), 0.0); }
+
+void main() {
+    float pos = v_objectPosition.x;          // shadows the global vec3 pos
+    vec3 uv = v_objectPosition * 0.5 + 0.5;  // shadows the global vec2 uv
+    vec3 c = tint(height()) * shade(uv) + pos * 0.1;
+    fragColor = vec4(c, 1.0);
+}
