@@ -132,6 +132,10 @@ CASES = {
         vec3 tint(float h) { return vec3(st, h); }
         void main() { float pos = uv.y; vec3 st = vec3(uv, 0.5);
                       fragColor = vec4(tint(height()) * 0.5 + st * 0.25 + pos * 0.1, 1.0); }""",
+    "local_named_like_a_builtin": """
+        float edge(float x) { return step(0.5, x) * 0.5 + smoothstep(0.2, 0.8, x) * 0.5; }
+        void main() { float step = 0.25; float smoothstep = uv.y;
+                      fragColor = vec4(edge(uv.x) + step, smoothstep, 0.5, 1.0); }""",
     "globals_after_main": """
         float wave(float x);
         void main() { fragColor = vec4(wave(uv.x), wave(uv.y), 0.5, 1.0); }

@@ -215,16 +215,23 @@ class _Inliner:
         return self.unit
 
     def _global_names_read(self, d: A.FunctionDecl) -> set[str]:
-        """The globals the body of ``d`` names (by their semantic symbols)."""
-        return {n.name for n in walk(d.body, decl_types=False)
-                if isinstance(n, A.Ident) and n.symbol is not None
-                and id(getattr(n.symbol, "decl", None)) in self.global_copy}
+        """The global names the body of ``d`` uses: globals (by their semantic symbols) and the
+        functions it calls (built-in or not)."""
+        names = set()
+        for n in walk(d.body, decl_types=False):
+            if isinstance(n, A.Ident):
+                if n.symbol is not None and id(getattr(n.symbol, "decl", None)) in self.global_copy:
+                    names.add(n.name)
+            elif isinstance(n, A.Call) and n.kind in ("builtin", "function"):
+                names.add(n.name)
+        return names
 
     def _unshadow_globals(self) -> None:
-        """Rename the locals and parameters that have the name of a global some inlinable
-        function reads: once that function's body is inlined into their scope, the name would
-        mean the local (``vec3 pos; float f() { return pos.y; }`` inlined where ``float pos``
-        is declared). Each gets a fresh ``_rr_<name>_<n>``; other names are left as written."""
+        """Rename the locals and parameters that have the name of a global or a function some
+        inlinable function uses: once that function's body is inlined into their scope, the
+        name would mean the local (``vec3 pos; float f() { return pos.y; }`` inlined where
+        ``float pos`` is declared; ``step(a, b)`` inlined where ``float step`` is). Each gets
+        a fresh ``_rr_<name>_<n>``; other names are left as written."""
         shadowed = set()
         for d in self.defs:
             if self.inlinable[id(d)]:
