@@ -5,8 +5,14 @@ A shader is loaded with the ``MODEL_VERTEX_*`` defines of the session's meshes (
 cacheable nodes). :func:`load_for_session` does the three once, and :func:`variant_for`
 compiles the variant of one node.
 
->>> work = load_for_session("shaders/marble.glsl", load_session("sessions/marble.json"))  # doctest: +SKIP
->>> variant = variant_for(work, "n2575", period=16)                                      # doctest: +SKIP
+>>> from rrcache.session import load_session
+>>> work = load_for_session("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"))
+>>> work.defines
+{'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TANGENT': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
+>>> node = max(work.table.nodes, key=lambda n: n.cost)
+>>> variant = variant_for(work, node.id, period=16)
+>>> variant.algorithm, variant.period, sorted(variant.passes)
+('three-pass', 16, ['payload', 'reproject', 'shade'])
 """
 from __future__ import annotations
 

@@ -90,9 +90,12 @@ def prepare(shader, defines: Optional[Mapping[str, str]] = None) -> PreparedShad
 
     ``defines`` are recorded (the shader must already have been loaded with them).
 
-    >>> from rrcache.glsl.frontend import parse_shader          # doctest: +SKIP
-    >>> prepare(parse_shader(open("marble.frag").read(), "marble.frag")).source[:17]  # doctest: +SKIP
-    '#version 330 core'
+    >>> from rrcache.glsl.frontend import parse_shader
+    >>> shader = parse_shader("varying vec3 v_normal;\\nvoid main() { gl_FragColor = vec4(v_normal, 1.0); }",
+    ...                       "normal.frag")
+    >>> p = prepare(shader)
+    >>> p.source[:17], sorted(p.inputs)
+    ('#version 330 core', ['v_normal'])
     """
     from rrcache.glsl.legacy import to_core
     from rrcache.glsl.printer import print_with_map
@@ -131,8 +134,8 @@ def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping
     iterable of attribute names (``normal texcoord color tangent``). ``extra_defines`` (e.g. from
     ``-D`` on the command line) are added and win over the mesh defines.
 
-    >>> prepared = prepare_file("marble.frag", {"normal", "texcoord"})   # doctest: +SKIP
-    >>> prepared.defines                                                 # doctest: +SKIP
+    >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", {"normal", "texcoord"})
+    >>> prepared.defines
     {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
     """
     from rrcache.glsl.frontend import load_shader
