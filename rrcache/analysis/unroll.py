@@ -21,6 +21,14 @@ variable is replaced by its value as a literal and the body's locals get fresh n
 copies. Nested loops unroll inside out once the outer variable is a literal. Other loops are
 left as they are (the cacheable-node analysis treats what is inside them as ``dynamic``).
 
+Constants are evaluated as GLSL does: ``int``/``uint`` wrap to 32 bits (``-1u`` is
+``0xFFFFFFFF``; a ``uint`` loop may count down through zero), ``float`` in single precision,
+comparisons and ``&&``/``||``/``^^``/``!`` to ``bool``. An ``if`` or ``?:`` whose condition
+became constant in a copy (``if (i > 0)`` with ``i`` = 0) keeps only the branch taken, since the
+other may index an array out of range (``a[i - 1]``), which is a compile error once the index
+is constant. A loop with a copy that still holds such an index (under a guard this pass does
+not decide, ``i > 0 && a[i - 1] > x``) is left rolled.
+
 >>> from rrcache.glsl.frontend import parse_shader
 >>> from rrcache.glsl.printer import print_glsl
 >>> s = parse_shader("void main() { float a = 0.0; for (int i = 0; i < 2; i++) a += float(i);"
