@@ -30,7 +30,7 @@ from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
-from rrcache.runtime import CacheRuntime
+from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
 
 #: the largest finite 16-bit float: payload values beyond it would be stored as ±inf
 HALF_MAX = 65504.0
@@ -64,7 +64,8 @@ class CachedRenderer:
     """
 
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
-                 period: int = 8, block: int = 4, refresh: str = "random", depth_epsilon: float = 1e-3,
+                 period: int = DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+                 depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None):
         self.ctx = ctx or get_context()
@@ -308,9 +309,9 @@ class Comparison:
         }
 
 
-def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
-            resolution: Optional[tuple[int, int]] = None, block: int = 4, refresh: str = "random",
-            depth_epsilon: float = 1e-3, hit_maps: bool = False,
+def compare(variant, session, prepared: PreparedShader, frames, period: int = DEFAULT_PERIOD,
+            resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+            depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
             window: Optional[tuple[int, int, int, int]] = None) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating

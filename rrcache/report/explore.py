@@ -1,5 +1,5 @@
 """The notebooks' figures and the interactive profiler widget (``notebooks/explore.ipynb`` and
-``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.report.demo_profile`).
+``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.profiler.demo_profile`).
 
 Figures (matplotlib): :func:`tradeoff_figure` (every node path, the original's time, the Pareto
 front, the selections), :func:`node_figure` (a node's measured errors with the fitted error model,
