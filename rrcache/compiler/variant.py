@@ -8,8 +8,13 @@ to the original shader), what the application must bind, and how the runtime mus
 
     variant = instance(analysed, node_id)            # rrcache.compiler.instance
     programs = variant.build_programs(ctx)
-    rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h),
+    rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h), period=16,
                       payload_dtype=variant.payload_dtype)
+    variant.write("out/", period=16)                 # the manifest records the period it ran with
+
+The refresh period and the cache's other run-time parameters are not part of a variant (the same
+passes run at any period): they are the runtime's, with their defaults in
+:mod:`rrcache.runtime.cache` (``DEFAULT_PERIOD`` …).
 """
 from __future__ import annotations
 

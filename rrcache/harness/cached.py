@@ -133,7 +133,9 @@ class CachedRenderer:
         self.runtime.reset()
         self._last = None
 
-    def _frame(self, index: int, hit_box: Optional[dict]):
+    def _frame(self, hit_box: Optional[dict]):
+        """Run the passes of the frame set on the drawer; with ``hit_box`` the exact hit map is
+        read after the first pass into ``hit_box["map"]``."""
         def read_hits():
             hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
         return self.runtime.frame(self.drawer.draw, after_first_pass=read_hits if hit_box is not None else None)
@@ -147,7 +149,7 @@ class CachedRenderer:
             self.runtime.reset()
         self.drawer.set_frame(index)
         if not self._warm:
-            self._frame(index, None)
+            self._frame(None)
             if self._check_half:
                 self._settle_payload()
             self.runtime.reset()
@@ -155,7 +157,7 @@ class CachedRenderer:
         hit_box = {} if self.hit_maps else None
         ctx.finish()
         start = time.perf_counter()
-        stats = self._frame(index, hit_box)
+        stats = self._frame(hit_box)
         ctx.finish()
         ms = (time.perf_counter() - start) * 1000.0
         self._last = index

@@ -6,7 +6,9 @@ predicted error grid E[N, P] (eq. 2) and frame-time grid T[N, P] (eq. 5) over Δ
 :func:`select` is then a masked argmin over those grids — a few tens of microseconds for 200
 nodes × 50 periods (:func:`selection_benchmark`), so a threshold slider can re-select at once.
 The original shader competes as the option (error 0, ``original_ms``): a node is chosen only
-when it is predicted strictly faster than the original.
+when it is predicted strictly faster than the original. A choice is the record
+:class:`rrcache.selection.Selection` (one ``CachedNode(node, period)`` part, or none for the
+original), the same record the store, ``profile.json``, the report and the bench carry.
 
 >>> table = synthetic_table(20, seed=1)
 >>> choice = select(table, max_error=0.05)
