@@ -125,6 +125,10 @@ def test_profile_json_schema(trained):
     for sel in data["selections"]:
         assert (folder / "out" / sel["files"] / "manifest.json").exists()
         assert all(part["kind"] == "cache" for part in sel["parts"]) and sel["algorithm"] == prof.algorithm
+        manifest = json.loads((folder / "out" / sel["files"] / "manifest.json").read_text())
+        if sel["parts"]:  # the manifest records what the selection runs with
+            assert manifest["period"] == sel["parts"][0]["period"] and manifest["algorithm"] == sel["algorithm"]
+            assert manifest["runtime"] == prof.settings.cache_options()
     # what is read back is what the run returned (written once, from the same record)
     assert load_profile(folder / "out") == prof
     # nothing non-finite leaks into the JSON
@@ -146,6 +150,7 @@ def test_auto_algorithm_keeps_the_faster_variant(trained):
     prof.write_variant(Selection((CachedNode(node, 13),)), folder / "chosen")
     manifest = json.loads((folder / "chosen" / "manifest.json").read_text())
     assert manifest["algorithm"] == prof.algorithm and manifest["period"] == 13  # what it runs with
+    assert manifest["runtime"] == {"block": 4, "refresh": "random", "depth_epsilon": 1e-3}
     assert prof.algorithm in algorithm_line(prof) and "auto:" in algorithm_line(prof)
 
 

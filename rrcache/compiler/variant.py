@@ -70,10 +70,12 @@ class Variant:
         """The passes in the order the runtime runs them."""
         return ALGORITHMS[self.algorithm]
 
-    def manifest(self, period: Optional[int] = None) -> dict:
+    def manifest(self, period: Optional[int] = None, runtime: Optional[dict] = None) -> dict:
         """A JSON-able description of the variant; ``period`` is the refresh period Δn it runs
         with (the runtime's default when None): the passes do not depend on it, the runtime
-        takes it, and the manifest records it.
+        takes it, and the manifest records it. ``runtime`` (the cache's other keyword arguments
+        it ran with: ``block``, ``refresh``, ``depth_epsilon``) is recorded as ``"runtime"`` when
+        given.
 
         >>> v = Variant("one-pass", 3, "float", "sin(x)", 1, "bilinear", "f4",
         ...             {"single": PassSource("vs", "fs")})
@@ -106,11 +108,14 @@ class Variant:
             },
             "uniforms": sorted({u for names in self.uniforms.values() for u in names}),
             "textures": sorted({s for names in self.samplers.values() for s in names}),
+            **({"runtime": dict(runtime)} if runtime else {}),
         }
 
-    def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None) -> list[str]:
-        """Write ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json`` (recording ``period``,
-        see :meth:`manifest`) into ``out_dir`` (created when missing); returns the paths written."""
+    def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,
+              runtime: Optional[dict] = None) -> list[str]:
+        """Write ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json`` (recording ``period``
+        and ``runtime``, see :meth:`manifest`) into ``out_dir`` (created when missing); returns
+        the paths written."""
         out_dir = os.fspath(out_dir)
         os.makedirs(out_dir, exist_ok=True)
         written = []
@@ -122,7 +127,7 @@ class Variant:
                 written.append(path)
         path = os.path.join(out_dir, "manifest.json")
         with open(path, "w", encoding="utf-8") as f:
-            json.dump(self.manifest(period), f, indent=2)
+            json.dump(self.manifest(period, runtime), f, indent=2)
             f.write("\n")
         written.append(path)
         return written

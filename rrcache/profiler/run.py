@@ -164,7 +164,7 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
             prof.write_variant(sel, folder)
         else:
             variant, period = variant_for_selection(work, sel)
-            variant.write(folder, period=period)
+            variant.write(folder, period=period, runtime=prof.settings.cache_options())
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out

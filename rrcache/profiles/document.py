@@ -249,7 +249,7 @@ class Profile:
             raise RRCacheError("the shader changed since it was profiled", str(self.shader),
                                hint="run 'rrcache profile' again")
         variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
-        return variant.write(out, period=period)
+        return variant.write(out, period=period, runtime=self.settings.cache_options())
 
     # ------------------------------------------------------------------ the document
     def to_json(self) -> dict:
