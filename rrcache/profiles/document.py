@@ -353,17 +353,16 @@ def _read(value, tp, path: str, file: str, meta):
         if not args:
             return dict(value)
         return {k: _read(v, args[1], f"{path}.{k}", file, meta) for k, v in value.items()}
-    if origin is list:
+    if origin is list or origin is tuple:
         if not isinstance(value, list):
             raise _fail(file, path, "must be a list")
-        return [_read(v, args[0], f"{path}[{i}]", file, meta) for i, v in enumerate(value)]
+        items = [_read(v, args[0], f"{path}[{i}]", file, meta) for i, v in enumerate(value)]
+        return items if origin is list else tuple(items)
     if tp is TrainingSettings:
         try:
             return TrainingSettings.from_json(value, "settings")
         except RRCacheError as err:  # "settings: block: ..." with the file in front
             raise RRCacheError(err.message, f"{file}: {path}", hint=err.hint) from None
-    if tp is Selection:
-        return _read_selection(value, path, file)
     if dataclasses.is_dataclass(tp):
         return _read_dataclass(tp, value, path, file)
     raise TypeError(f"no reader for {tp!r}")  # a shape declared with a type this module cannot check
@@ -389,39 +388,14 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise _fail(file, at, "is missing")
             continue
+        if f.metadata.get("parts"):  # the tagged parts of a Selection (rrcache.selection)
+            try:
+                kwargs[name] = parts_from_json(value[name], at)
+            except RRCacheError as err:
+                raise _fail(file, err.where, err.message) from None
+            continue
         kwargs[name] = _read(value[name], hints[name], at, file, f.metadata)
     return cls(**kwargs)
-
-
-_SELECTION_RANGES = {"predicted_error": (0, None), "predicted_ms": (0, None), "predicted_speedup": (0, None),
-                     "max_error": (0, None), "measured_error": (0, None), "measured_ms": (0, None),
-                     "measured_original_ms": (0, None), "measured_speedup": (0, None), "hit_rate": (0, 1),
-                     "frames": (0, None)}
-
-
-def _read_selection(value, path: str, file: str) -> Selection:
-    if not isinstance(value, dict):
-        raise _fail(file, path, "must be an object")
-    try:
-        parts = parts_from_json(value.get("parts", []), f"{path}.parts")
-    except RRCacheError as err:
-        raise RRCacheError(err.message, f"{file}: {err.where}", hint=_HINT) from None
-    hints = typing.get_type_hints(Selection)
-    names = {f.name for f in dataclasses.fields(Selection)}
-    unknown = sorted(set(value) - names)
-    if unknown:
-        raise _fail(file, f"{path}.{unknown[0]}", "unknown key")
-    kwargs = {"parts": parts}
-    for name in names - {"parts"}:
-        if name not in value:
-            continue
-        low, high = _SELECTION_RANGES.get(name, (None, None))
-        hint = hints[name]
-        if name == "speedups":
-            hint = list[float]
-        read = _read(value[name], hint, f"{path}.{name}", file, {"minimum": low, "maximum": high})
-        kwargs[name] = tuple(read) if name == "speedups" else read
-    return Selection(**kwargs)
 
 
 # ---------------------------------------------------------------------- reading
