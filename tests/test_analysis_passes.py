@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rrcache.analysis import analyse, expand_compound_assignments, inline_calls, unroll_loops
-from rrcache.analysis._tree import walk
+from rrcache.glsl.ast import walk
 from rrcache.errors import UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.frontend import parse_shader

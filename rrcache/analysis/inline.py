@@ -48,10 +48,12 @@ from typing import Optional
 from rrcache.glsl import ast as A
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import (
-    NameAllocator, assign, check_reserved_names, children, clone, declare, declare_typed,
-    is_literal, out_qualifiers, param_qualifier, rewrite_scoped, walk, with_chain,
+from rrcache.glsl.ast import children, is_literal, walk
+from rrcache.glsl.rewrite import (
+    NameAllocator, assign, check_reserved_names, clone, declare, declare_typed, rewrite_scoped,
+    with_chain,
 )
+from rrcache.glsl.writes import out_qualifiers, param_qualifier
 
 __all__ = ["inline_calls", "inline_unit"]
 
@@ -100,7 +102,7 @@ class _Template:
         if self.uses > 0:
             return clone(self.body, lambda loc: with_chain(loc, site))
         body, self.body = self.body, None
-        for n in walk(body):
+        for n in walk(body, decl_types=False):
             if n.loc is not None:
                 n.loc = with_chain(n.loc, site)
         return body
@@ -118,13 +120,7 @@ def _returns_in_loops(s: A.Node, inside: bool = False) -> bool:
 def _stmt_children(s: A.Node):
     if isinstance(s, A.Compound):
         return s.stmts
-    if isinstance(s, A.If):
-        return [x for x in (s.then, s.else_) if x is not None]
-    if isinstance(s, (A.For, A.While, A.DoWhile)):
-        return [s.body]
-    if isinstance(s, A.Switch):
-        return [s.body]
-    return []
+    return [sub for _, sub in A.branches(s)]
 
 
 def _has_return(s: A.Node) -> bool:
@@ -200,7 +196,7 @@ class _Inliner:
     def run(self) -> A.TranslationUnit:
         self.call_sites: dict[int, int] = {}
         for d in self.defs:
-            for n in walk(d.body):
+            for n in walk(d.body, decl_types=False):
                 if isinstance(n, A.Call):
                     t = self._target(n)
                     if t is not None:
@@ -221,7 +217,7 @@ class _Inliner:
         if id(d) in done:
             return
         done.add(id(d))
-        for n in walk(d.body):
+        for n in walk(d.body, decl_types=False):
             if isinstance(n, A.Call):
                 t = self._target(n)
                 if t is not None:
@@ -241,7 +237,7 @@ class _Inliner:
         if any(param_qualifier(p) != "in" for p in d.params):
             return True
         local = {p.name for p in d.params if p.name}
-        for n in walk(d.body):
+        for n in walk(d.body, decl_types=False):
             if isinstance(n, A.Declarator):
                 local.add(n.name)
             elif isinstance(n, A.Call):
@@ -270,7 +266,7 @@ class _Inliner:
         stack = [d for d in self.defs if d.name == "main"]
         roots = [x for x in self.unit.decls if not isinstance(x, A.FunctionDecl)]
         for r in roots:
-            for n in walk(r):
+            for n in walk(r, decl_types=False):
                 if isinstance(n, A.Call) and n.name in by_name:
                     stack.extend(by_name[n.name])
         while stack:
@@ -278,7 +274,7 @@ class _Inliner:
             if id(d) in keep:
                 continue
             keep.add(id(d))
-            for n in walk(d.body):
+            for n in walk(d.body, decl_types=False):
                 if isinstance(n, A.Call) and n.name in by_name:
                     stack.extend(by_name[n.name])
         kept_names = {d.name for d in self.defs if id(d) in keep}
@@ -306,7 +302,7 @@ class _Inliner:
                 t = self._target(e)
                 got = t is not None and self.inlinable.get(id(t), False)
             if not got:
-                got = any(self.has_call(c) for c in children(e))
+                got = any(self.has_call(c) for c in children(e, decl_types=False))
             self._calls_memo[key] = (e, got)
         return got
 
@@ -324,7 +320,7 @@ class _Inliner:
                     or getattr(e.target, "side_effects", False)):
                 got = True
             else:
-                got = any(self.has_effects(c) for c in children(e))
+                got = any(self.has_effects(c) for c in children(e, decl_types=False))
             self._effects_memo[key] = (e, got)
         return got
 
@@ -515,7 +511,7 @@ class _Inliner:
         return out
 
     def _effects_call(self, e) -> bool:
-        for n in walk(e):
+        for n in walk(e, decl_types=False):
             if isinstance(n, A.Call):
                 t = self._target(n)
                 if t is not None and self.effectful.get(id(t), True):

@@ -39,9 +39,9 @@ import numpy as np
 from rrcache.glsl import ast as A
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import (
-    InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped, walk, written_roots,
-)
+from rrcache.glsl.ast import walk
+from rrcache.glsl.rewrite import InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped
+from rrcache.glsl.writes import written_roots
 
 __all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL"]
 
@@ -363,7 +363,7 @@ def _breaks(s, depth: int = 0) -> bool:
     if isinstance(s, (A.For, A.While, A.DoWhile)):
         return False
     if isinstance(s, A.Switch):
-        return any(isinstance(n, A.Continue) for n in walk(s.body)
+        return any(isinstance(n, A.Continue) for n in walk(s.body, decl_types=False)
                    if not isinstance(n, (A.For, A.While, A.DoWhile)))
     if isinstance(s, A.Compound):
         return any(_breaks(x) for x in s.stmts)
