@@ -24,7 +24,10 @@ def main() -> None:
     ap.add_argument("--max-unroll", type=int, default=None)
     args = ap.parse_args()
     from rrcache.analysis import cacheable_nodes
-    from rrcache.analysis._tree import iter_exprs
+    try:
+        from rrcache.glsl.ast import iter_exprs
+    except ImportError:      # versions before the AST traversal moved to glsl/ast.py
+        from rrcache.analysis._tree import iter_exprs
     from rrcache.glsl.frontend import parse_shader
 
     source = open(args.shader, encoding="utf-8").read()
