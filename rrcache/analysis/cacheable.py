@@ -147,6 +147,10 @@ class ExcludedNode:
     cost: int = 0
     call_chain: list[str] = field(default_factory=list)
 
+    #: a node left out is valid for no algorithm
+    algorithms = property(lambda self: [])
+    invalid = property(lambda self: {a: self.reason for a in ALGORITHMS})
+
     def to_json(self) -> dict:
         return {"id": self.id, "reason": self.reason, "line": self.line, "column": self.column,
                 "text": self.text, "type": self.type, "cost": self.cost,

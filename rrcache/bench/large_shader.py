@@ -7,13 +7,18 @@ implicit level of detail, small arrays. :func:`realistic_shader` writes ``module
 ``main`` that calls every module and accumulates the colour by component, until the source has
 about ``target_lines`` lines. The shader reads only the harness's varyings, so it renders too.
 
+:func:`sketch_shader` writes the other common shape, a long ``main`` of straight-line code as
+ES sketches are written (a folding, rotating point and a distance refined step after step, the
+colour built by component): every value depends on all the steps before it, which is what made
+the old cacheable-set closure quadratic in time and memory.
+
 >>> src = realistic_shader(400)
 >>> 350 < src.count("\\n") < 600 and "textureGrad" not in src and "texture(u_tex" in src
 True
 """
 from __future__ import annotations
 
-__all__ = ["realistic_shader"]
+__all__ = ["realistic_shader", "sketch_shader"]
 
 _HEADER = """#version 330
 in vec4 v_position;
@@ -112,4 +117,35 @@ def realistic_shader(target_lines: int = 8000, octaves: int = 6) -> str:
     for k in range(modules):
         out.append(f"    color.rgb += module_{k}(p, n, v_texcoord);\n")
     out.append(f"    color.rgb /= {float(modules)};\n    fragColor = color;\n}}\n")
+    return "".join(out)
+
+
+_SKETCH_HEAD = """#version 330
+in vec4 v_position;
+in vec3 v_normal;
+in vec2 v_texcoord;
+uniform float u_time;
+out vec4 fragColor;
+
+void main() {
+    vec3 p0 = v_position.xyz;
+    float d0 = length(p0) - 1.0;
+    vec4 col = vec4(0.0, 0.0, 0.0, 1.0);
+"""
+
+_SKETCH_STEP = """    vec3 p{k} = abs(p{j}.yzx * 1.{a}) - vec3(0.{b}, 0.{c}, 0.3);
+    p{k}.xy = vec2(p{k}.x * 0.8 - p{k}.y * 0.6, p{k}.x * 0.6 + p{k}.y * 0.8);
+    float d{k} = min(d{j}, length(p{k}) * 0.5 - 0.{b});
+    col.rgb += 0.02 * vec3(sin(d{k} * 3.0), cos(p{k}.z), exp(-abs(d{k})));
+"""
+
+
+def sketch_shader(target_lines: int = 8000) -> str:
+    """An ES-sketch-shaped shader of about ``target_lines`` lines (module docstring)."""
+    per_step = _SKETCH_STEP.count("\n")
+    steps = max(1, (target_lines - _SKETCH_HEAD.count("\n") - 3) // per_step)
+    out = [_SKETCH_HEAD]
+    for k in range(1, steps + 1):
+        out.append(_SKETCH_STEP.format(k=k, j=k - 1, a=k % 9 + 1, b=k % 7 + 1, c=k % 5 + 1))
+    out.append(f"    fragColor = vec4(col.rgb * (0.5 + 0.5 * sin(d{steps})), 1.0);\n}}\n")
     return "".join(out)
