@@ -1,13 +1,14 @@
 """Time and peak memory of node analysis of one shader file, in this process.
 
-    python tools/bench_nodes_file.py SHADER [--max-unroll N]
+    python -m rrcache.bench.probe SHADER [--max-unroll N]
+    PYTHONPATH=OTHER_CHECKOUT python rrcache/bench/probe.py SHADER    # another version
 
 Prints one JSON line: lines, AST expression nodes of the analysed program, parse seconds,
 analysis seconds (inline + unroll + cacheable nodes), the process's peak resident memory (MB)
 before and after the analysis, and the table's counts. Only `parse_shader` and `cacheable_nodes`
-are used, so the same script measures any version of rrcache put on PYTHONPATH (that is how
-docs/bench_frontend.md compares before and after). Run each shader in a fresh process: peak
-resident memory only grows.
+are used, so the same file measures any version of rrcache put on PYTHONPATH (that is how
+docs/bench_frontend.md compares before and after). ``rrcache bench-frontend --generated`` runs
+it once per shader in a fresh process: peak resident memory only grows.
 """
 from __future__ import annotations
 
@@ -18,11 +19,11 @@ import sys
 import time
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("shader")
     ap.add_argument("--max-unroll", type=int, default=None)
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     from rrcache.analysis import cacheable_nodes
     try:
         from rrcache.glsl.ast import iter_exprs
