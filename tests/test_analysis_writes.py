@@ -273,3 +273,34 @@ def test_session_textures_are_mipmapped_and_minified_in_the_corpus(gl_ctx):
         level0 = r.render_frame(0)
     diff = np.abs(mipmapped.image - level0.image)[mipmapped.mask]
     assert diff.mean() > 0.01
+
+
+def test_every_node_after_implicit_lod_lookups_reproduces_the_original_at_period_one(gl_ctx):
+    """Issue 14 item 2 on rendered images: every listed node of the implicit-LOD corpus shader
+    (a minified mipmapped checker, a biased cube-map lookup, fwidth), in every algorithm its
+    table entry allows, reproduces the original at Δn = 1 on a 64×64 frame."""
+    import numpy as np
+
+    from rrcache.harness.cached import CachedRenderer
+    from rrcache.harness.renderer import Renderer
+    from rrcache.pipeline import load_for_session, variant_for
+    from rrcache.session import load_session
+
+    session = load_session(CORPUS / "implicit_lod.json")
+    work = load_for_session(CORPUS / "implicit_lod.glsl", session)
+    frames = range(min(2, session.frames))
+    with Renderer(work.prepared, session, (64, 64)) as original:
+        reference = [original.render_frame(i) for i in frames]
+    restricted = [n for n in work.table.nodes if n.algorithms == ["three-pass", "two-pass"]]
+    assert len(restricted) >= 5 and reference[0].covered_pixels > 200
+    checked = 0
+    for node in work.table.nodes:
+        for algorithm in node.algorithms:
+            variant = variant_for(work, node.id, 1, algorithm)
+            with CachedRenderer(variant, session, work.prepared, (64, 64), period=1) as cached:
+                for ref in reference:
+                    got = cached.render_frame(ref.index)
+                    err = float(np.abs(got.image - ref.image)[ref.mask].max())
+                    assert err <= 1e-4, (node.id, node.text, algorithm, ref.index, err)
+                    checked += 1
+    assert checked >= 2 * (2 * len(restricted))
