@@ -134,8 +134,11 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
                        compare_period=compare_period)
 
     plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
+    # only the algorithms the node table allows for this node (one-pass cannot cache a value
+    # that needs screen-space derivatives)
     plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period)
-             for algorithm in ("three-pass", "two-pass", "one-pass")]
+             for algorithm in ("three-pass", "two-pass", "one-pass")
+             if algorithm in getattr(entry, "algorithms", ("three-pass", "two-pass", "one-pass"))]
     plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period) for block in blocks]
     if periods:
         plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH))

@@ -7,8 +7,12 @@
 The table shows each node's id (for ``rrcache`` commands that take a node), GLSL type, source
 line:column, estimated cost (the work a cache hit saves, see ``rrcache.analysis.cost``), the
 inlined call chain and the expression. ``--all`` adds the nodes left out, with the reason
-(``type dynamic derivative uniform duplicate cheap``). ``--json`` prints
-``{"shader", "nodes": [...], "excluded": [...]}``; ``excluded`` is empty unless ``--all``.
+(``type dynamic screen derivative uniform duplicate cheap``). A node that only some cache
+algorithms can hold (one that needs screen-space derivatives cannot be cached by one-pass) gets
+an ``algorithms`` column naming those, with the reason for the others under the table.
+``--json`` prints ``{"shader", "nodes": [...], "excluded": [...]}``; every node has
+``algorithms`` (the valid ones) and ``not_valid`` (algorithm -> reason); ``excluded`` is empty
+unless ``--all``.
 """
 from __future__ import annotations
 
@@ -16,6 +20,7 @@ import json
 
 import click
 
+from rrcache.analysis.cacheable import REASONS
 from rrcache.cli.options import parse_defines
 from rrcache.pipeline import load_for_session
 
@@ -34,8 +39,9 @@ def _chain(chain: list[str], width: int = 36) -> str:
 def format_table(table, show_all: bool) -> str:
     """The readable text table of a :class:`NodeTable` (with ``show_all``, the nodes left out
     too, in id order, with their reason)."""
-    header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + [
-        "inlined from", "expression"]
+    restricted = any(n.invalid for n in table.nodes)
+    header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + (
+        ["algorithms"] if restricted else []) + ["inlined from", "expression"]
     entries = [(n, "final" if n.final else "") for n in table.nodes]
     if show_all:
         entries += [(x, x.reason) for x in table.excluded]
@@ -47,14 +53,19 @@ def format_table(table, show_all: bool) -> str:
             row.append(reason)
         elif reason:
             row[0] += "*"
+        if restricted:
+            valid = getattr(n, "algorithms", [])
+            row.append("all" if len(valid) == 3 else ",".join(valid) or "-")
         rows.append(row + [_chain(n.call_chain), _short(n.text)])
     widths = [max(len(r[i]) for r in rows) for i in range(len(header) - 1)]
     lines = ["  ".join(r[i].rjust(w) if i == 3 else r[i].ljust(w)
                        for i, w in enumerate(widths)) + "  " + r[-1] for r in rows]
     counts = table.counts()
-    left = ", ".join(f"{counts[k]} {k}" for k in ("type", "dynamic", "derivative", "uniform",
-                                                     "duplicate", "cheap") if counts[k])
+    left = ", ".join(f"{counts[k]} {k}" for k in REASONS if counts[k])
     lines.append("")
+    reasons = sorted({(a, why) for n in table.nodes for a, why in n.invalid.items()})
+    for a, why in reasons:
+        lines.append(f"not {a}: {why}")
     if not show_all and any(n.final for n in table.nodes):
         lines.append("* the final colour")
     lines.append(f"{counts['listed']} cacheable nodes" + (f"; left out: {left}" if left else "")
