@@ -28,6 +28,7 @@ from rrcache.errors import RRCacheError
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.renderer import Renderer
 from rrcache.profile.plan import Plan
+from rrcache.profile.profile import check_same_shader
 from rrcache.profile.train import _Meter, _error_run, _timing_run, timing_frame_indices
 
 DEFAULT_PERIODS = (6, 14, 30)
@@ -144,9 +145,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
                            hint="give trained node ids (profile.json lists them)")
     session = load_session(profile.session)
     work = load_for_session(profile.shader, session, profile.defines)
-    if work.shader.hash != profile.data.get("shader_hash"):
-        raise RRCacheError("the shader changed since it was profiled", str(profile.shader),
-                           hint="run 'rrcache profile' again")
+    check_same_shader(profile.data, work)
     plan = Plan.from_json(profile.data.get("plan") or {})
     full = tuple(int(v) for v in session.resolution)
     train_frames = list(range(settings.frames))

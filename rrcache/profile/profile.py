@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.glsl.frontend import describe_change, file_records
 from rrcache.jsonable import finite_json as _finite
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ProfileStore, StoreKey
@@ -223,9 +224,7 @@ class Profile:
         from rrcache.session import load_session
 
         work = load_for_session(self.shader, load_session(self.session), self.defines)
-        if work.shader.hash != self.data.get("shader_hash"):
-            raise RRCacheError("the shader changed since it was profiled", str(self.shader),
-                               hint="run 'rrcache profile' again")
+        check_same_shader(self.data, work)
         variant = variant_for(work, choice.node, int(choice.period), self.algorithm)
         return variant.write(out)
 
@@ -235,6 +234,22 @@ class Profile:
     def __repr__(self) -> str:
         return (f"Profile({self.shader!r}, {len(self.trained_nodes)}/{len(self.nodes)} nodes trained, "
                 f"original {self.original_ms:.2f} ms)" if isinstance(self.original_ms, float) else "Profile(...)")
+
+
+def check_same_shader(data: dict, work) -> None:
+    """Raise unless ``work`` (the shader loaded again for a profile's ``data``) has the profiled
+    hash; the error says which file changed, or that none did (never blames an edit that did not
+    happen)."""
+    if work.shader.hash == data.get("shader_hash"):
+        return
+    what = describe_change(data.get("shader_files"), work.shader, data.get("defines"))
+    if what.startswith("no shader file changed") or what.startswith("the record predates"):
+        raise RRCacheError(f"the shader's hash differs from the profile's, though {what}" if what.startswith("no ")
+                           else f"the shader's hash differs from the profile's: {what}",
+                           str(data.get("shader")),
+                           hint="run 'rrcache profile' again to make a profile for it")
+    raise RRCacheError(f"the shader changed since it was profiled: {what}", str(data.get("shader")),
+                       hint="run 'rrcache profile' again, or restore the file")
 
 
 def algorithm_line(prof: Profile) -> str:
@@ -378,6 +393,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         "session": str(Path(session_path).resolve()),
         "defines": dict(work.defines),
         "shader_hash": work.shader.hash,
+        "shader_files": file_records(work.shader),
         "session_hash": session.hash,
         "settings": settings.to_json(),
         "nodes": [dataclasses.asdict(n) for n in nodes],
