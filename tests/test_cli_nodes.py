@@ -107,3 +107,52 @@ def test_errors_exit_nonzero_without_traceback(capsys, tmp_path, content, messag
 def test_bad_define_is_a_usage_error(capsys, shader_file):
     code, _, err = run(capsys, "nodes", shader_file, "-D", "1BAD")
     assert code == 2 and "NAME or NAME=VALUE" in err and "Traceback" not in err
+
+
+# --- which GLSL a shader without #version was read as (issue 14, item 7) -------------------------
+
+SKETCH = """// a Book of Shaders sketch: no #version
+#ifdef GL_ES
+precision mediump float;
+#endif
+uniform vec2 u_resolution;
+uniform float u_time;
+varying vec2 v_texcoord;
+
+void main() {
+    vec2 st = v_texcoord * 4.0;
+#ifdef GL_ES
+    float w = sin(st.x * 3.0 + u_time) * cos(st.y * 5.0 - u_time);
+#else
+    float w = 0.0; // the desktop branch: never what the sketch tools run
+#endif
+    gl_FragColor = vec4(vec3(0.5 + 0.5 * w), 1.0);
+}
+"""
+
+
+@pytest.mark.parametrize("source,es,says", [
+    (SKETCH, True, "GLSL ES 1.00 (no #version;"),
+    ("varying vec2 v_texcoord;\nvoid main() { gl_FragColor = vec4(sin(v_texcoord * 9.0), 0.0, 1.0); }\n",
+     False, "desktop GLSL 1.10 (no #version"),
+    ("#version 330\nin vec2 v_texcoord; out vec4 c;\nvoid main() { c = vec4(sin(v_texcoord * 9.0), 0.0, 1.0); }\n",
+     False, "GLSL 330 core"),
+])
+def test_nodes_says_which_glsl(capsys, tmp_path, source, es, says):
+    path = tmp_path / "sketch.frag"
+    path.write_text(source)
+    code, out, _ = run(capsys, "nodes", str(path))
+    assert code == 0 and out.splitlines()[-1].startswith("read as " + says)
+    code, out, _ = run(capsys, "nodes", str(path), "--json")
+    lang = json.loads(out)["language"]
+    assert lang["es"] is es and lang["text"].startswith(says)
+    assert lang["assumed"] is ("no #version" in says)
+
+
+def test_es_sketch_takes_its_gl_es_branch(capsys, tmp_path):
+    path = tmp_path / "sketch.frag"
+    path.write_text(SKETCH)
+    code, out, _ = run(capsys, "nodes", str(path), "--json", "--all")
+    doc = json.loads(out)
+    texts = [n["text"] for n in doc["nodes"] + doc["excluded"]]
+    assert any("cos(st.y * 5.0 - u_time)" in t for t in texts), texts

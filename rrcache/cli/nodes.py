@@ -8,7 +8,11 @@ The table shows each node's id (for ``rrcache`` commands that take a node), GLSL
 line:column, estimated cost (the work a cache hit saves, see ``rrcache.analysis.cost``), the
 inlined call chain and the expression. ``--all`` adds the nodes left out, with the reason
 (``type dynamic derivative uniform duplicate cheap``). ``--json`` prints
-``{"shader", "nodes": [...], "excluded": [...]}``; ``excluded`` is empty unless ``--all``.
+``{"shader", "nodes": [...], "excluded": [...], "language": {...}}``; ``excluded`` is empty
+unless ``--all``. The last line (``language`` in JSON: version, profile, ``es``, ``assumed``,
+``text``) says which GLSL the shader was read as; a shader without ``#version`` is GLSL ES 1.00
+when it has a ``precision`` statement or tests ``GL_ES`` (as ES sketch tools run it), else
+desktop GLSL 1.10.
 """
 from __future__ import annotations
 
@@ -89,6 +93,9 @@ def command(shader, as_json, show_all, define, max_unroll, session):
         doc = table.to_json(shader)
         if not show_all:
             doc["excluded"] = []
+        doc["language"] = {"version": loaded.version, "profile": loaded.profile, "es": loaded.es,
+                           "assumed": loaded.assumed is not None, "text": loaded.language}
         click.echo(json.dumps(doc, indent=2))
     else:
         click.echo(format_table(table, show_all))
+        click.echo(f"read as {loaded.language}")

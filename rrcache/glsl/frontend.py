@@ -68,6 +68,23 @@ class Shader:
     defines: dict[str, object] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
     file_hashes: list[str] = field(default_factory=list)
+    #: without ``#version``: the language assumed and why (``Preprocessed.assumed``)
+    assumed: Optional[str] = None
+
+    @property
+    def language(self) -> str:
+        """The GLSL the shader was read as, in words: ``GLSL 330 core``, ``GLSL ES 3.00``, or for
+        a shader without ``#version`` the assumption and its reason.
+
+        >>> parse_shader("#version 300 es\nprecision highp float; out vec4 c;\n"
+        ...              "void main() { c = vec4(1.0); }").language
+        'GLSL ES 3.00'
+        """
+        if self.assumed:
+            return self.assumed
+        if self.es:
+            return f"GLSL ES {self.version // 100}.{self.version % 100:02d}"
+        return f"GLSL {self.version}" + (f" {self.profile}" if self.profile else "")
 
     @property
     def varyings(self) -> dict[str, tuple[Type, SourceLoc]]:
@@ -113,7 +130,7 @@ def parse_shader(source: str, filename: str = "<string>",
                   if s.type.contains_opaque()},
         inputs={n: (s.type, s.loc) for n, s in info.inputs.items() if n in info.used_globals},
         outputs={n: (s.type, s.loc) for n, s in info.outputs.items()},
-        defines=defines, files=files, file_hashes=digests)
+        defines=defines, files=files, file_hashes=digests, assumed=pp.assumed)
 
 
 def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, object]] = None,
