@@ -17,7 +17,7 @@ from rrcache.analysis import cacheable_nodes
 from rrcache.compiler import Variant, instance
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader, load_shader
-from rrcache.harness.prepare import PreparedShader, prepare
+from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare
 from rrcache.harness.vertex import mesh_defines, session_attributes
 
 
@@ -30,6 +30,16 @@ class ShaderWork:
     prepared: PreparedShader
     table: object
     defines: dict
+
+    @property
+    def vertex(self):
+        """The user's vertex shader (``UserVertex``), or None when the harness generates it."""
+        return self.prepared.vertex
+
+    @property
+    def hash(self) -> str:
+        """The fragment shader's hash, covering the user's vertex shader too when there is one."""
+        return self.prepared.hash
 
     def node(self, node_id: str):
         """The table entry (listed or excluded) with this id; an unknown id raises the analysis'
@@ -44,18 +54,20 @@ class ShaderWork:
 
 
 def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, str]] = None,
-                     include_dirs=()) -> ShaderWork:
+                     include_dirs=(), vertex=None) -> ShaderWork:
     """Load, prepare and analyse ``shader_path``; with a ``session`` its meshes' attributes set
-    the ``MODEL_VERTEX_*`` defines (``defines`` win over them)."""
+    the ``MODEL_VERTEX_*`` defines (``defines`` win over them). ``vertex`` is the path of the
+    user's vertex shader (None: the session's ``"vertex"``, else a generated one)."""
     all_defines = mesh_defines(session_attributes(session)) if session is not None else {}
     all_defines.update(defines or {})
     shader = load_shader(shader_path, defines=all_defines, include_dirs=include_dirs)
-    return ShaderWork(shader, prepare(shader, all_defines), cacheable_nodes(shader), all_defines)
+    user = load_user_vertex(vertex, session, all_defines, include_dirs)
+    return ShaderWork(shader, prepare(shader, all_defines, user), cacheable_nodes(shader), all_defines)
 
 
 def variant_for(work: ShaderWork, node_id: str, period: Optional[int] = None, algorithm: str = "three-pass",
                 filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``)."""
-    variant = instance(work.table, node_id, algorithm, filter, payload_dtype)
+    variant = instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex)
     variant.period = period
     return variant

@@ -21,7 +21,7 @@ import json
 import click
 
 from rrcache.analysis.cacheable import cacheable_nodes
-from rrcache.cli.options import parse_defines
+from rrcache.cli.options import parse_defines, vert_option
 from rrcache.glsl.frontend import load_shader
 
 _TEXT_WIDTH = 70
@@ -67,6 +67,17 @@ def format_table(table, show_all: bool) -> str:
     return "\n".join(lines)
 
 
+def _check_vertex(loaded, vert, session, defines) -> None:
+    """With a vertex shader (``--vert`` or the session's), check that it writes every input the
+    fragment shader reads (the error names the declaration)."""
+    from rrcache.harness.prepare import load_user_vertex
+
+    user = load_user_vertex(vert, session, defines)
+    if user is not None:
+        user.check_inputs({n: str(t) for n, (t, _loc) in loaded.inputs.items()},
+                          {n: loc for n, (_t, loc) in loaded.inputs.items()})
+
+
 @click.command("nodes")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
@@ -79,15 +90,19 @@ def format_table(table, show_all: bool) -> str:
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Apply the MODEL_VERTEX_* defines of this session's meshes, as `rrcache render` "
                    "and `rrcache profile` do (node ids depend on the defines).")
-def command(shader, as_json, show_all, define, max_unroll, session):
+@vert_option
+def command(shader, as_json, show_all, define, max_unroll, session, vert):
     """List the nodes of SHADER that a reprojection cache can hold."""
     defines = parse_defines(define)
+    loaded_session = None
     if session is not None:
         from rrcache.harness.vertex import mesh_defines, session_attributes
         from rrcache.session import load_session
 
-        defines = {**mesh_defines(session_attributes(load_session(session))), **defines}
+        loaded_session = load_session(session)
+        defines = {**mesh_defines(session_attributes(loaded_session)), **defines}
     loaded = load_shader(shader, defines)
+    _check_vertex(loaded, vert, loaded_session, defines)
     table = cacheable_nodes(loaded, max_iterations=max_unroll)
     if as_json:
         doc = table.to_json(shader)

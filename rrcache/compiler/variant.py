@@ -65,6 +65,7 @@ class Variant:
     forms: dict[str, str] = field(default_factory=dict)
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
+    vertex_path: Optional[str] = None  # the user's vertex shader (None: generated)
     period: Optional[int] = None  # the refresh period Δn chosen for this variant (None: runtime default)
 
     @property
@@ -138,7 +139,8 @@ class Variant:
                 programs[name] = build_program(
                     ctx, src.vertex, src.fragment, src.fragment_line_map,
                     fragment_name=f"{shader} ({name} pass)",
-                    vertex_name=f"<generated vertex shader of the {name} pass>")
+                    vertex_name=(f"{self.vertex_path} ({name} pass)" if self.vertex_path
+                                 else f"<generated vertex shader of the {name} pass>"))
             except GLError as err:
                 for prog in programs.values():
                     prog.release()

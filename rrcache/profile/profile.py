@@ -133,6 +133,7 @@ class Profile:
             self.shader = data["shader"]
             self.session = data["session"]
             self.defines = dict(data.get("defines") or {})
+            self.vertex = data.get("vertex")  # the user's vertex shader file, or None
             self.settings = TrainingSettings.from_json(data["settings"], where)
             self.nodes = [NodeProfile(**n) for n in data["nodes"]]
             self.selections = [SelectionReport(**s) for s in data.get("selections", [])]
@@ -223,7 +224,7 @@ class Profile:
         from rrcache.pipeline import load_for_session, variant_for
         from rrcache.session import load_session
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines)
+        work = load_for_session(self.shader, load_session(self.session), self.defines, vertex=self.vertex)
         check_same_shader(self.data, work)
         variant = variant_for(work, choice.node, int(choice.period), self.algorithm)
         return variant.write(out)
@@ -240,9 +241,13 @@ def check_same_shader(data: dict, work) -> None:
     """Raise unless ``work`` (the shader loaded again for a profile's ``data``) has the profiled
     hash; the error says which file changed, or that none did (never blames an edit that did not
     happen)."""
-    if work.shader.hash == data.get("shader_hash"):
+    if work.hash == data.get("shader_hash"):
         return
     what = describe_change(data.get("shader_files"), work.shader, data.get("defines"))
+    vertex_hash = work.vertex.hash if work.vertex is not None else None
+    if vertex_hash != data.get("vertex_hash") and "vertex_hash" in data:
+        changed = f"the vertex shader '{work.vertex.path if work.vertex is not None else data.get('vertex')}' changed"
+        what = changed if what.startswith("no shader file changed") else f"{what}; {changed}"
     if what.startswith("no shader file changed") or what.startswith("the record predates"):
         raise RRCacheError(f"the shader's hash differs from the profile's, though {what}" if what.startswith("no ")
                            else f"the shader's hash differs from the profile's: {what}",
@@ -305,11 +310,12 @@ def default_out_dir(shader_path, session_path) -> Path:
 
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
-            fresh: bool = False, plots: bool = True) -> Profile:
+            fresh: bool = False, plots: bool = True, vertex=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`Profile`. Resumes from a store in ``out_dir``
     trained with the same shader, session and settings; ``fresh=True`` moves it aside first.
-    ``progress`` receives :class:`~rrcache.profile.train.ProgressEvent` objects. A
+    ``progress`` receives :class:`~rrcache.profile.train.ProgressEvent` objects; ``vertex`` is
+    the user's vertex shader file (None: the session's ``"vertex"``, else generated). A
     ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and propagates.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
@@ -321,12 +327,12 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     from rrcache.session import load_session
 
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, defines)
+    work = load_for_session(shader_path, session, defines, vertex=vertex)
     resolved = (settings or TrainingSettings()).resolved(session)
     out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
-    key = StoreKey(work.shader.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
+    key = StoreKey(work.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
     store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
     started = time.time()
     try:
@@ -392,8 +398,10 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         "shader": str(Path(shader_path).resolve()),
         "session": str(Path(session_path).resolve()),
         "defines": dict(work.defines),
-        "shader_hash": work.shader.hash,
+        "shader_hash": work.hash,
         "shader_files": file_records(work.shader),
+        "vertex": os.path.abspath(work.vertex.path) if work.vertex is not None else None,
+        "vertex_hash": work.vertex.hash if work.vertex is not None else None,
         "session_hash": session.hash,
         "settings": settings.to_json(),
         "nodes": [dataclasses.asdict(n) for n in nodes],

@@ -170,6 +170,8 @@ class Session:
     description: str = ""
     background: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     document: dict = field(default_factory=dict, repr=False)
+    #: the user's vertex shader file (``"vertex"``, resolved), or None for a generated one
+    vertex: str | None = None
     _camera: Callable[[int], Camera] | None = field(default=None, repr=False)
     _light: Callable[[int], Light] | None = field(default=None, repr=False)
     _uniforms: Callable[[int], dict[str, Any]] | None = field(default=None, repr=False)
