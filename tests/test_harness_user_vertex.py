@@ -227,3 +227,26 @@ def test_cli_vert_option(tmp_path, capsys):
                          "--out", tmp_path / "inst")
     assert code == 0, err
     assert "rr_userMain" in (tmp_path / "inst" / "reproject.vert").read_text()
+
+
+def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
+    """A profile made with --vert re-selects with it, and a changed vertex shader is named."""
+    from types import SimpleNamespace
+
+    from rrcache.profile import TrainingSettings, load_profile, profile
+
+    frag, session = _scene(tmp_path, vertex=False)
+    vert = frag.with_suffix(".vert")
+    settings = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), timing_frames=4, timing_periods=(2, 8),
+                                validate=False)
+    prof = profile(frag, session, tmp_path / "out", settings, vertex=vert, plots=False)
+    assert prof.data["vertex"] == str(vert) and prof.data["vertex_hash"]
+    node = next(n.id for n in prof.nodes if n.trained)
+    again = load_profile(tmp_path / "out")
+    written = again.write_variant(SimpleNamespace(node=node, period=4), tmp_path / "sel")
+    assert "rr_userMain" in next(open(p).read() for p in written if p.endswith("reproject.vert") or
+                                 p.endswith("hit.vert") or p.endswith("single.vert"))
+    vert.write_text(VERT.replace("0.5 + 0.5 * a_position.y", "0.5 + 0.4 * a_position.y"))
+    with pytest.raises(RRCacheError, match="the vertex shader .*gv.vert' changed") as info:
+        again.write_variant(SimpleNamespace(node=node, period=4), tmp_path / "sel2")
+    assert "gv.frag' changed" not in str(info.value)
