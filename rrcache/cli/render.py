@@ -91,7 +91,7 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
         result = render(prepared, loaded, indices, resolution=resolution, progress=done)
 
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     if as_json:
         click.echo(json.dumps({
             "frames": len(result.frames),
@@ -146,7 +146,7 @@ def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resoluti
                          block=opts["block"], refresh=opts["refresh"], depth_epsilon=opts["depth_epsilon"],
                          on_frame=done)
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     summary = result.summary()
     if as_json:
         click.echo(json.dumps(dict(

@@ -71,7 +71,7 @@ class SceneDrawer:
         self.size = size
         self.scope = scope
         self.cull_back_faces = cull_back_faces
-        self.notes: list[str] = []
+        self.notes: list[str] = list(getattr(session, "notes", None) or [])
         self._plans: dict[int, BindingPlan] = {}
         self._vaos: dict[int, list] = {}
         self._buffers: dict[tuple[int, str], moderngl.Buffer] = {}

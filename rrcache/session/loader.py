@@ -250,4 +250,5 @@ def load_session(path: str | os.PathLike) -> Session:
         frames=int(doc["frames"]), fps=float(doc.get("fps", 30)), objects=objects, textures=textures,
         hash=assets.digest(doc), name=doc.get("name", ""), description=doc.get("description", ""),
         background=tuple(float(c) for c in doc.get("background", (0.0, 0.0, 0.0, 0.0))), document=doc,
-        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex)
+        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex,
+        notes=[f"{path}: {note}" for path, mesh in assets.meshes.items() for note in mesh.notes])
