@@ -57,6 +57,7 @@ from rrcache.glsl.printer import print_expr
 from rrcache.analysis._tree import chain_of, is_live_flag, iter_exprs, paused_gc, written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
+from rrcache.analysis.source_text import attach_source_text
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
 __all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "cacheable_nodes",
@@ -78,11 +79,12 @@ class CacheableNode:
     call_chain: list[str]
     node: A.Expr = field(repr=False, compare=False)
     final: bool = False
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
 
     def to_json(self) -> dict:
         return {"id": self.id, "type": self.type, "line": self.line, "column": self.column,
                 "text": self.text, "cost": self.cost, "call_chain": list(self.call_chain),
-                "final": self.final}
+                "final": self.final, "file": self.file}
 
 
 @dataclass
@@ -98,11 +100,12 @@ class ExcludedNode:
     type: str = ""
     cost: int = 0
     call_chain: list[str] = field(default_factory=list)
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
 
     def to_json(self) -> dict:
         return {"id": self.id, "reason": self.reason, "line": self.line, "column": self.column,
                 "text": self.text, "type": self.type, "cost": self.cost,
-                "call_chain": list(self.call_chain)}
+                "call_chain": list(self.call_chain), "file": self.file}
 
 
 @dataclass
@@ -176,7 +179,10 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     """
     with paused_gc():
         target = shader if analysed else analyse(shader, max_iterations)
-        return _Classifier(target, cheap_below).run()
+        table = _Classifier(target, cheap_below).run()
+        if not analysed:  # the text as written, and the file, of nodes from inlined code
+            attach_source_text(table, shader.unit)
+        return table
 
 
 # ----------------------------------------------------------------------------- classification

@@ -5,8 +5,13 @@
     rrcache nodes shaders/marble.glsl --json
 
 The table shows each node's id (for ``rrcache`` commands that take a node), GLSL type, source
-line:column, estimated cost (the work a cache hit saves, see ``rrcache.analysis.cost``), the
-inlined call chain and the expression. ``--all`` adds the nodes left out, with the reason
+line:column (``file:line:column`` for a line of an included file, the file relative to the
+shader's folder: ``lygia/generative/fbm.glsl:13:15``), estimated cost (the work a cache hit
+saves, see ``rrcache.analysis.cost``), the inlined call chain and the expression as written
+(``sum + amp * snoise(p)``, not the inliner's temporaries; ``rrcache.analysis.source_text``).
+Without ``--session``, a shader that tests ``MODEL_VERTEX_*`` macros gets a hint (a last line
+``hint: ...``, ``"hint"`` in JSON, and in the error message when it fails): those branches are
+off until a session's meshes (or ``-D``) define them. ``--all`` adds the nodes left out, with the reason
 (``type dynamic derivative uniform duplicate cheap``). ``--json`` prints
 ``{"shader", "nodes": [...], "excluded": [...], "language": {...}}``; ``excluded`` is empty
 unless ``--all``. The last line (``language`` in JSON: version, profile, ``es``, ``assumed``,
@@ -20,7 +25,12 @@ import json
 
 import click
 
+import os
+import re
+
 from rrcache.analysis.cacheable import cacheable_nodes
+from rrcache.analysis.source_text import display_file
+from rrcache.errors import RRCacheError
 from rrcache.cli.options import parse_defines, vert_option
 from rrcache.glsl.frontend import load_shader
 
@@ -46,8 +56,11 @@ def format_table(table, show_all: bool) -> str:
         entries += [(x, x.reason) for x in table.excluded]
         entries.sort(key=lambda p: int(p[0].id[1:]))
     rows = [header]
+    main_path = getattr(table.shader, "path", None)
     for n, reason in entries:
-        row = [n.id, n.type, f"{n.line}:{n.column}", str(n.cost)]
+        where = display_file(getattr(n, "file", None), main_path)
+        place = f"{where}:{n.line}:{n.column}" if where else f"{n.line}:{n.column}"
+        row = [n.id, n.type, place, str(n.cost)]
         if show_all:
             row.append(reason)
         elif reason:
@@ -65,6 +78,36 @@ def format_table(table, show_all: bool) -> str:
     lines.append(f"{counts['listed']} cacheable nodes" + (f"; left out: {left}" if left else "")
                  + ("" if show_all or not left else " (--all lists them)"))
     return "\n".join(lines)
+
+
+_MODEL_VERTEX_TEST = re.compile(
+    r"^[ \t]*#[ \t]*(?:if|ifdef|ifndef|elif)\b[^\n]*?\b(MODEL_VERTEX_\w+)", re.M)
+
+
+def model_vertex_tests(paths, defines) -> list[str]:
+    """The ``MODEL_VERTEX_*`` macros the files test in ``#if``/``#ifdef`` lines that ``defines``
+    leaves undefined (what a session's meshes would define)."""
+    found: list[str] = []
+    for path in paths:
+        if not path or str(path).startswith("<") or not os.path.isfile(path):
+            continue
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                text = f.read()
+        except OSError:
+            continue
+        for line in _MODEL_VERTEX_TEST.finditer(text):
+            for name in re.findall(r"\bMODEL_VERTEX_\w+", line.group(0)):
+                if name not in defines and name not in found:
+                    found.append(name)
+    return found
+
+
+def _mesh_hint(tested: list[str]) -> str:
+    names = ", ".join(tested)
+    return (f"the shader tests {names}, which a session's meshes define (glslViewer defines them for the "
+            f"model's attributes); without --session they are off, so those branches are left out and node "
+            f"ids differ: give --session SESSION (or -D {tested[0]})")
 
 
 def _check_vertex(loaded, vert, session, defines) -> None:
@@ -101,7 +144,19 @@ def command(shader, as_json, show_all, define, max_unroll, session, vert):
 
         loaded_session = load_session(session)
         defines = {**mesh_defines(session_attributes(loaded_session)), **defines}
-    loaded = load_shader(shader, defines)
+    mesh_hint = None
+    if session is None:
+        try:
+            loaded = load_shader(shader, defines)
+        except RRCacheError as err:
+            tested = model_vertex_tests([shader, getattr(getattr(err, "loc", None), "file", None)], defines)
+            if tested:
+                err.hint = (f"{err.hint}; " if err.hint else "") + _mesh_hint(tested)
+            raise
+        tested = model_vertex_tests(loaded.files or [shader], defines)
+        mesh_hint = _mesh_hint(tested) if tested else None
+    else:
+        loaded = load_shader(shader, defines)
     _check_vertex(loaded, vert, loaded_session, defines)
     table = cacheable_nodes(loaded, max_iterations=max_unroll)
     if as_json:
@@ -110,7 +165,10 @@ def command(shader, as_json, show_all, define, max_unroll, session, vert):
             doc["excluded"] = []
         doc["language"] = {"version": loaded.version, "profile": loaded.profile, "es": loaded.es,
                            "assumed": loaded.assumed is not None, "text": loaded.language}
+        doc["hint"] = mesh_hint
         click.echo(json.dumps(doc, indent=2))
     else:
         click.echo(format_table(table, show_all))
         click.echo(f"read as {loaded.language}")
+        if mesh_hint:
+            click.echo(f"hint: {mesh_hint}")
