@@ -227,6 +227,8 @@ def test_cli_vert_option(tmp_path, capsys):
                          "--out", tmp_path / "inst")
     assert code == 0, err
     assert "rr_userMain" in (tmp_path / "inst" / "reproject.vert").read_text()
+    manifest = json.loads((tmp_path / "inst" / "manifest.json").read_text())
+    assert manifest["vertex"] == str(vert) and "u_reprojectionMatrix" in manifest["passes"]["reproject"]["uniforms"]
 
 
 def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):

@@ -91,6 +91,7 @@ class Variant:
                 "location": str(self.node_loc) if self.node_loc else None,
             },
             "shader": self.shader_path,
+            "vertex": self.vertex_path,  # the user's vertex shader the passes' .vert derive from (None: generated)
             "algorithm": self.algorithm,
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
