@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -112,23 +111,20 @@ def test_ids_are_stable_and_resolve():
 
 @pytest.fixture(scope="module")
 def marble():
-    start = time.perf_counter()
-    shader = load_shader(MARBLE)
-    table = cacheable_nodes(shader)
-    return table, time.perf_counter() - start
+    # (how long this takes is measured by `rrcache bench-frontend`, not asserted here)
+    return cacheable_nodes(load_shader(MARBLE))
 
 
 def test_marble_has_at_least_100_candidates(marble):
-    table, seconds = marble
+    table = marble
     candidates = len(table.nodes) + table.counts()["cheap"]
     assert candidates >= 100
     assert len(table.nodes) >= 20
     assert [n for n in table.nodes if n.final]
-    assert seconds < 5.0         # the benchmark target is 1 s; a loaded CI machine gets slack
 
 
 def test_marble_has_a_node_per_noise_octave(marble):
-    table, _ = marble
+    table = marble
     octaves = {}
     for n in table.nodes:
         chain = n.call_chain
@@ -144,7 +140,7 @@ def test_marble_has_a_node_per_noise_octave(marble):
 
 
 def test_marble_nodes_inside_the_octave_loop_are_listed(marble):
-    table, _ = marble
+    table = marble
     sums = [n for n in table.nodes if n.text.startswith("sum + amplitude * abs(noise(")]
     assert len(sums) == 5                     # the partial sums of the turbulence
     assert sorted(n.cost for n in sums) == [n.cost for n in sums]

@@ -41,10 +41,9 @@ from typing import Callable, Mapping, Optional, Sequence
 
 import numpy as np
 
-from rrcache.analysis._tree import walk
 from rrcache.analysis.cacheable import find_node
 from rrcache.analysis.cost import op_cost
-from rrcache.compiler._ast import main_function, substitute
+from rrcache.glsl.ast import main_function, substitute, walk
 from rrcache.compiler.locate import NODE_TYPES
 from rrcache.compiler.prune import prune
 from rrcache.errors import GLSLError, RRCacheError, UnsupportedShaderError
@@ -97,7 +96,7 @@ def static_cost(unit: A.TranslationUnit) -> int:
     main = main_function(unit)
     if main is None:
         return 0
-    return int(sum(op_cost(n) for n in walk(main.body) if isinstance(n, A.Expr)))
+    return int(sum(op_cost(n) for n in walk(main.body, decl_types=False) if isinstance(n, A.Expr)))
 
 
 def simplified_shader(work, constants: Mapping[str, Sequence[float]]) -> Simplified:

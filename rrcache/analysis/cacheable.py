@@ -54,7 +54,9 @@ from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
 
-from rrcache.analysis._tree import chain_of, is_live_flag, iter_exprs, paused_gc, written_roots
+from rrcache.glsl.ast import iter_exprs
+from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
+from rrcache.glsl.writes import written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text

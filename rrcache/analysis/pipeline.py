@@ -15,7 +15,7 @@ import dataclasses
 
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import paused_gc
+from rrcache.glsl.rewrite import paused_gc
 from rrcache.analysis.compound import expand_unit
 from rrcache.analysis.inline import inline_unit
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL, unroll_unit

@@ -2,7 +2,7 @@
 
 Given the analysed shader (every call inlined into ``main``, constant loops unrolled; see
 :mod:`rrcache.analysis`) and the id of a cacheable node E, :func:`instance` emits the passes of
-the chosen algorithm (Sitthi-amorn et al. 2008a §3, DESIGN.md §3) as ``#version 330 core``
+the chosen algorithm (Sitthi-amorn et al. 2008a §3, docs/design.md §3) as ``#version 330 core``
 fragment shaders with the runtime's GLSL (:mod:`rrcache.runtime.glsl`), each pruned to what the
 pass needs, and their generated vertex shaders:
 

@@ -44,8 +44,8 @@ from __future__ import annotations
 from typing import Iterable, Optional
 
 from rrcache.glsl import ast as A
-from rrcache.analysis._tree import written_roots
-from rrcache.compiler._ast import main_function, walk
+from rrcache.glsl.ast import main_function, walk
+from rrcache.glsl.writes import written_roots
 
 DEAD, CONTROL, ESSENTIAL = 0, 1, 2
 

@@ -3,7 +3,7 @@ renderer and the cached one (one program per pass).
 
 :class:`SceneDrawer` uploads meshes and textures once, checks each program it is given against
 the session (:func:`rrcache.harness.bindings.plan_bindings`), and per frame sets the built-in
-uniforms of DESIGN.md §4 (camera, light, time, matrices, the previous frame's
+uniforms of docs/design.md §4 (camera, light, time, matrices, the previous frame's
 model-view-projection for reprojection), the session's uniforms and samplers, and renders every
 object, culling back faces unless the object is ``double_sided``.
 
@@ -160,7 +160,7 @@ class SceneDrawer:
             raise UnsupportedShaderError(
                 f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
                 decl.loc if decl is not None else None,
-                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
+                hint=f"declare `uniform {BUILTINS[name]} {name};` (docs/design.md §4)") from None
 
     def draw(self, program: moderngl.Program, _pass_name: str = "") -> None:
         """Draw every object of the current frame with ``program`` into the bound framebuffer

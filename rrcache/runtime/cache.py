@@ -10,7 +10,7 @@ frame it hands the runtime a ``draw(program, pass_name)`` callback that sets its
 user's own vertex shader; the manifest lists the uniforms of each pass) and renders its vertex
 arrays with it.
 
-Passes (DESIGN.md §3; Sitthi-amorn 2008a §3):
+Passes (docs/design.md §3; Sitthi-amorn 2008a §3):
 
 three-pass (default; programs ``reproject``, ``payload``, ``shade``)
     1. ``reproject`` — depth test ``<`` with depth writes. At a hit it writes the reconstructed
