@@ -26,12 +26,12 @@ import re
 from typing import Optional
 
 from rrcache.glsl import ast as A
+from rrcache.glsl.ast import children, iter_exprs
 from rrcache.glsl.printer import print_expr
-
-from rrcache.analysis._tree import _GENERATED, children, iter_exprs
 
 __all__ = ["attach_source_text", "display_file"]
 
+_GENERATED = re.compile(r"^_rr_(.+)_(\d+)$")  # the names the passes make (glsl/rewrite.NameAllocator)
 _MATCH_DEPTH = 6  # enough to tell apart the left-nested chains that share a start
 
 

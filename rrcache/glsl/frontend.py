@@ -76,7 +76,7 @@ class Shader:
         """The GLSL the shader was read as, in words: ``GLSL 330 core``, ``GLSL ES 3.00``, or for
         a shader without ``#version`` the assumption and its reason.
 
-        >>> parse_shader("#version 300 es\nprecision highp float; out vec4 c;\n"
+        >>> parse_shader("#version 300 es\\nprecision highp float; out vec4 c;\\n"
         ...              "void main() { c = vec4(1.0); }").language
         'GLSL ES 3.00'
         """
