@@ -32,7 +32,7 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
-from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
+from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare, prepare_file
 from rrcache.harness.vertex import vertex_for
 
 #: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
@@ -221,11 +221,12 @@ def frame_indices(session, frames=None) -> list[int]:
 
 def as_prepared(shader, session, defines=None) -> PreparedShader:
     """A :class:`PreparedShader` from a prepared shader, a front-end ``Shader`` or a shader path
-    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``)."""
+    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``), with the session's
+    ``"vertex"`` shader when it names one."""
     if isinstance(shader, PreparedShader):
         return shader
     if hasattr(shader, "unit"):
-        return prepare(shader, defines)
+        return prepare(shader, defines, load_user_vertex(None, session, shader.defines or defines))
     return prepare_file(shader, session, defines)
 
 
