@@ -252,3 +252,16 @@ def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
     with pytest.raises(RRCacheError, match="the vertex shader .*gv.vert' changed") as info:
         again.write_variant(SimpleNamespace(node=node, period=4), tmp_path / "sel2")
     assert "gv.frag' changed" not in str(info.value)
+
+
+def test_an_error_in_the_users_vertex_shader_names_its_line(tmp_path, capsys):
+    from rrcache.cli import main
+
+    frag, session = _scene(tmp_path, vertex=False)
+    bad = tmp_path / "bad.vert"
+    bad.write_text(VERT.replace("v_ratio = 0.5 + 0.5 * a_position.y;", "v_ratio = 0.5 + 0.5 * a_positon.y;"))
+    with pytest.raises(SystemExit) as info:
+        main(["render", str(frag), str(session), "--vert", str(bad), "--frames", "1"])
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and f"{bad}:26:" in err and "a_positon" in err
+    assert "bug in rrcache" not in err and len(err.strip().splitlines()) == 1
