@@ -104,6 +104,9 @@ def test_select_and_accuracy_from_another_directory(made, tmp_path, monkeypatch)
     root, proj = made
     data = json.loads((proj / "out" / "profile.json").read_text())
     assert [os.path.basename(f["path"]) for f in data["shader_files"]] == ["main.frag", "wave.glsl"]
+    # nodes written in the library file say so, and read as written there
+    from_lib = [n for n in data["nodes"] if n["file"] and n["file"].endswith("wave.glsl")]
+    assert from_lib and not any("_rr_" in n["text"] for n in data["nodes"])
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     profile = os.path.relpath(proj / "out", elsewhere)

@@ -70,6 +70,7 @@ class NodeProfile:
     error_fit: dict = field(default_factory=dict)
     perf_fit: dict = field(default_factory=dict)
     note: Optional[str] = None
+    file: Optional[str] = None  # the included file the node was written in (None: the shader itself)
 
 
 @dataclass
@@ -379,7 +380,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     for nid in result.order:
         entry = by_id[nid]
         node = NodeProfile(nid, entry.type, entry.line, entry.column, entry.text, list(entry.call_chain),
-                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid))
+                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid),
+                           file=getattr(entry, "file", None))
         runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
         node.periods = [r.period for r in runs]
         node.errors = [r.mean_error for r in runs]
