@@ -50,6 +50,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Optional, Union
 
+from rrcache.deep import deep
 from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
@@ -160,6 +161,7 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
                        hint="node ids look like 'n42'; list them with 'rrcache nodes SHADER'")
 
 
+@deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
                     cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
@@ -180,6 +182,40 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
 
 
 # ----------------------------------------------------------------------------- classification
+
+#: a node's text is printed whole up to this many syntax nodes; a larger one (a generated chain of
+#: thousands of terms) is abbreviated, so that listing every node of a chain stays linear
+_TEXT_NODES = 400
+
+
+def _bounded_texts(exprs):
+    """``text(e)`` for the expressions ``exprs``: the printed expression, abbreviated to its last
+    operand when its subtree is over ``_TEXT_NODES`` nodes (sizes counted once, without recursion)."""
+    size: dict[int, int] = {}
+    for root in exprs:
+        if id(root) in size:
+            continue
+        stack = [(root, False)]
+        while stack:
+            node, done = stack.pop()
+            if done:
+                size[id(node)] = 1 + sum(size[id(c)] for c in node.children())
+                continue
+            if id(node) in size:
+                continue
+            stack.append((node, True))
+            stack.extend((c, False) for c in node.children() if id(c) not in size)
+
+    def text(e) -> str:
+        n = size.get(id(e), 0)
+        if n <= _TEXT_NODES:
+            return print_expr(e)
+        if isinstance(e, A.Binary) and size.get(id(e.right), _TEXT_NODES + 1) <= _TEXT_NODES:
+            return f"(... {n:,} nodes ...) {e.op} {print_expr(e.right)}"
+        return f"(expression of {n:,} nodes)"
+
+    return text
+
 
 
 class _Def:
@@ -289,6 +325,7 @@ class _Classifier:
         self.records.sort(key=lambda r: order[id(r[0])])
         final, cheap_below = self.final, self.cheap_below
         type_names: dict = {}
+        text = _bounded_texts([r[0] for r in self.records])
         for e, reason, info, ctx, dup in self.records:
             cost = self.cost(info) if info is not None else 0
             is_final = e is final
@@ -309,10 +346,10 @@ class _Classifier:
             line, column = (loc.line, loc.col) if loc else (0, 0)
             chain = list(chain_of(loc))
             if reason is None:
-                nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
+                nodes.append(CacheableNode(node_id, tname, line, column, text(e), cost,
                                            chain, e, is_final))
             else:
-                excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
+                excluded.append(ExcludedNode(node_id, reason, line, column, text(e), e,
                                              tname, cost, chain))
         return NodeTable(self.shader, nodes, excluded)
 

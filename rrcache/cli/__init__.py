@@ -11,6 +11,7 @@ import sys
 
 import click
 
+from rrcache.budgets import budget, reset_budget
 from rrcache.errors import RRCacheError
 
 # subcommand name -> module in rrcache.cli (each module defines a click command named `command`)
@@ -41,12 +42,25 @@ class _LazyGroup(click.Group):
 
 @click.group(cls=_LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help="Show Python tracebacks for errors.")
+@click.option("--max-ast-nodes", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Analysis budget: refuse shaders of more syntax nodes (default {budget.analysis_nodes:,}).")
+@click.option("--max-depth", type=click.IntRange(min=1, max=250_000), default=None, metavar="N",
+              help=f"Refuse expressions nested deeper (default {budget.expression_depth:,}).")
+@click.option("--max-texture-pixels", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Refuse textures of more pixels, read from the header (default {budget.image_pixels:,}).")
 @click.version_option(package_name="rrcache")
 @click.pass_context
-def cli(ctx, debug):
+def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels):
     """rrcache: speed up expensive pixel shaders with a reverse reprojection cache."""
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
+    reset_budget()  # an in-process caller (tests, notebooks) starts from the defaults each time
+    if max_ast_nodes is not None:
+        budget.analysis_nodes = max_ast_nodes
+    if max_depth is not None:
+        budget.expression_depth = max_depth
+    if max_texture_pixels is not None:
+        budget.image_pixels = max_texture_pixels
 
 
 def main(argv=None):

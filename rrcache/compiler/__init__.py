@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from typing import Any, Union
 
+from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
@@ -44,6 +45,7 @@ from rrcache.runtime.glsl import FILTERS
 __all__ = ["instance", "Variant", "PassSource"]
 
 
+@deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
              filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.

@@ -41,10 +41,16 @@ class Node:
                                 yield sub
 
     def walk(self) -> Iterator["Node"]:
-        """This node and all its descendants, pre-order."""
-        yield self
-        for child in self.children():
-            yield from child.walk()
+        """This node and all its descendants, pre-order (iterative: a chain of 100,000 binary
+        operators walks without recursion)."""
+        stack = [self]
+        pop, extend = stack.pop, stack.extend
+        while stack:
+            node = pop()
+            yield node
+            kids = list(node.children())
+            kids.reverse()
+            extend(kids)
 
 
 # ----------------------------------------------------------------------------- types, qualifiers
