@@ -33,6 +33,8 @@ class Budget:
     analysis_nodes: int = 400_000
     expression_depth: int = 100_000
     source_bytes: int = 16 * 1024 * 1024
+    #: not a size: whether session paths may leave the session's folder tree (the opt-out)
+    allow_outside_paths: bool = False
 
 
 #: the limits in force (the CLI's global options change them)

@@ -10,6 +10,7 @@ compiles the variant of one node.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Mapping, Optional
 
@@ -30,6 +31,7 @@ class ShaderWork:
     prepared: PreparedShader
     table: object
     defines: dict
+    include_dirs: tuple = ()
 
     def node(self, node_id: str):
         """The table entry (listed or excluded) with this id; an unknown id raises the analysis'
@@ -46,11 +48,18 @@ class ShaderWork:
 def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, str]] = None,
                      include_dirs=()) -> ShaderWork:
     """Load, prepare and analyse ``shader_path``; with a ``session`` its meshes' attributes set
-    the ``MODEL_VERTEX_*`` defines (``defines`` win over them)."""
+    the ``MODEL_VERTEX_*`` defines (``defines`` win over them). Includes are looked up next to the
+    including file, then in ``include_dirs`` (``-I``), then in the session's ``"include_dirs"``."""
     all_defines = mesh_defines(session_attributes(session)) if session is not None else {}
     all_defines.update(defines or {})
-    shader = load_shader(shader_path, defines=all_defines, include_dirs=include_dirs)
-    return ShaderWork(shader, prepare(shader, all_defines), cacheable_nodes(shader), all_defines)
+    shader = load_shader(shader_path, defines=all_defines, include_dirs=all_include_dirs(include_dirs, session))
+    return ShaderWork(shader, prepare(shader, all_defines), cacheable_nodes(shader), all_defines,
+                      tuple(os.path.abspath(d) for d in include_dirs or ()))
+
+
+def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
+    """The command line's ``-I`` folders, then the session's ``"include_dirs"``."""
+    return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
 def variant_for(work: ShaderWork, node_id: str, period: Optional[int] = None, algorithm: str = "three-pass",

@@ -12,7 +12,7 @@ import sys
 import click
 
 from rrcache.budgets import budget, reset_budget
-from rrcache.errors import RRCacheError
+from rrcache.errors import RRCacheError, printable
 
 # subcommand name -> module in rrcache.cli (each module defines a click command named `command`)
 _COMMANDS = {
@@ -48,9 +48,13 @@ class _LazyGroup(click.Group):
               help=f"Refuse expressions nested deeper (default {budget.expression_depth:,}).")
 @click.option("--max-texture-pixels", type=click.IntRange(min=1), default=None, metavar="N",
               help=f"Refuse textures of more pixels, read from the header (default {budget.image_pixels:,}).")
+@click.option("--max-source-bytes", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Refuse shaders whose sources (with includes) are larger (default {budget.source_bytes:,}).")
+@click.option("--allow-outside-paths", is_flag=True,
+              help="Let sessions name meshes, textures and include folders outside their own folder tree.")
 @click.version_option(package_name="rrcache")
 @click.pass_context
-def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels):
+def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, allow_outside_paths):
     """rrcache: speed up expensive pixel shaders with a reverse reprojection cache."""
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
@@ -61,6 +65,9 @@ def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels):
         budget.expression_depth = max_depth
     if max_texture_pixels is not None:
         budget.image_pixels = max_texture_pixels
+    if max_source_bytes is not None:
+        budget.source_bytes = max_source_bytes
+    budget.allow_outside_paths = allow_outside_paths
 
 
 def main(argv=None):
@@ -71,7 +78,7 @@ def main(argv=None):
     except RRCacheError as err:
         if debug:
             raise
-        click.echo(f"rrcache: error: {err}", err=True)
+        click.echo(f"rrcache: error: {printable(str(err))}", err=True)
         sys.exit(2)
     except click.exceptions.Abort:
         click.echo("rrcache: aborted", err=True)
@@ -87,5 +94,6 @@ def main(argv=None):
     except Exception as err:  # an internal error: say so plainly, traceback only with --debug
         if debug:
             raise
-        click.echo(f"rrcache: internal error: {type(err).__name__}: {err} (run with --debug for the traceback)", err=True)
+        click.echo(f"rrcache: internal error: {type(err).__name__}: {printable(str(err))} "
+                   "(run with --debug for the traceback)", err=True)
         sys.exit(70)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import parse_defines
+from rrcache.cli.options import include_dirs_option, parse_defines
 from rrcache.runtime import ALGORITHMS, FILTERS
 
 
@@ -22,15 +22,16 @@ from rrcache.runtime import ALGORITHMS, FILTERS
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Take the MODEL_VERTEX_* defines from this session's meshes.")
+@include_dirs_option
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
-def command(shader, node, period, algorithm, filter_, payload, session, defines, out_dir):
+def command(shader, node, period, algorithm, filter_, payload, session, defines, include_dirs, out_dir):
     """Write the shaders of the variant of SHADER that caches --node, and a manifest."""
     from rrcache.pipeline import load_for_session, variant_for
     from rrcache.session import load_session
 
     loaded = load_session(session) if session else None
-    work = load_for_session(shader, loaded, parse_defines(defines))
+    work = load_for_session(shader, loaded, parse_defines(defines), include_dirs)
     entry = work.node(node)
     variant = variant_for(work, node, period, algorithm, filter_, payload)
     written = variant.write(out_dir)

@@ -17,7 +17,7 @@ import json
 import click
 
 from rrcache.analysis.cacheable import cacheable_nodes
-from rrcache.cli.options import parse_defines
+from rrcache.cli.options import include_dirs_option, parse_defines
 from rrcache.glsl.frontend import load_shader
 
 _TEXT_WIDTH = 70
@@ -72,18 +72,23 @@ def format_table(table, show_all: bool) -> str:
               help="Define a preprocessor macro (repeatable).")
 @click.option("--max-unroll", type=click.IntRange(min=0), default=64, show_default=True,
               help="Unroll constant loops of at most this many iterations.")
+@include_dirs_option
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Apply the MODEL_VERTEX_* defines of this session's meshes, as `rrcache render` "
                    "and `rrcache profile` do (node ids depend on the defines).")
-def command(shader, as_json, show_all, define, max_unroll, session):
+def command(shader, as_json, show_all, define, max_unroll, include_dirs, session):
     """List the nodes of SHADER that a reprojection cache can hold."""
+    from rrcache.pipeline import all_include_dirs
+
     defines = parse_defines(define)
+    loaded_session = None
     if session is not None:
         from rrcache.harness.vertex import mesh_defines, session_attributes
         from rrcache.session import load_session
 
-        defines = {**mesh_defines(session_attributes(load_session(session))), **defines}
-    loaded = load_shader(shader, defines)
+        loaded_session = load_session(session)
+        defines = {**mesh_defines(session_attributes(loaded_session)), **defines}
+    loaded = load_shader(shader, defines, all_include_dirs(include_dirs, loaded_session))
     table = cacheable_nodes(loaded, max_iterations=max_unroll)
     if as_json:
         doc = table.to_json(shader)

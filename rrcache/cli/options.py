@@ -22,6 +22,14 @@ def parse_defines(items) -> dict[str, str]:
     return defines
 
 
+def include_dirs_option(fn):
+    """``-I DIR`` (repeatable): folders where ``#include`` files are looked up after the including
+    file's own folder, as compilers do (a session's ``"include_dirs"`` come after these)."""
+    return click.option("-I", "include_dirs", multiple=True, type=click.Path(file_okay=False), metavar="DIR",
+                        help="Look for #include files in DIR too (repeatable); includes are read only from "
+                             "the shader's folder tree and these folders.")(fn)
+
+
 def resolution_option(ctx, param, value):
     """click callback: ``WxH`` → ``(w, h)`` (None stays None)."""
     if value is None:

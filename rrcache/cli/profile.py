@@ -21,7 +21,7 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, 
                            TimeRemainingColumn)
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution
 from rrcache.errors import RRCacheError
 from rrcache.profile.profile import STORE_NAME, algorithm_line, default_out_dir, profile
 from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
@@ -73,8 +73,9 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -102,7 +103,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         with bar, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh)
+                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh,
+                               include_dirs=include_dirs)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

@@ -23,7 +23,8 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option
+from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option
+from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
@@ -43,6 +44,7 @@ from rrcache.session import load_session
               help="Render at this size instead of the session's.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@include_dirs_option
 @click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
 @click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
@@ -55,18 +57,18 @@ from rrcache.session import load_session
               help="Cache precision: 32- or 16-bit float.")
 @click.option("--depth-epsilon", type=float, default=1e-3, show_default=True,
               help="Relative tolerance of the reprojected depth test.")
-def command(shader, session, out_dir, frame_count, resolution, as_json, defines, node, period, algorithm,
+def command(shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, node, period, algorithm,
             block, refresh, filter_, payload, depth_epsilon):
     """Render SESSION through the fragment shader SHADER and report time and coverage per frame;
     with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
     loaded = load_session(session)
     if node is not None:
-        _render_cached(shader, loaded, parse_defines(defines), node, out_dir, frame_count, resolution, as_json,
+        _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
                             filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console)
         return
-    prepared = prepare_file(shader, loaded, parse_defines(defines))
+    prepared = prepare_file(shader, loaded, parse_defines(defines), all_include_dirs(include_dirs, loaded))
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:
@@ -115,11 +117,11 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                   + (f"; images in {out}" if out is not None else ""), highlight=False)
 
 
-def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resolution, as_json, opts, err_console):
+def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_count, resolution, as_json, opts, err_console):
     from rrcache.harness.cached import compare
     from rrcache.pipeline import load_for_session, variant_for
 
-    work = load_for_session(shader, loaded, defines)
+    work = load_for_session(shader, loaded, defines, include_dirs)
     entry = work.node(node)
     variant = variant_for(work, node, opts["period"], opts["algorithm"], opts["filter"], opts["payload"])
     indices = frame_indices(loaded, frame_count)

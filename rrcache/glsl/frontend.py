@@ -156,10 +156,13 @@ def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
     path = os.fspath(path)
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            data = f.read(budget.source_bytes + 1)
     except OSError as e:
         raise GLSLError(f"cannot read shader file '{path}': {e.strerror or e}", None,
                         "check the path" if isinstance(e, FileNotFoundError) else None) from None
+    if len(data) > budget.source_bytes:
+        raise GLSLError(f"the shader file is larger than {budget.source_bytes:,} bytes, the analysis budget",
+                        SourceLoc(path, 1, 1), "raise it with 'rrcache --max-source-bytes N ...'")
     try:
         source = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:

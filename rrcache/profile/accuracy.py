@@ -143,7 +143,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
         raise RRCacheError(f"nodes {unknown} are not trained in this profile", str(profile.path or "profile"),
                            hint="give trained node ids (profile.json lists them)")
     session = load_session(profile.session)
-    work = load_for_session(profile.shader, session, profile.defines)
+    work = load_for_session(profile.shader, session, profile.defines, getattr(profile, "include_dirs", ()))
     if work.shader.hash != profile.data.get("shader_hash"):
         raise RRCacheError("the shader changed since it was profiled", str(profile.shader),
                            hint="run 'rrcache profile' again")

@@ -132,6 +132,8 @@ class Profile:
             self.shader = data["shader"]
             self.session = data["session"]
             self.defines = dict(data.get("defines") or {})
+            #: the -I folders of the profiling command (the session's own come with the session)
+            self.include_dirs = [str(d) for d in data.get("include_dirs") or []]
             self.settings = TrainingSettings.from_json(data["settings"], where)
             self.nodes = [NodeProfile(**n) for n in data["nodes"]]
             self.selections = [SelectionReport(**s) for s in data.get("selections", [])]
@@ -222,7 +224,7 @@ class Profile:
         from rrcache.pipeline import load_for_session, variant_for
         from rrcache.session import load_session
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines)
+        work = load_for_session(self.shader, load_session(self.session), self.defines, self.include_dirs)
         if work.shader.hash != self.data.get("shader_hash"):
             raise RRCacheError("the shader changed since it was profiled", str(self.shader),
                                hint="run 'rrcache profile' again")
@@ -290,7 +292,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
-            fresh: bool = False, plots: bool = True) -> Profile:
+            fresh: bool = False, plots: bool = True, include_dirs=()) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`Profile`. Resumes from a store in ``out_dir``
     trained with the same shader, session and settings; ``fresh=True`` moves it aside first.
@@ -306,7 +308,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     from rrcache.session import load_session
 
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, defines)
+    work = load_for_session(shader_path, session, defines, include_dirs)
     resolved = (settings or TrainingSettings()).resolved(session)
     out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
     if out.exists() and not out.is_dir():
@@ -377,6 +379,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         "shader": str(Path(shader_path).resolve()),
         "session": str(Path(session_path).resolve()),
         "defines": dict(work.defines),
+        "include_dirs": list(work.include_dirs),
         "shader_hash": work.shader.hash,
         "session_hash": session.hash,
         "settings": settings.to_json(),
