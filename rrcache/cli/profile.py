@@ -72,10 +72,12 @@ def _fmt(value, spec=".3g", none="–"):
               help="Render each selection over the first N frames (default: all).")
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
+@click.option("--wait", is_flag=True,
+              help="If another rrcache process is profiling into the same --out, wait for it (default: exit 2).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines, include_dirs):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, wait, defines, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -104,7 +106,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
             warnings.simplefilter("always")
             try:
                 prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh,
-                               include_dirs=include_dirs)
+                               include_dirs=include_dirs, wait=wait)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

@@ -24,6 +24,7 @@ import dataclasses
 import json
 import math
 import os
+import sqlite3
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,6 +32,7 @@ from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json as _finite
+from rrcache.profile.lock import LOCK_NAME, StoreLock
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ProfileStore, StoreKey
 from rrcache.profile.train import ProgressFn, TrainingResult, train
@@ -292,11 +294,12 @@ def default_out_dir(shader_path, session_path) -> Path:
 
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
-            fresh: bool = False, plots: bool = True, include_dirs=()) -> Profile:
+            fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`Profile`. Resumes from a store in ``out_dir``
     trained with the same shader, session and settings; ``fresh=True`` moves it aside first.
-    ``progress`` receives :class:`~rrcache.profile.train.ProgressEvent` objects. A
+    Another process profiling into the same folder holds its lock: this one raises an error naming
+    it, or with ``wait=True`` waits. ``progress`` receives :class:`~rrcache.profile.train.ProgressEvent` objects. A
     ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and propagates.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
@@ -314,27 +317,39 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     if out.exists() and not out.is_dir():
         raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
     key = StoreKey(work.shader.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
-    store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
-    started = time.time()
+    # one writer per folder: taken before the store is opened (or moved aside by --fresh)
+    lock = StoreLock.acquire(out / LOCK_NAME, wait=wait)
     try:
-        store.begin_run()
-        result = train(work, session, resolved, store, progress)
-        prof = _assemble(work, session, shader_path, session_path, resolved, result, store, progress)
-        _write_outputs(prof, out, work, plots)
-        store.end_run("done")
-        _write_times(prof, out, store, time.time() - started)
-    except KeyboardInterrupt:
-        store.end_run("interrupted")
-        store.close()
-        raise
-    except BaseException:
+        store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
+        started = time.time()
         try:
-            store.end_run("failed")
-        finally:
-            store.close()
-        raise
-    store.close()
+            store.begin_run()
+            result = train(work, session, resolved, store, progress)
+            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, progress)
+            _write_outputs(prof, out, work, plots)
+            store.end_run("done")
+            _write_times(prof, out, store, time.time() - started)
+        except KeyboardInterrupt:
+            _end_quietly(store, "interrupted")
+            raise
+        except BaseException:
+            _end_quietly(store, "failed")
+            raise
+        store.close()
+    finally:
+        lock.release()
     return prof
+
+
+def _end_quietly(store, status: str) -> None:
+    """Log how the run ended if the store can still be written (a full disk may forbid it; the
+    error that stopped the run is the one to report)."""
+    try:
+        store.end_run(status)
+    except (RRCacheError, OSError, sqlite3.Error):
+        pass
+    finally:
+        store.close()
 
 
 def _write_times(prof: Profile, out: Path, store, run_wall_s: float) -> None:
