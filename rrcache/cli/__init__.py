@@ -6,7 +6,10 @@ shows the Python traceback as well.
 """
 from __future__ import annotations
 
+import contextlib
+import errno
 import importlib
+import os
 import sys
 
 import click
@@ -70,11 +73,32 @@ def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_byt
     budget.allow_outside_paths = allow_outside_paths
 
 
+def _environment_error(err: OSError) -> None:
+    """One line for an operating-system error (``[Errno 28] No space left on device``), exit 2.
+    Output that cannot be written (``> /dev/full``) is dropped so the interpreter's own flush at
+    exit does not fail a second time."""
+    where = err.filename if err.filename is not None else "output"
+    try:
+        sys.stdout.flush()
+    except OSError:
+        pass
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    hint = {errno.ENOSPC: "free disk space and run the command again",
+            errno.EROFS: "write to a folder on a writable file system (--out)",
+            errno.EACCES: "choose a folder you can write to (--out)",
+            errno.EPIPE: "the reader of the output went away"}.get(err.errno, "check the path and the disk")
+    click.echo(f"rrcache: error: {printable(str(where))}: {printable(err.strerror or str(err))} (hint: {hint})", err=True)
+    sys.exit(2)
+
+
 def main(argv=None):
     """Entry point of the console script and ``python -m rrcache``."""
     debug = "--debug" in (argv if argv is not None else sys.argv[1:])
     try:
         cli.main(args=argv, prog_name="rrcache", standalone_mode=False)
+        sys.stdout.flush()  # a full or closed output fails here, while we can still say so
     except RRCacheError as err:
         if debug:
             raise
@@ -91,6 +115,10 @@ def main(argv=None):
         sys.exit(130)
     except SystemExit:
         raise
+    except OSError as err:  # the machine's side: a full disk, a read-only folder, a closed pipe
+        if debug:
+            raise
+        _environment_error(err)
     except Exception as err:  # an internal error: say so plainly, traceback only with --debug
         if debug:
             raise
