@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Mapping, Optional
 
 from rrcache.analysis import cacheable_nodes
+from rrcache.budgets import check_period
 from rrcache.compiler import Variant, instance
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader, load_shader
@@ -65,6 +66,8 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
 def variant_for(work: ShaderWork, node_id: str, period: Optional[int] = None, algorithm: str = "three-pass",
                 filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``)."""
+    if period is not None:
+        period = check_period(period, "--period")
     variant = instance(work.table, node_id, algorithm, filter, payload_dtype)
     variant.period = period
     return variant

@@ -108,7 +108,12 @@ def main(argv=None):
         click.echo("rrcache: aborted", err=True)
         sys.exit(130)
     except click.ClickException as err:
-        err.show()
+        # one line, like every other error (click's own form adds the usage text)
+        hint = ""
+        ctx = getattr(err, "ctx", None)
+        if isinstance(err, click.UsageError) and ctx is not None:
+            hint = f" (hint: see '{ctx.command_path} --help')"
+        click.echo(f"rrcache: error: {printable(err.format_message())}{hint}", err=True)
         sys.exit(err.exit_code)
     except KeyboardInterrupt:
         click.echo("rrcache: interrupted", err=True)

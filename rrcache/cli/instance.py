@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import include_dirs_option, parse_defines
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines
 from rrcache.runtime import ALGORITHMS, FILTERS
 
 
 @click.command("instance")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--node", required=True, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=PERIOD, default=8, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)

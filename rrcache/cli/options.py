@@ -3,7 +3,12 @@ from __future__ import annotations
 
 import click
 
+from rrcache.budgets import MAX_PERIOD
 from rrcache.harness.renderer import parse_resolution
+
+
+#: the ``--period`` type of every command: Δn from 1 to :data:`rrcache.budgets.MAX_PERIOD`
+PERIOD = click.IntRange(min=1, max=MAX_PERIOD)
 
 
 def parse_defines(items) -> dict[str, str]:

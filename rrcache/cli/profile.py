@@ -12,6 +12,7 @@ four selections (node, Δn, predicted/measured speed-up and error, PSNR).
 """
 from __future__ import annotations
 
+import math
 import sys
 import warnings
 
@@ -30,7 +31,13 @@ from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, Trainin
 def _periods(ctx, param, value):
     if value is None:
         return None
-    return parse_periods(value, "--periods")
+    return parse_periods(value, param.opts[0])  # the option given: --periods or --timing-periods
+
+
+def _seconds(ctx, param, value):
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter(f"{value} is not a finite number of seconds (e.g. 480)")
+    return value
 
 
 def _fmt(value, spec=".3g", none="–"):
@@ -63,7 +70,7 @@ def _fmt(value, spec=".3g", none="–"):
               help="Refresh periods at which each node is timed (default: 2,8,50).")
 @click.option("--algorithm", type=click.Choice(ALGORITHM_CHOICES), default="auto", show_default=True,
               help="auto: time three-pass and two-pass on the first node and keep the faster.")
-@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
               help=f"Skip nodes whose static cost is below this share of the costliest node's "

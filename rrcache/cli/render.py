@@ -23,7 +23,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, resolution_option
 from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
@@ -46,7 +46,7 @@ from rrcache.session import load_session
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @include_dirs_option
 @click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=PERIOD, default=8, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--block", type=click.Choice(["1", "2", "4", "8"]), default="4", show_default=True,
               help="Refresh block size k (pixels).")

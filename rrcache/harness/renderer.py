@@ -27,7 +27,7 @@ import numpy as np
 
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
-from rrcache.gl.limits import check_target_size
+from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
@@ -126,9 +126,10 @@ class Renderer:
         self.plan = self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
         w, h = self.size
-        self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
-        self._depth = self._scope.own(ctx.depth_texture((w, h)))
-        self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
+        with target_guard(self.size, where):
+            self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
+            self._depth = self._scope.own(ctx.depth_texture((w, h)))
+            self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
         self.fbo.scissor = self.window
         # moderngl's Query has no release(); it goes with the Python object
         self._query = ctx.query(samples=True)

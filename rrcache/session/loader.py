@@ -67,13 +67,26 @@ def parse_json(text: str, file: str) -> Any:
         raise SessionError(f"invalid JSON: {e}", file, None) from None
 
 
+def _check_text(text: str, file: str, parts: list) -> None:
+    """A JSON string may spell a lone UTF-16 surrogate (``"\\ud800"``), which is no character:
+    refused here, at its path, rather than failing later when it is written out."""
+    for ch in text:
+        if "\ud800" <= ch <= "\udfff":
+            raise SessionError(f"the text holds a lone surrogate (\\u{ord(ch):04x}), which is not a character",
+                               file, json_path(parts) or None, "write the text as plain UTF-8")
+
+
 def _check_numbers(value: Any, file: str, parts: list) -> None:
+    if isinstance(value, str):
+        _check_text(value, file, parts)
+        return
     if isinstance(value, float) and not math.isfinite(value):
         raise SessionError(f"number {value} is out of range", file, json_path(parts))
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2 ** 63 - 1:
         raise SessionError("integer is out of range", file, json_path(parts))
     if isinstance(value, dict):
         for k, v in value.items():
+            _check_text(k, file, parts + [k])
             _check_numbers(v, file, parts + [k])
     elif isinstance(value, list):
         for k, v in enumerate(value):
