@@ -21,8 +21,11 @@ from dataclasses import dataclass
 
 from rrcache.errors import RRCacheError
 
-#: the largest refresh period Δn accepted anywhere (2^20 frames: over 4 hours at 60 fps)
+#: the largest refresh period Δn a user may ask for (2^20 frames: over 4 hours at 60 fps)
 MAX_PERIOD = 2 ** 20
+#: the largest the runtime's signed 32-bit phase uniforms hold with room for frame arithmetic
+#: (its "never refresh" mode for the all-hit limit uses 2^30)
+MAX_RUNTIME_PERIOD = 2 ** 30
 
 
 @dataclass
@@ -47,7 +50,7 @@ def reset_budget() -> None:
         setattr(budget, name, value)
 
 
-def check_period(value, where: str, option: str = "--period") -> int:
+def check_period(value, where: str, limit: int = MAX_PERIOD) -> int:
     """``value`` as a refresh period: an integer in 1 .. :data:`MAX_PERIOD`, else an error naming
     ``where`` (an option or a file's key path).
 
@@ -61,11 +64,11 @@ def check_period(value, where: str, option: str = "--period") -> int:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or (
             isinstance(value, float) and (not math.isfinite(value) or value != int(value))):
         raise RRCacheError(f"refresh period {value!r} is not a whole number", where,
-                           hint=f"use an integer from 1 to {MAX_PERIOD}")
+                           hint=f"use an integer from 1 to {limit}")
     value = int(value)
     if value < 1:
         raise RRCacheError(f"refresh period {value} is below 1", where, hint="Δn = 1 recomputes every frame")
-    if value > MAX_PERIOD:
-        raise RRCacheError(f"refresh period {value} is larger than {MAX_PERIOD} (2^20), the largest rrcache "
-                           "supports", where, hint=f"use a period of at most {MAX_PERIOD} frames")
+    if value > limit:
+        raise RRCacheError(f"refresh period {value} is larger than {limit} (2^{limit.bit_length() - 1}), the "
+                           "largest rrcache supports", where, hint=f"use a period of at most {limit} frames")
     return value

@@ -9,11 +9,13 @@ from __future__ import annotations
 import contextlib
 import errno
 import importlib
+import math
 import os
 import sys
 
 import click
 
+from rrcache import watchdog
 from rrcache.budgets import budget, reset_budget
 from rrcache.errors import RRCacheError, printable
 
@@ -53,11 +55,14 @@ class _LazyGroup(click.Group):
               help=f"Refuse textures of more pixels, read from the header (default {budget.image_pixels:,}).")
 @click.option("--max-source-bytes", type=click.IntRange(min=1), default=None, metavar="N",
               help=f"Refuse shaders whose sources (with includes) are larger (default {budget.source_bytes:,}).")
+@click.option("--frame-timeout", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
+              help="Stop with an error when one frame takes longer than S seconds (what is done is kept).")
 @click.option("--allow-outside-paths", is_flag=True,
               help="Let sessions name meshes, textures and include folders outside their own folder tree.")
 @click.version_option(package_name="rrcache")
 @click.pass_context
-def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, allow_outside_paths):
+def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, frame_timeout,
+        allow_outside_paths):
     """rrcache: speed up expensive pixel shaders with a reverse reprojection cache."""
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
@@ -71,6 +76,9 @@ def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_byt
     if max_source_bytes is not None:
         budget.source_bytes = max_source_bytes
     budget.allow_outside_paths = allow_outside_paths
+    if frame_timeout is not None and not math.isfinite(frame_timeout):
+        raise click.BadParameter("must be a finite number of seconds", param_hint="--frame-timeout")
+    watchdog.set_timeout(frame_timeout)
 
 
 def _environment_error(err: OSError) -> None:

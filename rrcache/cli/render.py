@@ -89,7 +89,8 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                 write_image(stem.with_suffix(".png"), frame.image)
             progress.advance(task)
 
-        result = render(prepared, loaded, indices, resolution=resolution, progress=done)
+        # streamed: each frame's figures are taken (and its images written) as it is done
+        result = render(prepared, loaded, indices, resolution=resolution, progress=done, keep_images=False)
 
     for note in result.notes:
         err_console.print(f"note: {note}", highlight=False, markup=False)

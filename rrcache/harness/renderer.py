@@ -27,6 +27,7 @@ import numpy as np
 
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
+from rrcache import watchdog
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
@@ -161,10 +162,11 @@ class Renderer:
         The first call draws once untimed (llvmpipe compiles the shader on its first draw).
         """
         index = self._check_frame(index)
-        if not self._warm:
-            self._draw(index)
-            self._warm = True
-        ms, samples = self._draw(index)
+        with watchdog.frame(f"frame {index} of the original"):
+            if not self._warm:
+                self._draw(index)
+                self._warm = True
+            ms, samples = self._draw(index)
         w, h = self.size
         image = crop_rows(np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4), self.window).copy()
         depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
@@ -229,11 +231,13 @@ def as_prepared(shader, session, defines=None) -> PreparedShader:
 
 
 def render(shader, session, frames=None, resolution=None, defines=None,
-           progress: Optional[Callable[[FrameResult], None]] = None) -> RenderResult:
+           progress: Optional[Callable[[FrameResult], None]] = None, keep_images: bool = True) -> RenderResult:
     """Render ``frames`` of ``session`` (None: all, an int: the first n, or a list of indices).
 
     ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
-    called with each :class:`FrameResult` as it is done.
+    called with each :class:`FrameResult` as it is done. With ``keep_images=False`` frames are
+    streamed: ``progress`` sees each image, and the result keeps only the per-frame figures
+    (``image`` and ``mask`` are None), so a session of a million frames runs in constant memory.
 
     >>> result = render("marble.frag", load_session("session.json"), frames=2)   # doctest: +SKIP
     >>> [f.index for f in result.frames]                                          # doctest: +SKIP
@@ -244,9 +248,11 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     results = []
     with Renderer(prepared, session, resolution) as renderer:
         for result in renderer.frames(indices):
-            results.append(result)
             if progress is not None:
                 progress(result)
+            if not keep_images:
+                result.image = result.mask = None
+            results.append(result)
         notes = renderer.notes
         size = renderer.size
     ms = statistics.median(r.ms for r in results) if results else float("nan")
