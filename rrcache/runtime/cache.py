@@ -52,6 +52,7 @@ import moderngl
 import numpy as np
 
 from rrcache.budgets import MAX_RUNTIME_PERIOD, check_period
+from rrcache.errors import RRCacheError
 from rrcache.gl.context import bind_default_framebuffer
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.window import check_window, crop_rows
@@ -166,7 +167,10 @@ class CacheRuntime:
 
     @period.setter
     def period(self, value: int) -> None:
-        self._period = check_period(value, "period", MAX_RUNTIME_PERIOD)
+        try:
+            self._period = check_period(value, "period", MAX_RUNTIME_PERIOD)
+        except RRCacheError as err:  # the runtime's API has always raised ValueError here
+            raise ValueError(str(err)) from None
 
     def set_refresh(self, mode: Optional[str] = None, block: Optional[int] = None, seed: Optional[int] = None) -> None:
         """Change the refresh pattern (mode ``random``/``tiled``, block size k, seed)."""
