@@ -332,7 +332,12 @@ class ProfileStore:
             conn = cls._connect_existing(path)
             store = cls(path, conn)
             try:
-                store._check(key)
+                if store._is_empty():
+                    # a run killed while it created the store (its one transaction never
+                    # committed) leaves an SQLite file with no tables: nothing to lose, start it
+                    store._create(key)
+                else:
+                    store._check(key)
             except BaseException:
                 conn.close()
                 raise
@@ -362,6 +367,12 @@ class ProfileStore:
             detail = "; ".join(str(r[0]) for r in rows[:3])
             raise _refuse(path, f"the profile store is damaged (integrity check: {detail})", _FRESH_HINT)
         return conn
+
+    def _is_empty(self) -> bool:
+        try:
+            return self.conn.execute("SELECT COUNT(*) FROM sqlite_master").fetchone()[0] == 0
+        except sqlite3.DatabaseError:
+            return False  # _check reports the damage
 
     def _create(self, key: StoreKey) -> None:
         conn = self.conn
