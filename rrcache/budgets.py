@@ -34,7 +34,7 @@ class Budget:
 
     image_pixels: int = 64 * 1024 * 1024      # 8192 x 8192
     analysis_nodes: int = 400_000
-    expression_depth: int = 100_000
+    expression_depth: int = 125_000   # a 100,000-term chain nests ~100,010 deep
     source_bytes: int = 16 * 1024 * 1024
     #: not a size: whether session paths may leave the session's folder tree (the opt-out)
     allow_outside_paths: bool = False

@@ -79,6 +79,9 @@ def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_byt
     if frame_timeout is not None and not math.isfinite(frame_timeout):
         raise click.BadParameter("must be a finite number of seconds", param_hint="--frame-timeout")
     watchdog.set_timeout(frame_timeout)
+    if frame_timeout is not None and os.environ.get(watchdog.PIPE_ENV) is None and ctx.invoked_subcommand:
+        # the command runs in a child process the watchdog can kill (a GL draw cannot be interrupted)
+        sys.exit(watchdog.supervise(_ARGV if _ARGV is not None else sys.argv[1:], frame_timeout))
 
 
 def _environment_error(err: OSError) -> None:
@@ -101,8 +104,13 @@ def _environment_error(err: OSError) -> None:
     sys.exit(2)
 
 
+_ARGV = None  # the arguments main() was given (for the frame watchdog's child process)
+
+
 def main(argv=None):
     """Entry point of the console script and ``python -m rrcache``."""
+    global _ARGV
+    _ARGV = list(argv) if argv is not None else None
     debug = "--debug" in (argv if argv is not None else sys.argv[1:])
     try:
         cli.main(args=argv, prog_name="rrcache", standalone_mode=False)
