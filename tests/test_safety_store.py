@@ -14,8 +14,8 @@ import time
 import pytest
 
 from rrcache.errors import RRCacheError
-from rrcache.profile.lock import LOCK_NAME, StoreLock
-from rrcache.profile.store import ErrorFrame, ErrorRun, ProfileStore, StoreKey, TimingFrame
+from rrcache.profiler.lock import LOCK_NAME, StoreLock
+from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, StoreKey, TimingFrame
 from safety_cli import QUICK_PROFILE, env, one_error_line, rrcache, write_case
 
 AREA = "safety: one store, one writer; stored rows checked"
@@ -23,7 +23,7 @@ KEY = StoreKey("s" * 64, "t" * 64, "u" * 64, "0.0-test", "{}")
 
 _HOLDER = """
 import sys, time
-from rrcache.profile.lock import StoreLock
+from rrcache.profiler.lock import StoreLock
 lock = StoreLock.acquire(sys.argv[1])
 print("held", flush=True)
 time.sleep(float(sys.argv[2]))

@@ -16,7 +16,7 @@ import math
 import click
 
 from rrcache.cli.options import include_dirs_option
-from rrcache.profile.profile import load_profile
+from rrcache.profiles.document import load_profile
 
 
 @click.command("select")
