@@ -23,6 +23,7 @@ manifest when the variant is written (:meth:`rrcache.compiler.Variant.write`, ``
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Mapping, Optional
@@ -44,9 +45,10 @@ class ShaderWork:
     shader: Shader
     table: object
     defines: dict
-
     #: the user's vertex shader (``UserVertex``), or None when the harness generates it
     vertex: object = None
+    #: the command line's include folders (absolute; the session's own are in the session)
+    include_dirs: tuple = ()
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -73,11 +75,19 @@ def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, s
                      include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None) -> ShaderWork:
     """Load and analyse ``shader_path`` (loops of at most ``max_unroll`` iterations unrolled);
     with a ``session`` its meshes' attributes set the ``MODEL_VERTEX_*`` defines (``defines``
-    win over them). ``vertex`` is the path of the user's vertex shader (None: the session's
-    ``"vertex"``, else a generated one)."""
-    shader, all_defines = load_for_meshes(shader_path, session, defines, include_dirs)
-    user = load_user_vertex(vertex, session, all_defines, include_dirs)
-    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user)
+    win over them). Includes are looked up next to the including file, then in ``include_dirs``
+    (``-I``), then in the session's ``"include_dirs"``. ``vertex`` is the path of the user's
+    vertex shader (None: the session's ``"vertex"``, else a generated one)."""
+    dirs = all_include_dirs(include_dirs, session)
+    shader, all_defines = load_for_meshes(shader_path, session, defines, dirs)
+    user = load_user_vertex(vertex, session, all_defines, dirs)
+    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user,
+                      tuple(os.path.abspath(d) for d in include_dirs or ()))
+
+
+def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
+    """The command line's ``-I`` folders, then the session's ``"include_dirs"``."""
+    return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
 def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",

@@ -25,7 +25,7 @@ MAIN = """// glslViewer-style sketch: the noise lives in a library file
 precision mediump float;
 #endif
 
-#include "../lib/wave.glsl"
+#include "lib/wave.glsl"
 
 uniform vec3 u_light;
 uniform float u_scale;
@@ -67,9 +67,9 @@ def _run(*args, cwd, check=True):
 
 def _project(root):
     (root / "proj" / "shaders").mkdir(parents=True)
-    (root / "proj" / "lib").mkdir()
+    (root / "proj" / "shaders" / "lib").mkdir()
     (root / "proj" / "shaders" / "main.frag").write_text(MAIN)
-    (root / "proj" / "lib" / "wave.glsl").write_text(WAVE)
+    (root / "proj" / "shaders" / "lib" / "wave.glsl").write_text(WAVE)
     (root / "proj" / "orbit.json").write_text(json.dumps(SESSION))
     return root / "proj"
 
@@ -81,11 +81,11 @@ def test_hash_is_content_not_path(tmp_path, monkeypatch):
     recorded = file_records(relative)  # absolute paths, as a profile records them
     monkeypatch.chdir(tmp_path)
     absolute = load_shader(str(proj / "shaders" / "main.frag"))
-    spelled = load_shader("proj/lib/../shaders/main.frag")
+    spelled = load_shader("proj/shaders/lib/../main.frag")
     assert relative.hash == absolute.hash == spelled.hash
     assert len(relative.files) == 2 and relative.files != absolute.files
     # a different content of the included file is a different hash, and is named
-    (proj / "lib" / "wave.glsl").write_text(WAVE.replace("1.3", "1.4"))
+    (proj / "shaders" / "lib" / "wave.glsl").write_text(WAVE.replace("1.3", "1.4"))
     edited = load_shader(str(proj / "shaders" / "main.frag"))
     assert edited.hash != absolute.hash
     assert describe_change(recorded, edited) == f"'{edited.files[1]}' changed"
@@ -141,7 +141,7 @@ def test_errors_name_the_changed_file_or_none(made, tmp_path):
     assert proc.returncode == 2
     assert "no shader file changed" in proc.stderr and "changed since" not in proc.stderr
     # the included file really changed: it is named
-    lib = proj / "lib" / "wave.glsl"
+    lib = proj / "shaders" / "lib" / "wave.glsl"
     lib.write_text(WAVE.replace("0.7", "0.75"))
     try:
         proc = _run("accuracy", proj / "out", "--periods", "3", "--nodes", node, cwd=tmp_path, check=False)

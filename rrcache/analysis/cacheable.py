@@ -75,6 +75,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
+from rrcache.deep import deep
 from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
@@ -215,6 +216,7 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
                        hint="node ids look like 'n42'; list them with 'rrcache nodes SHADER'")
 
 
+@deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
                     cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
@@ -251,6 +253,40 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
 
 _DERIV = 1    # the value needs screen-space derivatives (invalid under one-pass)
 _SCREEN = 2   # the value depends on the pixel's screen position
+
+#: a node's text is printed whole up to this many syntax nodes; a larger one (a generated chain of
+#: thousands of terms) is abbreviated, so that listing every node of a chain stays linear
+_TEXT_NODES = 400
+
+
+def _bounded_texts(exprs):
+    """``text(e)`` for the expressions ``exprs``: the printed expression, abbreviated to its last
+    operand when its subtree is over ``_TEXT_NODES`` nodes (sizes counted once, without recursion)."""
+    size: dict[int, int] = {}
+    for root in exprs:
+        if id(root) in size:
+            continue
+        stack = [(root, False)]
+        while stack:
+            node, done = stack.pop()
+            if done:
+                size[id(node)] = 1 + sum(size[id(c)] for c in node.children())
+                continue
+            if id(node) in size:
+                continue
+            stack.append((node, True))
+            stack.extend((c, False) for c in node.children() if id(c) not in size)
+
+    def text(e) -> str:
+        n = size.get(id(e), 0)
+        if n <= _TEXT_NODES:
+            return print_expr(e)
+        if isinstance(e, A.Binary) and size.get(id(e.right), _TEXT_NODES + 1) <= _TEXT_NODES:
+            return f"(... {n:,} nodes ...) {e.op} {print_expr(e.right)}"
+        return f"(expression of {n:,} nodes)"
+
+    return text
+
 
 
 class _Def:
@@ -404,6 +440,7 @@ class _Classifier:
         self.records.sort(key=lambda r: order[id(r.expr)])
         final, cheap_below = self.final, self.cheap_below
         type_names: dict = {}
+        text = _bounded_texts([r.expr for r in self.records])
         for r in self.records:
             e, reason, cost = r.expr, r.reason, r.cost
             is_final = e is final
@@ -425,10 +462,10 @@ class _Classifier:
             chain = list(chain_of(loc))
             if reason is None:
                 invalid = {"one-pass": ONE_PASS_DERIVATIVE} if r.flags & _DERIV else {}
-                nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
+                nodes.append(CacheableNode(node_id, tname, line, column, text(e), cost,
                                            chain, e, is_final, invalid=invalid))
             else:
-                excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
+                excluded.append(ExcludedNode(node_id, reason, line, column, text(e), e,
                                              tname, cost, chain))
         return NodeTable(self.shader, nodes, excluded)
 

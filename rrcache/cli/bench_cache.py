@@ -8,7 +8,7 @@ import json
 import click
 from rich.console import Console
 
-from rrcache.cli.options import resolution_option as _resolution, vert_option
+from rrcache.cli.options import include_dirs_option, resolution_option as _resolution, vert_option
 
 
 @click.command("bench-cache")
@@ -24,7 +24,9 @@ from rrcache.cli.options import resolution_option as _resolution, vert_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
 @vert_option
-def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown, vert):
+@include_dirs_option
+def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown,
+            vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import run
 
@@ -34,6 +36,7 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
     except ValueError:
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
     bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution, repeats=repeats,
+                include_dirs=include_dirs,
                 progress=lambda msg: err.print(f"[dim]{msg}[/dim]"), vertex=vert)
     if as_json:
         click.echo(json.dumps(bench.to_json()))

@@ -9,29 +9,30 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import parse_defines, vert_option
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
 
 @click.command("instance")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--node", required=True, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=PERIOD, default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Take the MODEL_VERTEX_* defines from this session's meshes.")
+@include_dirs_option
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
 @vert_option
-def command(shader, node, period, algorithm, filter_, payload, session, defines, out_dir, vert):
+def command(shader, node, period, algorithm, filter_, payload, session, defines, include_dirs, out_dir, vert):
     """Write the shaders of the variant of SHADER that caches --node, and a manifest."""
     from rrcache.pipeline import load_for_session, variant_for
     from rrcache.session import load_session
 
     loaded = load_session(session) if session else None
-    work = load_for_session(shader, loaded, parse_defines(defines), vertex=vert)
+    work = load_for_session(shader, loaded, parse_defines(defines), include_dirs, vertex=vert)
     entry = work.node(node)
     variant = variant_for(work, node, algorithm, filter_, payload)
     written = variant.write(out_dir, period=period)

@@ -33,7 +33,7 @@ import re
 
 from rrcache.analysis.cacheable import REASONS
 from rrcache.analysis.source_text import display_file
-from rrcache.cli.options import parse_defines, vert_option
+from rrcache.cli.options import include_dirs_option, parse_defines, vert_option
 from rrcache.errors import RRCacheError
 from rrcache.pipeline import load_for_session
 
@@ -136,11 +136,12 @@ def _check_vertex(loaded, user) -> None:
               help="Define a preprocessor macro (repeatable).")
 @click.option("--max-unroll", type=click.IntRange(min=0), default=64, show_default=True,
               help="Unroll constant loops of at most this many iterations.")
+@include_dirs_option
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Apply the MODEL_VERTEX_* defines of this session's meshes, as `rrcache render` "
                    "and `rrcache profile` do (node ids depend on the defines).")
 @vert_option
-def command(shader, as_json, show_all, define, max_unroll, session, vert):
+def command(shader, as_json, show_all, define, max_unroll, include_dirs, session, vert):
     """List the nodes of SHADER that a reprojection cache can hold."""
     defines = parse_defines(define)
     loaded_session = None
@@ -149,7 +150,8 @@ def command(shader, as_json, show_all, define, max_unroll, session, vert):
 
         loaded_session = load_session(session)
     try:
-        work = load_for_session(shader, loaded_session, defines, max_unroll=max_unroll, vertex=vert)
+        work = load_for_session(shader, loaded_session, defines, include_dirs, max_unroll=max_unroll,
+                                vertex=vert)
     except RRCacheError as err:
         if loaded_session is None:
             tested = model_vertex_tests([shader, getattr(getattr(err, "loc", None), "file", None)], defines)

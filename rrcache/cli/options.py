@@ -3,7 +3,12 @@ from __future__ import annotations
 
 import click
 
+from rrcache.budgets import MAX_PERIOD
 from rrcache.harness.renderer import parse_resolution
+
+
+#: the ``--period`` type of every command: Δn from 1 to :data:`rrcache.budgets.MAX_PERIOD`
+PERIOD = click.IntRange(min=1, max=MAX_PERIOD)
 
 
 def parse_defines(items) -> dict[str, str]:
@@ -20,6 +25,14 @@ def parse_defines(items) -> dict[str, str]:
             raise click.BadParameter(f"{item!r} is not NAME or NAME=VALUE", param_hint="-D")
         defines[name] = value if sep else "1"
     return defines
+
+
+def include_dirs_option(fn):
+    """``-I DIR`` (repeatable): folders where ``#include`` files are looked up after the including
+    file's own folder, as compilers do (a session's ``"include_dirs"`` come after these)."""
+    return click.option("-I", "include_dirs", multiple=True, type=click.Path(file_okay=False), metavar="DIR",
+                        help="Look for #include files in DIR too (repeatable); includes are read only from "
+                             "the shader's folder tree and these folders.")(fn)
 
 
 def resolution_option(ctx, param, value):

@@ -32,6 +32,7 @@ from __future__ import annotations
 from typing import Any, Union
 
 from rrcache.errors import UnsupportedShaderError
+from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
@@ -58,6 +59,7 @@ def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: 
                 f"use --algorithm {' or '.join(valid)}" if valid else "pick another node")
 
 
+@deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
              filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.

@@ -25,6 +25,7 @@ from typing import Any, Optional
 
 import moderngl
 
+from rrcache import atomic
 from rrcache.errors import GLError, SourceLoc
 from rrcache.gl.program import build_program
 from rrcache.runtime.cache import ALGORITHMS, DEFAULT_PERIOD
@@ -121,16 +122,14 @@ class Variant:
         out_dir = os.fspath(out_dir)
         os.makedirs(out_dir, exist_ok=True)
         written = []
+        # each file whole or not at all (a full disk leaves no truncated shader or manifest)
         for name, src in self.passes.items():
             for ext, text in (("vert", src.vertex), ("frag", src.fragment)):
                 path = os.path.join(out_dir, f"{name}.{ext}")
-                with open(path, "w", encoding="utf-8") as f:
-                    f.write(text if text.endswith("\n") else text + "\n")
+                atomic.write_text(path, text if text.endswith("\n") else text + "\n")
                 written.append(path)
         path = os.path.join(out_dir, "manifest.json")
-        with open(path, "w", encoding="utf-8") as f:
-            json.dump(self.manifest(period, runtime), f, indent=2)
-            f.write("\n")
+        atomic.write_text(path, json.dumps(self.manifest(period, runtime), indent=2) + "\n")
         written.append(path)
         return written
 

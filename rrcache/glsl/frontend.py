@@ -16,6 +16,8 @@ import os
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Optional
 
+from rrcache.budgets import budget
+from rrcache.deep import deep
 from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import NON_FRAGMENT_VARIABLES
@@ -97,6 +99,7 @@ class Shader:
         return self.info.es
 
 
+@deep
 def parse_shader(source: str, filename: str = "<string>",
                  defines: Optional[Mapping[str, object]] = None,
                  include_dirs: Iterable[str] = ()) -> Shader:
@@ -114,6 +117,7 @@ def parse_shader(source: str, filename: str = "<string>",
     defines = dict(defines or {})
     pp = preprocess(source, filename, defines, tuple(include_dirs))
     unit = parse_preprocessed(pp, filename)
+    check_size(unit, filename)
     frag_data = _reject_other_stages(unit, filename)
     info = check(unit, filename)
     _reject_multiple_outputs(frag_data, info)
@@ -133,6 +137,34 @@ def parse_shader(source: str, filename: str = "<string>",
         defines=defines, files=files, file_hashes=digests, assumed=pp.assumed)
 
 
+def check_size(unit: A.TranslationUnit, filename: str) -> None:
+    """Refuse a program beyond the analysis budgets (:mod:`rrcache.budgets`): more syntax nodes
+    than ``budget.analysis_nodes`` or an expression nested deeper than ``budget.expression_depth``
+    (counted without recursion, before any recursive pass runs)."""
+    count = 0
+    deepest, deepest_node = 0, None
+    stack = [(unit, 0)]
+    pop, push = stack.pop, stack.append
+    while stack:
+        node, depth = pop()
+        count += 1
+        if depth > deepest:
+            deepest, deepest_node = depth, node
+        for child in node.children():
+            push((child, depth + 1))
+    if count > budget.analysis_nodes:
+        raise GLSLError(f"the shader has {count:,} syntax nodes after preprocessing, more than the analysis "
+                        f"budget of {budget.analysis_nodes:,}", SourceLoc(filename, 1, 1),
+                        "raise it with 'rrcache --max-ast-nodes N ...' if the machine has the memory "
+                        "(analysis takes roughly 10 KB per node)")
+    if deepest > budget.expression_depth:
+        loc = getattr(deepest_node, "loc", None) or SourceLoc(filename, 1, 1)
+        raise GLSLError(f"an expression is nested {deepest:,} levels deep, more than the "
+                        f"{budget.expression_depth:,} rrcache analyses", loc,
+                        "split it into several statements, or raise the limit with "
+                        "'rrcache --max-depth N ...'")
+
+
 def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, object]] = None,
                 include_dirs: Iterable[str] = ()) -> Shader:
     """Read the fragment shader file ``path`` and return the checked :class:`Shader`.
@@ -146,10 +178,13 @@ def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
     path = os.fspath(path)
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            data = f.read(budget.source_bytes + 1)
     except OSError as e:
         raise GLSLError(f"cannot read shader file '{path}': {e.strerror or e}", None,
                         "check the path" if isinstance(e, FileNotFoundError) else None) from None
+    if len(data) > budget.source_bytes:
+        raise GLSLError(f"the shader file is larger than {budget.source_bytes:,} bytes, the analysis budget",
+                        SourceLoc(path, 1, 1), "raise it with 'rrcache --max-source-bytes N ...'")
     try:
         source = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:

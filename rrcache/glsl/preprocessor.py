@@ -26,7 +26,7 @@ from bisect import bisect_right
 from dataclasses import dataclass, field
 from typing import Iterator, Mapping, Sequence
 
-from rrcache.errors import PreprocessorError, SourceLoc
+from rrcache.errors import PreprocessorError, SourceLoc, printable as _printable
 from rrcache.glsl.extensions import predefined as predefined_extensions
 
 __all__ = ["PPToken", "Preprocessed", "preprocess", "preprocess_file"]
@@ -400,6 +400,10 @@ class _Preprocessor:
         self.out: list[PPToken] = []
         self.result = Preprocessed(tokens=self.out)
         self.include_dirs = [os.fspath(d) for d in include_dirs]
+        #: the folders includes may come from: the main file's folder tree (added by preprocess)
+        #: and the include directories' trees, as real paths
+        self.roots = [os.path.realpath(d) for d in self.include_dirs]
+        self.source_bytes = 0
         self.cond: list[_Cond] = []
         self.includes: list[tuple[str, str, frozenset]] = []
         self.version_done = False
@@ -462,7 +466,9 @@ class _Preprocessor:
         return files.index(label)
 
     def run_file(self, text: str, label: str, key: str, include_loc: SourceLoc | None) -> None:
-        state = frozenset((n, m.key) for n, m in self.macros.items())
+        # the user's macros only: the built-in ones appear when the version is settled, which
+        # must not make a file's second entry look like a different state
+        state = frozenset((n, m.key) for n, m in self.macros.items() if not m.builtin)
         for i, (k, _, s) in enumerate(self.includes):
             if k == key and s == state:
                 chain = " -> ".join([lab for _, lab, _ in self.includes[i:]] + [label])
@@ -801,10 +807,31 @@ class _Preprocessor:
                 found = cand
                 break
         if found is None:
-            raise _err(f"cannot find include file '{path}' (tried: {', '.join(tried) or 'none'})",
-                       first.loc, "add its directory to the include directories")
-        text = _read_text(found, first.loc)
-        self.run_file(text, found, os.path.realpath(found), first.loc)
+            raise _err(f"cannot find include file '{_printable(path)}' (tried: "
+                       f"{', '.join(map(_printable, tried)) or 'none'})",
+                       first.loc, "add its directory to the include directories (-I DIR, or the "
+                       "session's \"include_dirs\")")
+        real = self._confined(path, found, first.loc)
+        text = _read_text(found, first.loc, self)
+        self.run_file(text, found, real, first.loc)
+
+    def _confined(self, path: str, found: str, loc: SourceLoc) -> str:
+        """The real path of the include file ``found``, which must be a shader file inside the
+        main file's folder tree or an include directory's; anything else is refused without
+        reading it (a shader from the web must not read, nor leak, the machine's other files)."""
+        real = os.path.realpath(found)
+        if not any(real == r or real.startswith(r.rstrip(os.sep) + os.sep) for r in self.roots):
+            where = " and ".join(_printable(r) for r in self.roots) or "no folder (no include directory given)"
+            raise _err(f"#include '{_printable(path)}' resolves to {_printable(real)}, outside the folders "
+                       f"includes are read from ({where})", loc,
+                       "includes come from the shader's own folder tree and the include directories; "
+                       "add a folder with -I DIR (or the session's \"include_dirs\") if you trust it")
+        ext = os.path.splitext(real)[1].lower()
+        if ext not in SHADER_EXTENSIONS:
+            raise _err(f"#include '{_printable(path)}' is not a shader file (its name ends in "
+                       f"'{_printable(ext) or 'no extension'}')", loc,
+                       f"includes must be shader sources: {' '.join(sorted(SHADER_EXTENSIONS))}")
+        return real
 
     # -- macro expansion -----------------------------------------------------------------------
     def _expand(self, toks: list[_Tok], depth: int = 0) -> list[_Tok]:
@@ -947,12 +974,31 @@ class _Preprocessor:
         return _Tok(kind, text, use.loc, a.space)
 
 
-def _read_text(path: str, loc: SourceLoc | None) -> str:
+#: the file name endings an ``#include`` may read (GLSL sources and their usual headers)
+SHADER_EXTENSIONS = frozenset({".glsl", ".frag", ".vert", ".fs", ".vs", ".fsh", ".vsh", ".fp", ".vp",
+                               ".h", ".inc", ".glslinc", ".hlsl", ".comp", ".geom", ".tesc", ".tese",
+                               ".shader", ".fx", ".cginc"})
+
+def _read_text(path: str, loc: SourceLoc | None, pp: "_Preprocessor | None" = None) -> str:
+    from rrcache.budgets import budget
+
+    limit = budget.source_bytes - (pp.source_bytes if pp is not None else 0)
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            data = f.read(limit + 1)
     except OSError as e:
-        raise _err(f"cannot read '{path}': {e.strerror or e}", loc) from None
+        raise _err(f"cannot read '{_printable(path)}': {e.strerror or e}", loc) from None
+    if len(data) > limit:
+        raise _err(f"'{_printable(path)}' takes the shader's sources past {budget.source_bytes:,} bytes, the "
+                   "analysis budget", loc, "raise it with 'rrcache --max-source-bytes N ...'")
+    if pp is not None:
+        pp.source_bytes += len(data)
+    nul = data.find(b"\0")
+    if nul >= 0:
+        line = data.count(b"\n", 0, nul) + 1
+        col = nul - (data.rfind(b"\n", 0, nul) + 1) + 1
+        raise _err("the file contains a NUL byte: it is not GLSL source text", SourceLoc(path, line, col),
+                   "pass a shader source file")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
@@ -1006,6 +1052,9 @@ def preprocess(source: str, filename: str | os.PathLike = "<string>",
     filename = os.fspath(filename)
     pp = _Preprocessor(defines, include_dirs)
     pp.main_source = source
+    if not filename.startswith("<"):
+        pp.roots.insert(0, os.path.dirname(os.path.realpath(filename)))
+    pp.source_bytes = len(source.encode("utf-8", "surrogatepass"))
     key = os.path.realpath(filename) if not filename.startswith("<") else filename
     # Tokens are many small acyclic objects: pausing the cyclic GC halves the run time.
     gc_was_enabled = gc.isenabled()

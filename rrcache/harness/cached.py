@@ -24,6 +24,7 @@ from typing import Callable, Optional
 import moderngl
 import numpy as np
 
+from rrcache import watchdog
 from rrcache.gl.context import get_context
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
@@ -155,11 +156,12 @@ class CachedRenderer:
             self.runtime.reset()
             self._warm = True
         hit_box = {} if self.hit_maps else None
-        ctx.finish()
-        start = time.perf_counter()
-        stats = self._frame(hit_box)
-        ctx.finish()
-        ms = (time.perf_counter() - start) * 1000.0
+        with watchdog.frame(f"frame {index} of the cached variant"):
+            ctx.finish()
+            start = time.perf_counter()
+            stats = self._frame(hit_box)
+            ctx.finish()
+            ms = (time.perf_counter() - start) * 1000.0
         self._last = index
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0

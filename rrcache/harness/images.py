@@ -16,7 +16,9 @@ import os
 
 import numpy as np
 
-from rrcache.errors import AssetError
+from rrcache import atomic
+from rrcache.errors import AssetError, printable
+from rrcache.stdio import quiet_stderr
 
 _FLOAT_FORMATS = (".exr", ".hdr", ".tif", ".tiff")
 
@@ -44,9 +46,19 @@ def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
     if out is None:
         raise AssetError(f"cannot write an image: {oiio.geterror()}", path,
                          hint="use a .exr or .png file name")
-    ok = out.open(path, spec) and out.write_image(pixels)
-    message = out.geterror()
-    out.close()
-    if not ok:
-        raise AssetError(f"cannot write the image: {message or 'unknown OpenImageIO error'}", path,
-                         hint="check that the directory exists and is writable")
+    # written beside, read back, then renamed: a full disk leaves no empty or truncated image
+    # (OpenImageIO's codecs do not always report a failed write)
+    with atomic.temporary_path(path) as tmp:
+        with quiet_stderr():
+            ok = out.open(tmp, spec) and out.write_image(pixels)
+            message = out.geterror()
+            out.close()
+            check = oiio.ImageInput.open(tmp) if ok else None
+            if check is not None:
+                ok = check.read_image(0, 0, 0, c, oiio.FLOAT) is not None and not check.geterror()
+                check.close()
+            else:
+                ok = False
+        if not ok:
+            raise AssetError(f"cannot write the image: {printable(message) or 'it did not read back whole (is the disk full?)'}",
+                             path, hint="check that the folder is writable and the disk has room")

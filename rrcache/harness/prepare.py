@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Mapping, Optional, Sequence
 
+from rrcache.deep import deep
 from rrcache.errors import SourceLoc
 from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes
 
@@ -86,6 +87,7 @@ def declarations(unit) -> tuple[dict[str, Decl], dict[str, Decl]]:
     return uniforms, inputs
 
 
+@deep
 def prepare(shader, defines: Optional[Mapping[str, str]] = None, vertex=None) -> PreparedShader:
     """A :class:`PreparedShader` from a front-end ``Shader``: rewritten to ``#version 330 core``
     (``rrcache.glsl.legacy.to_core``) and printed with a line map.

@@ -27,7 +27,8 @@ import numpy as np
 
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
-from rrcache.gl.limits import check_target_size
+from rrcache import watchdog
+from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
@@ -134,9 +135,10 @@ class Renderer:
         self.plan = self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
         w, h = self.size
-        self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
-        self._depth = self._scope.own(ctx.depth_texture((w, h)))
-        self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
+        with target_guard(self.size, where):
+            self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
+            self._depth = self._scope.own(ctx.depth_texture((w, h)))
+            self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
         self.fbo.scissor = self.window
         # moderngl's Query has no release(); it goes with the Python object
         self._query = ctx.query(samples=True)
@@ -168,10 +170,11 @@ class Renderer:
         The first call draws once untimed (llvmpipe compiles the shader on its first draw).
         """
         index = self._check_frame(index)
-        if not self._warm:
-            self._draw(index)
-            self._warm = True
-        ms, samples = self._draw(index)
+        with watchdog.frame(f"frame {index} of the original"):
+            if not self._warm:
+                self._draw(index)
+                self._warm = True
+            ms, samples = self._draw(index)
         w, h = self.size
         image = crop_rows(np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4), self.window).copy()
         depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
@@ -237,11 +240,13 @@ def as_prepared(shader, session, defines=None) -> PreparedShader:
 
 
 def render(shader, session, frames=None, resolution=None, defines=None,
-           progress: Optional[Callable[[FrameResult], None]] = None) -> RenderResult:
+           progress: Optional[Callable[[FrameResult], None]] = None, keep_images: bool = True) -> RenderResult:
     """Render ``frames`` of ``session`` (None: all, an int: the first n, or a list of indices).
 
     ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
-    called with each :class:`FrameResult` as it is done.
+    called with each :class:`FrameResult` as it is done. With ``keep_images=False`` frames are
+    streamed: ``progress`` sees each image, and the result keeps only the per-frame figures
+    (``image`` and ``mask`` are None), so a session of a million frames runs in constant memory.
 
     >>> from rrcache.session import load_session
     >>> result = render("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"),
@@ -254,9 +259,11 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     results = []
     with Renderer(prepared, session, resolution) as renderer:
         for result in renderer.frames(indices):
-            results.append(result)
             if progress is not None:
                 progress(result)
+            if not keep_images:
+                result.image = result.mask = None
+            results.append(result)
         notes = renderer.notes
         size = renderer.size
     ms = statistics.median(r.ms for r in results) if results else float("nan")

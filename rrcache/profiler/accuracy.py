@@ -144,7 +144,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
         raise RRCacheError(f"nodes {unknown} are not trained in this profile", str(profile.path or "profile"),
                            hint="give trained node ids (profile.json lists them)")
     session = load_session(profile.session)
-    work = load_for_session(profile.shader, session, profile.defines, vertex=profile.vertex)
+    work = load_for_session(profile.shader, session, profile.defines, profile.include_dirs, vertex=profile.vertex)
     check_same_shader(profile, work)
     plan = Plan.from_json(profile.plan or {})
     full = tuple(int(v) for v in session.resolution)

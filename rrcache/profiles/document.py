@@ -128,6 +128,8 @@ class Profile:
     algorithm: str
     nodes: list[NodeProfile]
     defines: dict[str, str] = field(default_factory=dict)
+    #: the -I folders of the profiling command (the session's own "include_dirs" come with it)
+    include_dirs: list[str] = field(default_factory=list)
     algorithm_times: dict[str, float] = _range(minimum=0, factory=dict)
     plan: Optional[dict] = None
     untrained: list[str] = field(default_factory=list)
@@ -249,7 +251,8 @@ class Profile:
         from rrcache.pipeline import load_for_session, variant_for_selection
         from rrcache.session import load_session
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines, vertex=self.vertex)
+        work = load_for_session(self.shader, load_session(self.session), self.defines, self.include_dirs,
+                                vertex=self.vertex)
         check_same_shader(self, work)
         variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
         return variant.write(out, period=period, runtime=self.settings.cache_options())

@@ -160,8 +160,9 @@ class TrainingSettings:
                 or not 0 <= self.min_saving < 1:
             raise _fail("min_saving", f"{self.min_saving!r} is not a share in [0, 1)", "the default is 0.1")
         object.__setattr__(self, "min_saving", float(self.min_saving))
-        if not isinstance(self.budget_s, (int, float)) or not self.budget_s > 0:
-            raise _fail("budget_s", f"{self.budget_s!r} is not a positive number of seconds", "e.g. 480")
+        if isinstance(self.budget_s, bool) or not isinstance(self.budget_s, (int, float)) \
+                or not 0 < self.budget_s < float("inf"):
+            raise _fail("budget_s", f"{self.budget_s!r} is not a positive, finite number of seconds", "e.g. 480")
         object.__setattr__(self, "budget_s", float(self.budget_s))
 
     # ------------------------------------------------------------------ JSON

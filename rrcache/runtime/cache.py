@@ -53,8 +53,10 @@ from typing import Callable, Optional
 import moderngl
 import numpy as np
 
+from rrcache.budgets import MAX_RUNTIME_PERIOD, check_period
+from rrcache.errors import RRCacheError
 from rrcache.gl.context import bind_default_framebuffer
-from rrcache.gl.limits import check_target_size
+from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
 from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_uniforms
@@ -178,10 +180,10 @@ class CacheRuntime:
 
     @period.setter
     def period(self, value: int) -> None:
-        value = int(value)
-        if value < 1:
-            raise ValueError(f"the refresh period must be at least 1, not {value}")
-        self._period = value
+        try:
+            self._period = check_period(value, "period", MAX_RUNTIME_PERIOD)
+        except RRCacheError as err:  # the runtime's API has always raised ValueError here
+            raise ValueError(str(err)) from None
 
     def set_refresh(self, mode: Optional[str] = None, block: Optional[int] = None, seed: Optional[int] = None) -> None:
         """Change the refresh pattern (mode ``random``/``tiled``, block size k, seed)."""
@@ -207,25 +209,26 @@ class CacheRuntime:
         self._release_targets()
         ctx = self.ctx
         self.size = (w, h)
-        self.depth = ctx.depth_texture((w, h))
-        self.color = ctx.texture((w, h), 4, dtype="f4")
-        self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
-        self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
-        for tex in self._payload + self._invdepth:
-            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            tex.repeat_x = tex.repeat_y = False
-        if self.algorithm == "three-pass":
-            self._cache_fbos = [ctx.framebuffer([self._payload[i], self._invdepth[i]], self.depth) for i in range(2)]
-        else:
-            self._cache_fbos = [
-                ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
-            ]
-        # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
-        # the colour to the background; the payload needs no clear (it is read only where the
-        # inverse depth says a surface was cached)
-        self._clear_fbos = [ctx.framebuffer([self._invdepth[i]], self.depth) for i in range(2)]
-        self._out_fbo = ctx.framebuffer([self.color], self.depth)
-        self._color_only_fbo = ctx.framebuffer([self.color])
+        with target_guard((w, h), "cache size"):
+            self.depth = ctx.depth_texture((w, h))
+            self.color = ctx.texture((w, h), 4, dtype="f4")
+            self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
+            self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
+            for tex in self._payload + self._invdepth:
+                tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+                tex.repeat_x = tex.repeat_y = False
+            if self.algorithm == "three-pass":
+                self._cache_fbos = [ctx.framebuffer([self._payload[i], self._invdepth[i]], self.depth) for i in range(2)]
+            else:
+                self._cache_fbos = [
+                    ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
+                ]
+            # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
+            # the colour to the background; the payload needs no clear (it is read only where the
+            # inverse depth says a surface was cached)
+            self._clear_fbos = [ctx.framebuffer([self._invdepth[i]], self.depth) for i in range(2)]
+            self._out_fbo = ctx.framebuffer([self.color], self.depth)
+            self._color_only_fbo = ctx.framebuffer([self.color])
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
         if self.window is not None:

@@ -115,7 +115,6 @@ class SceneObject:
 DEFAULT_FILTER = "mipmap"
 
 
-@dataclass(eq=False)
 class TextureAsset:
     """An image bound to a sampler uniform.
 
@@ -129,24 +128,50 @@ class TextureAsset:
     filtering, as an application sets up a texture its shader samples with an implicit level of
     detail; without mipmaps a minified ``texture()`` lookup aliases). ``path`` is the
     resolved file (the +X face for a cube map given as six files); ``files`` lists every file read.
+
+    The session loader reads only the image headers (size checked against the pixel budget) and
+    gives a ``loader``: the pixels are decoded the first time ``data`` is read, so a texture the
+    shader never samples is never decoded. ``header`` is the (width, height, channels) of the file.
     """
 
-    name: str
-    path: str
-    kind: str
-    data: np.ndarray
-    filter: str = DEFAULT_FILTER
-    wrap: str = "repeat"
-    files: tuple[str, ...] = ()
+    def __init__(self, name: str, path: str, kind: str, data: "np.ndarray | None" = None,
+                 filter: str = DEFAULT_FILTER, wrap: str = "repeat", files: tuple[str, ...] = (),
+                 loader: "Callable[[], np.ndarray] | None" = None,
+                 header: "tuple[int, int, int] | None" = None):
+        if data is None and loader is None:
+            raise ValueError("a TextureAsset needs data or a loader")
+        self.name, self.path, self.kind = name, path, kind
+        self.filter, self.wrap, self.files = filter, wrap, tuple(files)
+        self._data, self._loader, self.header = data, loader, header
+
+    def __repr__(self) -> str:
+        return (f"TextureAsset(name={self.name!r}, path={self.path!r}, kind={self.kind!r}, "
+                f"loaded={self.loaded}, filter={self.filter!r}, wrap={self.wrap!r})")
+
+    @property
+    def loaded(self) -> bool:
+        """Whether the pixels have been decoded."""
+        return self._data is not None
+
+    @property
+    def data(self) -> np.ndarray:
+        """The decoded pixels (decoded now if they were not yet)."""
+        if self._data is None:
+            self._data = self._loader()
+        return self._data
 
     @property
     def size(self) -> tuple[int, int]:
         """(width, height) of the image (of one face for a cube map)."""
+        if self._data is None and self.header is not None and self.kind == "2d":
+            return int(self.header[0]), int(self.header[1])
         h, w = self.data.shape[-3], self.data.shape[-2]
         return int(w), int(h)
 
     @property
     def channels(self) -> int:
+        if self._data is None and self.header is not None:
+            return int(self.header[2])
         return int(self.data.shape[-1])
 
 
@@ -183,6 +208,8 @@ class Session:
     vertex: str | None = None
     #: what loading the session's assets had to say that is not an error (one line each)
     notes: list = field(default_factory=list)
+    #: the session's "include_dirs", resolved against its folder (after the command line's -I)
+    include_dirs: tuple[str, ...] = ()
     _camera: Callable[[int], Camera] | None = field(default=None, repr=False)
     _light: Callable[[int], Light] | None = field(default=None, repr=False)
     _uniforms: Callable[[int], dict[str, Any]] | None = field(default=None, repr=False)
