@@ -35,8 +35,9 @@ input, built as follows.
 - A body inlined into another function keeps meaning what it meant: a local or parameter of
   the caller named like a global or a function the body uses (``float pos`` where the body
   reads the global ``vec3 pos``; ``float step`` where it calls ``step()``) is renamed first,
-  and a definition that now uses a global or struct type declared after it (``main`` written before the
-  helpers and their globals) moves after that global, its prototype left in place.
+  and a definition that now uses a global or struct type declared after it (``main`` written
+  before the helpers and their globals) moves after that declaration, its prototype left in
+  place.
 - A ``?:`` of ``void`` calls used as a statement becomes an ``if``.
 
 >>> from rrcache.glsl.frontend import parse_shader
