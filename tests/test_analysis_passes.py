@@ -142,6 +142,12 @@ CASES = {
         const float FREQ = 7.0;
         float g_bias = 0.25;
         float wave(float x) { return g_bias + 0.5 * sin(x * FREQ); }""",
+    "struct_after_main": """
+        float lit(vec2 p);
+        void main() { fragColor = vec4(lit(uv), lit(uv.yx), 0.5, 1.0); }
+        struct Light { vec2 dir; float k; };
+        const Light SUN = Light(vec2(0.6, 0.8), 0.75);
+        float lit(vec2 p) { Light l = SUN; l.k *= 0.5; return max(dot(p, l.dir), 0.0) * l.k + 0.1; }""",
     "void_ternary": """
         vec3 g;
         void a(float k) { g = vec3(k, 0.2, 0.1); }

@@ -379,3 +379,17 @@ void main() { float s = 0.0; for (int i = 0; i < n; i++) { { int i = 2; s += flo
     text = _pruned(src)
     assert "for (int i = 0; i < n; i++)\n    {\n        {\n            int i = 2;" in text
     check(parse_source(text))
+
+
+def test_prune_drops_case_labels_left_at_the_end_of_a_switch():
+    src = """#version 330
+uniform int k; uniform float a; out vec4 c;
+void main() { float x = 0.0; float dead = 0.0;
+    switch (k) { case 0: x = a; break; case 1: dead = 2.0; break; default: dead = 3.0; }
+    c = vec4(x); }
+"""
+    text = _pruned(src)
+    body = text.split("switch (k)", 1)[1]
+    # the driver refuses a label followed by '}' (GLSL: a label precedes a statement)
+    assert "case 0:" in body and "default:" not in body
+    assert not body.split("}")[0].rstrip().endswith(":")

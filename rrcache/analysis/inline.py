@@ -35,8 +35,9 @@ input, built as follows.
 - A body inlined into another function keeps meaning what it meant: a local or parameter of
   the caller named like a global or a function the body uses (``float pos`` where the body
   reads the global ``vec3 pos``; ``float step`` where it calls ``step()``) is renamed first,
-  and a definition that now reads a global declared after it (``main`` written before the
-  helpers and their globals) moves after that global, its prototype left in place.
+  and a definition that now uses a global or struct type declared after it (``main`` written
+  before the helpers and their globals) moves after that declaration, its prototype left in
+  place.
 - A ``?:`` of ``void`` calls used as a statement becomes an ``if``.
 
 >>> from rrcache.glsl.frontend import parse_shader
@@ -256,24 +257,30 @@ class _Inliner:
                            lambda name: self.names.fresh(name) if name in shadowed else None)
 
     def _define_after_globals(self) -> None:
-        """Move a function definition that now reads a global declared after it (a body
+        """Move a function definition that now uses a global declared after it (a body
         inlined from a function defined later: ``float f(); void main() { ... f() ... }
-        float k; float f() { return k; }``) to right after the last such global, leaving a
-        prototype in its place (none for ``main``)."""
+        float k; float f() { return k; }``; a variable, or a struct type) to right after the
+        last such declaration, leaving a prototype in its place (none for ``main``)."""
         decls = self.unit.decls
         defs = [i for i, x in enumerate(decls) if isinstance(x, A.FunctionDecl) and x.body is not None]
         if not defs or not any(not isinstance(x, A.FunctionDecl) for x in decls[defs[0] + 1:]):
             return   # every global is declared before the first definition (the usual layout)
         pos = {id(x): i for i, x in enumerate(decls)}
+        struct_pos = {x.type.spec.struct.name: i for i, x in enumerate(decls)
+                      if isinstance(x, A.VariableDecl) and x.type.spec.struct is not None
+                      and x.type.spec.struct.name}
         after: dict[int, list] = {}
         moved: dict[int, A.FunctionDecl] = {}
         for i, d in enumerate(decls):
             if not isinstance(d, A.FunctionDecl) or d.body is None:
                 continue
-            last = max((pos.get(id(self.global_copy[id(n.symbol.decl)]), -1)
-                        for n in walk(d.body, decl_types=False)
-                        if isinstance(n, A.Ident) and n.symbol is not None
-                        and id(getattr(n.symbol, "decl", None)) in self.global_copy), default=-1)
+            last = -1
+            for n in walk(d.body):
+                if isinstance(n, A.Ident) and n.symbol is not None \
+                        and id(getattr(n.symbol, "decl", None)) in self.global_copy:
+                    last = max(last, pos.get(id(self.global_copy[id(n.symbol.decl)]), -1))
+                elif isinstance(n, (A.TypeSpecifier, A.Call)) and n.name in struct_pos:
+                    last = max(last, struct_pos[n.name])
             if last > i:
                 after.setdefault(id(decls[last]), []).append(d)
                 moved[id(d)] = d

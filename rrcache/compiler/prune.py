@@ -19,7 +19,9 @@ told apart by their declaration, so shadowing is handled):
   when nothing references the variable any more;
 - what is left is tidied (:func:`tidy_blocks`): blocks left empty are removed, and a block
   whose only statement is a block (inlined calls and unrolled iterations whose other statements
-  went) becomes that block, so no pass shows runs of nested braces.
+  went) becomes that block, so no pass shows runs of nested braces; ``case`` labels left at the
+  end of a ``switch`` with no statement after them are removed (a label must precede a
+  statement).
 
 Globals — from ``main`` and the declarations in ``keep`` (the runtime's snippets), everything
 referenced by name is kept, transitively: functions (and prototypes), uniforms, samplers,
@@ -484,6 +486,10 @@ def tidy_blocks(s: Optional[A.Stmt], keep_names: frozenset = frozenset()) -> Non
     elif isinstance(s, A.Switch):
         for x in s.body.stmts:
             tidy_blocks(x)
+        # labels left with no statement after them (their code was pruned) end the body: a
+        # label must precede a statement, and nothing would run there anyway
+        while s.body.stmts and isinstance(s.body.stmts[-1], A.Case):
+            s.body.stmts.pop()
 
 
 def _names(node: A.Node) -> set[str]:
