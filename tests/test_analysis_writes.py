@@ -304,3 +304,13 @@ def test_every_node_after_implicit_lod_lookups_reproduces_the_original_at_period
                     assert err <= 1e-4, (node.id, node.text, algorithm, ref.index, err)
                     checked += 1
     assert checked >= 2 * (2 * len(restricted))
+
+
+def test_bench_frontend_probes_generated_shaders_in_fresh_processes():
+    from rrcache.bench.frontend import run_generated
+
+    rows = run_generated([150], repeat=1)
+    assert [r["shader"] for r in rows] == ["realistic-150", "sketch-150"]
+    for r in rows:
+        assert 50 < r["lines"] <= 150 and r["exprs"] > 500 and r["counts"]["listed"] > 0
+        assert r["rss_peak_mb"] >= r["rss_before_mb"] > 0 and r["analyse_cpu_s"] > 0

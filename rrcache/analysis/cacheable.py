@@ -82,7 +82,7 @@ from rrcache.glsl.printer import print_expr
 
 from rrcache.glsl.ast import iter_exprs
 from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.writes import out_qualifiers, written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text
@@ -784,8 +784,7 @@ class _Classifier:
                 uniform, effects = False, True
             if getattr(e.target, "side_effects", False):
                 effects = True
-            quals = getattr(e.target, "qualifiers", ())
-            out_pos = {i: q for i, q in enumerate(quals) if q != "in"}
+            out_pos = {i: q for i, q in enumerate(out_qualifiers(e)) if q != "in"}
             diff_pos = _differentiated_args(e)
         outs = []
         if isinstance(e, A.Ternary) or (isinstance(e, A.Binary) and e.op in ("&&", "||")):

@@ -13,7 +13,9 @@ colour built by component): every value depends on all the steps before it, whic
 the old cacheable-set closure quadratic in time and memory.
 
 >>> src = realistic_shader(400)
->>> 350 < src.count("\\n") < 600 and "textureGrad" not in src and "texture(u_tex" in src
+>>> 300 < src.count("\\n") <= 400 and "texture(u_tex" in src
+True
+>>> 300 < sketch_shader(400).count("\\n") <= 400
 True
 """
 from __future__ import annotations

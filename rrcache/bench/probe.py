@@ -4,7 +4,8 @@
     PYTHONPATH=OTHER_CHECKOUT python rrcache/bench/probe.py SHADER    # another version
 
 Prints one JSON line: lines, AST expression nodes of the analysed program, parse seconds,
-analysis seconds (inline + unroll + cacheable nodes), the process's peak resident memory (MB)
+analysis seconds (inline + unroll + cacheable nodes; wall clock, and the process's CPU time,
+which a loaded machine inflates less), the process's peak resident memory (MB)
 before and after the analysis, and the table's counts. Only `parse_shader` and `cacheable_nodes`
 are used, so the same file measures any version of rrcache put on PYTHONPATH (that is how
 docs/bench_frontend.md compares before and after). ``rrcache bench-frontend --generated`` runs
@@ -35,14 +36,17 @@ def main(argv=None) -> None:
     t0 = time.perf_counter()
     shader = parse_shader(source, args.shader)
     t1 = time.perf_counter()
+    c1 = time.process_time()
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     kw = {} if args.max_unroll is None else {"max_iterations": args.max_unroll}
     table = cacheable_nodes(shader, **kw)
     t2 = time.perf_counter()
+    c2 = time.process_time()
     rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     exprs = sum(1 for _ in iter_exprs(table.shader.unit))
     print(json.dumps({"shader": args.shader, "lines": source.count("\n") + 1, "exprs": exprs,
                       "parse_s": round(t1 - t0, 3), "analyse_s": round(t2 - t1, 3),
+                      "analyse_cpu_s": round(c2 - c1, 3),
                       "rss_before_mb": round(rss0), "rss_peak_mb": round(rss1),
                       "counts": table.counts()}))
     sys.stdout.flush()

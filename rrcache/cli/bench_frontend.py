@@ -28,11 +28,12 @@ def command(shader, lines, repeat, as_json, generated):
             click.echo(json.dumps(rows))
             return
         table = Table(title="node analysis of generated shaders (fresh process each; median of %d)" % repeat)
-        for col in ("shader", "lines", "AST exprs", "parse s", "analyse s", "µs/expr", "peak MB"):
+        for col in ("shader", "lines", "AST exprs", "parse s", "analyse s", "CPU s", "µs/expr", "peak MB"):
             table.add_column(col, justify="right" if col != "shader" else "left")
         for r in rows:
             table.add_row(r["shader"], str(r["lines"]), str(r["exprs"]), f"{r['parse_s']:.2f}",
-                          f"{r['analyse_s']:.2f}", f"{1e6 * r['analyse_s'] / max(1, r['exprs']):.0f}",
+                          f"{r['analyse_s']:.2f}", f"{r['analyse_cpu_s']:.2f}",
+                          f"{1e6 * r['analyse_cpu_s'] / max(1, r['exprs']):.0f}",
                           str(r["rss_peak_mb"]))
         Console().print(table)
         return
