@@ -45,15 +45,22 @@ def test_each_reason_on_a_small_shader():
     assert reason_of(t, "int(v_uv.x * 4.0)") == "type"
     assert reason_of(t, "v_uv.y > 0.5") == "type"
     assert reason_of(t, "sin(u_k) * 2.0") == "uniform"
-    assert reason_of(t, "fwidth(v_uv.x * 3.0) + pow(v_uv.y, 3.0)") == "derivative"
+    # a value computed with fwidth() is not excluded: only one-pass cannot cache it
+    assert reason_of(t, "fwidth(v_uv.x * 3.0) + pow(v_uv.y, 3.0)") == "cheap"
     assert reason_of(t, "v_uv.x * 3.0") == "derivative"                  # inside fwidth()
     assert reason_of(t, "exp(v_uv.x * float(i))") == "dynamic"           # run-time loop
     assert reason_of(t, "log(v_uv.y + 2.0) * exp(v_uv.x)") == "dynamic"  # per-pixel branch
     assert reason_of(t, "v_uv.x") == "cheap"
     assert reason_of(t, "a") == "duplicate"            # a read of a single definition
-    # the colour reads d, computed with fwidth(): derivative through a local variable
-    assert not [n for n in t.nodes if n.final]
-    assert reason_of(t, "vec4(a + b * w + vec3(d + s + float(k)), 1.0)") == "derivative"
+    # the colour reads d, computed with fwidth(): through a local variable, it needs
+    # derivatives, so it is listed for three-pass and two-pass only, with the reason
+    final = [n for n in t.nodes if n.final]
+    assert [n.text for n in final] == ["vec4(a + b * w + vec3(d + s + float(k)), 1.0)"]
+    assert final[0].algorithms == ["three-pass", "two-pass"]
+    assert final[0].invalid["one-pass"].startswith("derivative")
+    assert reason_of(t, "a + b * w") == "listed"
+    assert [n.algorithms for n in t.nodes if n.text == "a + b * w"] == [
+        ["three-pass", "two-pass", "one-pass"]]
     assert set(x.reason for x in t.excluded) <= set(REASONS)
 
 

@@ -178,7 +178,7 @@ def test_variants_reproduce_the_original(gl_ctx, tmp_path, algorithm):
     chosen = [n for n in work.table.nodes if "v_ratio" in n.text or n.final][:2]
     assert chosen
     for node in chosen:
-        variant = variant_for(work, node.id, 1, algorithm)
+        variant = variant_for(work, node.id, algorithm)
         assert all("rr_userMain" in p.vertex for p in variant.passes.values())
         result = compare(variant, session, work.prepared, range(4), period=1)
         s = result.summary()
@@ -195,7 +195,7 @@ def test_reprojection_matches_the_generated_vertex_shader(gl_ctx, tmp_path):
         session = load_session(sp)
         work = load_for_session(f, session)
         node = next(n for n in work.table.nodes if n.final)
-        result = compare(variant_for(work, node.id, 4, "three-pass"), session, work.prepared, range(8), period=4)
+        result = compare(variant_for(work, node.id, "three-pass"), session, work.prepared, range(8), period=4)
         rates.append(result.summary()["hit_rate"])
     assert rates[0] > 0.5 and math.isclose(rates[0], rates[1], abs_tol=0.01), rates
 
@@ -233,24 +233,24 @@ def test_cli_vert_option(tmp_path, capsys):
 
 def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
     """A profile made with --vert re-selects with it, and a changed vertex shader is named."""
-    from types import SimpleNamespace
-
-    from rrcache.profile import TrainingSettings, load_profile, profile
+    from rrcache.profiler import profile
+    from rrcache.profiles import TrainingSettings, load_profile
+    from rrcache.selection import CachedNode, Selection
 
     frag, session = _scene(tmp_path, vertex=False)
     vert = frag.with_suffix(".vert")
     settings = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), timing_frames=4, timing_periods=(2, 8),
                                 validate=False)
     prof = profile(frag, session, tmp_path / "out", settings, vertex=vert, plots=False)
-    assert prof.data["vertex"] == str(vert) and prof.data["vertex_hash"]
+    assert prof.vertex == str(vert) and prof.vertex_hash
     node = next(n.id for n in prof.nodes if n.trained)
     again = load_profile(tmp_path / "out")
-    written = again.write_variant(SimpleNamespace(node=node, period=4), tmp_path / "sel")
+    written = again.write_variant(Selection((CachedNode(node, 4),)), tmp_path / "sel")
     assert "rr_userMain" in next(open(p).read() for p in written if p.endswith("reproject.vert") or
                                  p.endswith("hit.vert") or p.endswith("single.vert"))
     vert.write_text(VERT.replace("0.5 + 0.5 * a_position.y", "0.5 + 0.4 * a_position.y"))
     with pytest.raises(RRCacheError, match="the vertex shader .*gv.vert' changed") as info:
-        again.write_variant(SimpleNamespace(node=node, period=4), tmp_path / "sel2")
+        again.write_variant(Selection((CachedNode(node, 4),)), tmp_path / "sel2")
     assert "gv.frag' changed" not in str(info.value)
 
 

@@ -32,6 +32,12 @@ input, built as follows.
   A function with a ``return`` inside a loop or ``switch`` is *not inlined*: it stays a function,
   and the cacheable-node analysis marks the nodes in its body ``dynamic``.
 - Functions no longer called are removed. Names starting with ``_rr`` are reserved.
+- A body inlined into another function keeps meaning what it meant: a local or parameter of
+  the caller named like a global or a function the body uses (``float pos`` where the body
+  reads the global ``vec3 pos``; ``float step`` where it calls ``step()``) is renamed first,
+  and a definition that now reads a global declared after it (``main`` written before the
+  helpers and their globals) moves after that global, its prototype left in place.
+- A ``?:`` of ``void`` calls used as a statement becomes an ``if``.
 
 >>> from rrcache.glsl.frontend import parse_shader
 >>> s = parse_shader("float sq(float x) { return x * x; }\\n"
@@ -255,6 +261,9 @@ class _Inliner:
         float k; float f() { return k; }``) to right after the last such global, leaving a
         prototype in its place (none for ``main``)."""
         decls = self.unit.decls
+        defs = [i for i, x in enumerate(decls) if isinstance(x, A.FunctionDecl) and x.body is not None]
+        if not defs or not any(not isinstance(x, A.FunctionDecl) for x in decls[defs[0] + 1:]):
+            return   # every global is declared before the first definition (the usual layout)
         pos = {id(x): i for i, x in enumerate(decls)}
         after: dict[int, list] = {}
         moved: dict[int, A.FunctionDecl] = {}

@@ -10,8 +10,11 @@ cacheable (the paper lists this as future work). A ``for`` loop is unrolled when
   ``i = i - c``;
 - the body does not write the variable and has no ``break``/``continue`` of this loop;
 - the trip count, simulated in the variable's own precision (``float`` loops in single
-  precision), is at most ``max_iterations``, and the total number of body copies made in the
-  shader stays within ``max_total``.
+  precision), is at most ``max_iterations``, the total number of body copies made in the
+  shader stays within ``max_total``, and the syntax nodes of all the copies stay within
+  ``max_size`` (a total-size budget: a shader of many loops, or of loops whose bodies inline
+  large functions, stops unrolling when the analysed program would outgrow it; loops are
+  unrolled in program order while the budget lasts and the remaining ones are left rolled).
 
 "Constant" means literals, ``const`` globals, and locals initialised with a constant and not
 written before the loop (so ``int n = 5; for (int i = 0; i < n; i++)`` and an inlined parameter
@@ -20,6 +23,14 @@ variable is replaced by its value as a literal and the body's locals get fresh n
 (``_rr_<name>_<n>``); an assigned (not declared) loop variable gets its exit value after the
 copies. Nested loops unroll inside out once the outer variable is a literal. Other loops are
 left as they are (the cacheable-node analysis treats what is inside them as ``dynamic``).
+
+Constants are evaluated as GLSL does: ``int``/``uint`` wrap to 32 bits (``-1u`` is
+``0xFFFFFFFF``; a ``uint`` loop may count down through zero), ``float`` in single precision,
+comparisons and ``&&``/``||``/``^^``/``!`` to ``bool``. An ``if`` or ``?:`` whose condition
+became constant in a copy (``if (i > 0)`` with ``i`` = 0) keeps only the branch taken, since the
+other may index an array out of range (``a[i - 1]``), which is a compile error once the index
+is constant. A loop with a copy that still holds such an index (under a guard this pass does
+not decide, ``i > 0 && a[i - 1] > x``) is left rolled.
 
 >>> from rrcache.glsl.frontend import parse_shader
 >>> from rrcache.glsl.printer import print_glsl
@@ -43,10 +54,14 @@ from rrcache.glsl.ast import walk
 from rrcache.glsl.rewrite import InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped
 from rrcache.glsl.writes import written_roots
 
-__all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL"]
+__all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL",
+           "DEFAULT_MAX_SIZE"]
 
 DEFAULT_MAX_ITERATIONS = 64
 DEFAULT_MAX_TOTAL = 4096
+#: the syntax nodes all unrolled copies may add (the paper scenes add under 3,000; node analysis
+#: runs at roughly 10-30k expression nodes per second, see docs/bench_frontend.md)
+DEFAULT_MAX_SIZE = 60_000
 _COMPARE = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
             "!=": np.not_equal, "==": np.equal}
 _FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!=", "==": "=="}
@@ -54,7 +69,7 @@ _DTYPE = {"int": np.int32, "uint": np.uint32, "float": np.float32}
 
 
 def unroll_loops(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                 max_total: int = DEFAULT_MAX_TOTAL):
+                 max_total: int = DEFAULT_MAX_TOTAL, max_size: int = DEFAULT_MAX_SIZE):
     """Return a copy of ``shader`` with its constant-trip-count ``for`` loops unrolled (see the
     module docstring). The input is not modified; the result is type-checked again.
 
@@ -65,19 +80,20 @@ def unroll_loops(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     >>> "for" in print_glsl(unroll_loops(s, max_iterations=10).unit)
     True
     """
-    unit = unroll_unit(clone(shader.unit), shader.info, max_iterations, max_total)
+    unit = unroll_unit(clone(shader.unit), shader.info, max_iterations, max_total, max_size)
     info = check(unit, shader.path or "<string>")
     return dataclasses.replace(shader, unit=unit, info=info)
 
 
 def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                max_total: int = DEFAULT_MAX_TOTAL) -> A.TranslationUnit:
+                max_total: int = DEFAULT_MAX_TOTAL,
+                max_size: int = DEFAULT_MAX_SIZE) -> A.TranslationUnit:
     """The unrolling pass, in place on ``unit`` (a copy the caller owns). ``info`` is the
     :class:`SemanticInfo` of the input (for the values of ``const`` globals)."""
     consts = {name: sym.const_value for name, sym in info.globals.items()
               if sym.kind == "const" and isinstance(sym.const_value, (int, float, bool))
               and not sym.type.dims}
-    u = _Unroller(unit, consts, max_iterations, max_total)
+    u = _Unroller(unit, consts, max_iterations, max_total, max_size)
     u.const_bases = {name: info.globals[name].type.base for name in consts}
     for d in unit.decls:
         if isinstance(d, A.FunctionDecl) and d.body is not None:
@@ -90,10 +106,11 @@ def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX
 
 
 class _Unroller:
-    def __init__(self, unit, consts, max_iterations, max_total):
+    def __init__(self, unit, consts, max_iterations, max_total, max_size=DEFAULT_MAX_SIZE):
         self.consts = consts
         self.max_iterations = max_iterations
         self.budget = max_total
+        self.size_budget = max_size
         self.names = NameAllocator(unit)
         self.scopes: list[dict[str, Optional[tuple[str, object]]]] = [{}]
         self.const_bases: dict[str, str] = {}
@@ -299,7 +316,11 @@ class _Unroller:
                     return None
                 v = dtype(v + dv)
         budget = self.budget
+        size = sum(1 for _ in walk(s.body)) * len(values)
+        if size > self.size_budget:
+            return None       # over the total-size budget: left rolled (its nodes are dynamic)
         self.budget -= len(values)
+        self.size_budget -= size
         loc = s.loc
         copies: list = []
         for value in values:
@@ -313,6 +334,7 @@ class _Unroller:
             # a constant index out of range left in a copy (``a[i - 1]`` under a guard this
             # pass does not decide): the unrolled program would not compile; keep the loop
             self.budget = budget
+            self.size_budget += size
             return None
         if not declared:
             exit_value = _literal(base, v.item())(A.Ident(name, loc=loc))

@@ -9,15 +9,20 @@ line:column (``file:line:column`` for a line of an included file, the file relat
 shader's folder: ``lygia/generative/fbm.glsl:13:15``), estimated cost (the work a cache hit
 saves, see ``rrcache.analysis.cost``), the inlined call chain and the expression as written
 (``sum + amp * snoise(p)``, not the inliner's temporaries; ``rrcache.analysis.source_text``).
-Without ``--session``, a shader that tests ``MODEL_VERTEX_*`` macros gets a hint (a last line
+``--all`` adds the nodes left out, with the reason
+(``type dynamic screen derivative uniform duplicate cheap``). A node that only some cache
+algorithms can hold (one that needs screen-space derivatives cannot be cached by one-pass) gets
+an ``algorithms`` column naming those, with the reason for the others under the table.
+``--json`` prints ``{"shader", "nodes": [...], "excluded": [...], "language": {...}, "hint"}``;
+every node has ``algorithms`` (the valid ones), ``not_valid`` (algorithm -> reason) and ``file``
+(None for the shader's own lines); ``excluded`` is empty unless ``--all``. The line after the
+table (``language`` in JSON: version, profile, ``es``, ``assumed``, ``text``) says which GLSL the
+shader was read as: a shader without ``#version`` is GLSL ES 1.00 when it has a ``precision``
+statement or tests ``GL_ES`` (as ES sketch tools run it), else desktop GLSL 1.10. Without
+``--session``, a shader that tests ``MODEL_VERTEX_*`` macros gets a hint (a last line
 ``hint: ...``, ``"hint"`` in JSON, and in the error message when it fails): those branches are
-off until a session's meshes (or ``-D``) define them. ``--all`` adds the nodes left out, with the reason
-(``type dynamic derivative uniform duplicate cheap``). ``--json`` prints
-``{"shader", "nodes": [...], "excluded": [...], "language": {...}}``; ``excluded`` is empty
-unless ``--all``. The last line (``language`` in JSON: version, profile, ``es``, ``assumed``,
-``text``) says which GLSL the shader was read as; a shader without ``#version`` is GLSL ES 1.00
-when it has a ``precision`` statement or tests ``GL_ES`` (as ES sketch tools run it), else
-desktop GLSL 1.10.
+off until a session's meshes (or ``-D``) define them. ``--vert FILE`` (or the session's
+``"vertex"``) checks that the vertex shader writes every input the fragment shader reads.
 """
 from __future__ import annotations
 
@@ -28,11 +33,11 @@ import click
 import os
 import re
 
-from rrcache.analysis.cacheable import cacheable_nodes
+from rrcache.analysis.cacheable import REASONS
 from rrcache.analysis.source_text import display_file
-from rrcache.errors import RRCacheError
 from rrcache.cli.options import parse_defines, vert_option
-from rrcache.glsl.frontend import load_shader
+from rrcache.errors import RRCacheError
+from rrcache.pipeline import load_for_session
 
 _TEXT_WIDTH = 70
 
@@ -49,8 +54,9 @@ def _chain(chain: list[str], width: int = 36) -> str:
 def format_table(table, show_all: bool) -> str:
     """The readable text table of a :class:`NodeTable` (with ``show_all``, the nodes left out
     too, in id order, with their reason)."""
-    header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + [
-        "inlined from", "expression"]
+    restricted = any(n.invalid for n in table.nodes)
+    header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + (
+        ["algorithms"] if restricted else []) + ["inlined from", "expression"]
     entries = [(n, "final" if n.final else "") for n in table.nodes]
     if show_all:
         entries += [(x, x.reason) for x in table.excluded]
@@ -65,14 +71,19 @@ def format_table(table, show_all: bool) -> str:
             row.append(reason)
         elif reason:
             row[0] += "*"
+        if restricted:
+            valid = getattr(n, "algorithms", [])
+            row.append("all" if len(valid) == 3 else ",".join(valid) or "-")
         rows.append(row + [_chain(n.call_chain), _short(n.text)])
     widths = [max(len(r[i]) for r in rows) for i in range(len(header) - 1)]
     lines = ["  ".join(r[i].rjust(w) if i == 3 else r[i].ljust(w)
                        for i, w in enumerate(widths)) + "  " + r[-1] for r in rows]
     counts = table.counts()
-    left = ", ".join(f"{counts[k]} {k}" for k in ("type", "dynamic", "derivative", "uniform",
-                                                     "duplicate", "cheap") if counts[k])
+    left = ", ".join(f"{counts[k]} {k}" for k in REASONS if counts[k])
     lines.append("")
+    reasons = sorted({(a, why) for n in table.nodes for a, why in n.invalid.items()})
+    for a, why in reasons:
+        lines.append(f"not {a}: {why}")
     if not show_all and any(n.final for n in table.nodes):
         lines.append("* the final colour")
     lines.append(f"{counts['listed']} cacheable nodes" + (f"; left out: {left}" if left else "")
@@ -110,15 +121,13 @@ def _mesh_hint(tested: list[str]) -> str:
             f"ids differ: give --session SESSION (or -D {tested[0]})")
 
 
-def _check_vertex(loaded, vert, session, defines) -> None:
+def _check_vertex(work) -> None:
     """With a vertex shader (``--vert`` or the session's), check that it writes every input the
     fragment shader reads (the error names the declaration)."""
-    from rrcache.harness.prepare import load_user_vertex
-
-    user = load_user_vertex(vert, session, defines)
-    if user is not None:
-        user.check_inputs({n: str(t) for n, (t, _loc) in loaded.inputs.items()},
-                          {n: loc for n, (_t, loc) in loaded.inputs.items()})
+    if work.vertex is not None:
+        inputs = work.shader.inputs
+        work.vertex.check_inputs({n: str(t) for n, (t, _loc) in inputs.items()},
+                                 {n: loc for n, (_t, loc) in inputs.items()})
 
 
 @click.command("nodes")
@@ -137,38 +146,35 @@ def _check_vertex(loaded, vert, session, defines) -> None:
 def command(shader, as_json, show_all, define, max_unroll, session, vert):
     """List the nodes of SHADER that a reprojection cache can hold."""
     defines = parse_defines(define)
-    loaded_session = None
+    loaded = None
     if session is not None:
-        from rrcache.harness.vertex import mesh_defines, session_attributes
         from rrcache.session import load_session
 
-        loaded_session = load_session(session)
-        defines = {**mesh_defines(session_attributes(loaded_session)), **defines}
+        loaded = load_session(session)
     mesh_hint = None
-    if session is None:
-        try:
-            loaded = load_shader(shader, defines)
-        except RRCacheError as err:
-            tested = model_vertex_tests([shader, getattr(getattr(err, "loc", None), "file", None)], defines)
-            if tested:
-                err.hint = (f"{err.hint}; " if err.hint else "") + _mesh_hint(tested)
-            raise
-        tested = model_vertex_tests(loaded.files or [shader], defines)
+    try:
+        work = load_for_session(shader, loaded, defines, max_unroll=max_unroll, vertex=vert)
+    except RRCacheError as err:
+        tested = [] if loaded is not None else model_vertex_tests(
+            [shader, getattr(getattr(err, "loc", None), "file", None)], defines)
+        if tested:
+            err.hint = (f"{err.hint}; " if err.hint else "") + _mesh_hint(tested)
+        raise
+    if loaded is None:
+        tested = model_vertex_tests(work.shader.files or [shader], defines)
         mesh_hint = _mesh_hint(tested) if tested else None
-    else:
-        loaded = load_shader(shader, defines)
-    _check_vertex(loaded, vert, loaded_session, defines)
-    table = cacheable_nodes(loaded, max_iterations=max_unroll)
+    _check_vertex(work)
+    table, source = work.table, work.shader
     if as_json:
         doc = table.to_json(shader)
         if not show_all:
             doc["excluded"] = []
-        doc["language"] = {"version": loaded.version, "profile": loaded.profile, "es": loaded.es,
-                           "assumed": loaded.assumed is not None, "text": loaded.language}
+        doc["language"] = {"version": source.version, "profile": source.profile, "es": source.es,
+                           "assumed": source.assumed is not None, "text": source.language}
         doc["hint"] = mesh_hint
         click.echo(json.dumps(doc, indent=2))
     else:
         click.echo(format_table(table, show_all))
-        click.echo(f"read as {loaded.language}")
+        click.echo(f"read as {source.language}")
         if mesh_hint:
             click.echo(f"hint: {mesh_hint}")

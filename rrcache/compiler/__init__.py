@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from typing import Any, Union
 
+from rrcache.errors import UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
@@ -41,7 +42,20 @@ from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS
 
-__all__ = ["instance", "Variant", "PassSource"]
+__all__ = ["instance", "check_algorithm", "Variant", "PassSource"]
+
+
+def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: str) -> None:
+    """Raise :class:`UnsupportedShaderError` when ``analysed`` is a node table whose entry for
+    ``node_id`` is not valid for ``algorithm`` (a node that needs screen-space derivatives
+    cannot be cached by one-pass), naming the reason and the algorithms that can."""
+    for n in getattr(analysed, "nodes", None) or ():
+        if (n.id == node_id or n.node is node_id) and algorithm in getattr(n, "invalid", {}):
+            valid = getattr(n, "algorithms", [])
+            raise UnsupportedShaderError(
+                f"node {n.id} '{n.text}' cannot be cached with {algorithm}: "
+                f"{n.invalid[algorithm]}", n.node.loc,
+                f"use --algorithm {' or '.join(valid)}" if valid else "pick another node")
 
 
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
@@ -55,7 +69,8 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     runtime. ``vertex`` is the user's vertex shader (a
     :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
     :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a
-    node that cannot be cached.
+    node that cannot be cached, or that the node table says ``algorithm`` cannot cache
+    (:func:`check_algorithm`).
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -63,6 +78,7 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
     if payload_dtype not in PAYLOAD_DTYPES:
         raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    check_algorithm(analysed, node_id, algorithm)
     loc = prepare(analysed, node_id)
     passes: dict[str, PassSource] = {}
     uniforms: dict[str, list[str]] = {}

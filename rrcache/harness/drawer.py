@@ -7,9 +7,19 @@ uniforms of docs/design.md §4 (camera, light, time, matrices, the previous fram
 model-view-projection for reprojection), the session's uniforms and samplers, and renders every
 object, culling back faces unless the object is ``double_sided``.
 
->>> drawer = SceneDrawer(ctx, session, prepared, (640, 480), scope)    # doctest: +SKIP
->>> drawer.add_program(program)                                         # doctest: +SKIP
->>> drawer.set_frame(10); drawer.draw(program)                          # doctest: +SKIP
+>>> from rrcache.gl import GLScope, build_program, get_context
+>>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.harness.vertex import vertex_source
+>>> from rrcache.session import load_session
+>>> ctx, scope = get_context(), GLScope()
+>>> session = load_session("sessions/marble.json")
+>>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+>>> program = scope.own(build_program(ctx, vertex_source({n: d.type for n, d in prepared.inputs.items()}),
+...                                   prepared.source))
+>>> drawer = SceneDrawer(ctx, session, prepared, (32, 24), scope)
+>>> _ = drawer.add_program(program)
+>>> drawer.set_frame(10); drawer.draw(program)
+>>> scope.release()
 """
 from __future__ import annotations
 
