@@ -115,9 +115,9 @@ class CacheableNode:
     call_chain: list[str]
     node: A.Expr = field(repr=False, compare=False)
     final: bool = False
-    file: Optional[str] = None  # the included file the node was written in (None: the main file)
     #: the algorithms that cannot cache this node, each with the reason
     invalid: dict = field(default_factory=dict)
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
 
     @property
     def algorithms(self) -> list[str]:
