@@ -39,13 +39,14 @@ from rrcache.selection import CachedNode, Selection
 @dataclass
 class ShaderWork:
     """A shader loaded for a session: the checked ``shader``, the ``table`` of cacheable nodes,
-    the ``defines`` used, the user's ``vertex`` shader (a ``UserVertex``; None when the harness
-    generates it) and (made when first read) the harness's ``prepared`` core source."""
+    the ``defines`` used and (made when first read) the harness's ``prepared`` core source."""
 
     shader: Shader
     table: object
     defines: dict
-    vertex: Optional[object] = None
+
+    #: the user's vertex shader (``UserVertex``), or None when the harness generates it
+    vertex: object = None
 
     @cached_property
     def prepared(self) -> PreparedShader:

@@ -233,9 +233,10 @@ def test_cli_vert_option(tmp_path, capsys):
 
 def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
     """A profile made with --vert re-selects with it, and a changed vertex shader is named."""
+    from rrcache.selection import CachedNode, Selection
+
     from rrcache.profiler import profile
     from rrcache.profiles import TrainingSettings, load_profile
-    from rrcache.selection import CachedNode, Selection
 
     frag, session = _scene(tmp_path, vertex=False)
     vert = frag.with_suffix(".vert")
@@ -245,12 +246,12 @@ def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
     assert prof.vertex == str(vert) and prof.vertex_hash
     node = next(n.id for n in prof.nodes if n.trained)
     again = load_profile(tmp_path / "out")
-    written = again.write_variant(Selection((CachedNode(node, 4),)), tmp_path / "sel")
+    written = again.write_variant(Selection(parts=(CachedNode(node, 4),)), tmp_path / "sel")
     assert "rr_userMain" in next(open(p).read() for p in written if p.endswith("reproject.vert") or
                                  p.endswith("hit.vert") or p.endswith("single.vert"))
     vert.write_text(VERT.replace("0.5 + 0.5 * a_position.y", "0.5 + 0.4 * a_position.y"))
     with pytest.raises(RRCacheError, match="the vertex shader .*gv.vert' changed") as info:
-        again.write_variant(Selection((CachedNode(node, 4),)), tmp_path / "sel2")
+        again.write_variant(Selection(parts=(CachedNode(node, 4),)), tmp_path / "sel2")
     assert "gv.frag' changed" not in str(info.value)
 
 

@@ -11,6 +11,7 @@ import json
 import os
 import subprocess
 import sys
+from rrcache.selection import CachedNode, Selection
 
 import pytest
 
@@ -18,7 +19,6 @@ from test_profile import SESSION
 
 from rrcache.glsl.frontend import describe_change, file_records, load_shader
 from rrcache.profiles import load_profile
-from rrcache.selection import CachedNode, Selection
 
 MAIN = """// glslViewer-style sketch: the noise lives in a library file
 #ifdef GL_ES
@@ -119,7 +119,7 @@ def test_select_and_accuracy_from_another_directory(made, tmp_path, monkeypatch)
     # cached node's variant too, which loads the shader again and checks its hash
     monkeypatch.chdir(elsewhere)
     prof = load_profile(profile)
-    choice = Selection((CachedNode(node, 4),))
+    choice = Selection(parts=(CachedNode(node, 4),))
     written = prof.write_variant(choice, "opt2")
     assert any(p.endswith(".frag") for p in written)
     assert json.loads((elsewhere / "opt2" / "manifest.json").read_text())["node"]["id"] == node

@@ -115,9 +115,9 @@ class CacheableNode:
     call_chain: list[str]
     node: A.Expr = field(repr=False, compare=False)
     final: bool = False
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
     #: the algorithms that cannot cache this node, each with the reason
     invalid: dict = field(default_factory=dict)
-    file: Optional[str] = None  # the included file the node was written in (None: the main file)
 
     @property
     def algorithms(self) -> list[str]:
@@ -426,7 +426,7 @@ class _Classifier:
             if reason is None:
                 invalid = {"one-pass": ONE_PASS_DERIVATIVE} if r.flags & _DERIV else {}
                 nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
-                                           chain, e, is_final, invalid))
+                                           chain, e, is_final, invalid=invalid))
             else:
                 excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
                                              tname, cost, chain))

@@ -72,6 +72,7 @@ def attach_source_text(table, original_unit: A.TranslationUnit) -> None:
     shader = getattr(table, "shader", None)
     if shader is not None:
         main_file = getattr(shader, "path", None)
+    main_file = str(main_file) if main_file else None
     functions = {d.name for d in original_unit.decls if isinstance(d, A.FunctionDecl)}
     index: dict[tuple, list] = {}
     for e in iter_exprs(original_unit):
@@ -83,8 +84,9 @@ def attach_source_text(table, original_unit: A.TranslationUnit) -> None:
         loc = getattr(e, "loc", None)
         if loc is None:
             continue
-        if loc.file and loc.file != main_file and not loc.file.startswith("<"):
-            entry.file = loc.file
+        file = str(loc.file) if loc.file else None
+        if file and file != main_file and not file.startswith("<"):
+            entry.file = file
         if not entry.call_chain and "_rr_" not in entry.text:
             continue
         for candidate in index.get(_key(loc), ()):

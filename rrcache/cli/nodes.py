@@ -9,20 +9,18 @@ line:column (``file:line:column`` for a line of an included file, the file relat
 shader's folder: ``lygia/generative/fbm.glsl:13:15``), estimated cost (the work a cache hit
 saves, see ``rrcache.analysis.cost``), the inlined call chain and the expression as written
 (``sum + amp * snoise(p)``, not the inliner's temporaries; ``rrcache.analysis.source_text``).
-``--all`` adds the nodes left out, with the reason
+Without ``--session``, a shader that tests ``MODEL_VERTEX_*`` macros gets a hint (a last line
+``hint: ...``, ``"hint"`` in JSON, and in the error message when it fails): those branches are
+off until a session's meshes (or ``-D``) define them. ``--all`` adds the nodes left out, with the reason
 (``type dynamic screen derivative uniform duplicate cheap``). A node that only some cache
 algorithms can hold (one that needs screen-space derivatives cannot be cached by one-pass) gets
-an ``algorithms`` column naming those, with the reason for the others under the table.
-``--json`` prints ``{"shader", "nodes": [...], "excluded": [...], "language": {...}, "hint"}``;
-every node has ``algorithms`` (the valid ones), ``not_valid`` (algorithm -> reason) and ``file``
-(None for the shader's own lines); ``excluded`` is empty unless ``--all``. The line after the
-table (``language`` in JSON: version, profile, ``es``, ``assumed``, ``text``) says which GLSL the
-shader was read as: a shader without ``#version`` is GLSL ES 1.00 when it has a ``precision``
-statement or tests ``GL_ES`` (as ES sketch tools run it), else desktop GLSL 1.10. Without
-``--session``, a shader that tests ``MODEL_VERTEX_*`` macros gets a hint (a last line
-``hint: ...``, ``"hint"`` in JSON, and in the error message when it fails): those branches are
-off until a session's meshes (or ``-D``) define them. ``--vert FILE`` (or the session's
-``"vertex"``) checks that the vertex shader writes every input the fragment shader reads.
+an ``algorithms`` column naming those, with the reason for the others under the table. ``--json`` prints
+``{"shader", "nodes": [...], "excluded": [...], "language": {...}}``; ``excluded`` is empty
+unless ``--all``; every node has ``algorithms`` (the valid ones) and ``not_valid`` (algorithm ->
+reason). The last line (``language`` in JSON: version, profile, ``es``, ``assumed``,
+``text``) says which GLSL the shader was read as; a shader without ``#version`` is GLSL ES 1.00
+when it has a ``precision`` statement or tests ``GL_ES`` (as ES sketch tools run it), else
+desktop GLSL 1.10.
 """
 from __future__ import annotations
 
@@ -121,13 +119,12 @@ def _mesh_hint(tested: list[str]) -> str:
             f"ids differ: give --session SESSION (or -D {tested[0]})")
 
 
-def _check_vertex(work) -> None:
+def _check_vertex(loaded, user) -> None:
     """With a vertex shader (``--vert`` or the session's), check that it writes every input the
     fragment shader reads (the error names the declaration)."""
-    if work.vertex is not None:
-        inputs = work.shader.inputs
-        work.vertex.check_inputs({n: str(t) for n, (t, _loc) in inputs.items()},
-                                 {n: loc for n, (_t, loc) in inputs.items()})
+    if user is not None:
+        user.check_inputs({n: str(t) for n, (t, _loc) in loaded.inputs.items()},
+                          {n: loc for n, (_t, loc) in loaded.inputs.items()})
 
 
 @click.command("nodes")
@@ -146,35 +143,35 @@ def _check_vertex(work) -> None:
 def command(shader, as_json, show_all, define, max_unroll, session, vert):
     """List the nodes of SHADER that a reprojection cache can hold."""
     defines = parse_defines(define)
-    loaded = None
+    loaded_session = None
     if session is not None:
         from rrcache.session import load_session
 
-        loaded = load_session(session)
-    mesh_hint = None
+        loaded_session = load_session(session)
     try:
-        work = load_for_session(shader, loaded, defines, max_unroll=max_unroll, vertex=vert)
+        work = load_for_session(shader, loaded_session, defines, max_unroll=max_unroll, vertex=vert)
     except RRCacheError as err:
-        tested = [] if loaded is not None else model_vertex_tests(
-            [shader, getattr(getattr(err, "loc", None), "file", None)], defines)
-        if tested:
-            err.hint = (f"{err.hint}; " if err.hint else "") + _mesh_hint(tested)
+        if loaded_session is None:
+            tested = model_vertex_tests([shader, getattr(getattr(err, "loc", None), "file", None)], defines)
+            if tested:
+                err.hint = (f"{err.hint}; " if err.hint else "") + _mesh_hint(tested)
         raise
-    if loaded is None:
-        tested = model_vertex_tests(work.shader.files or [shader], defines)
+    loaded, table = work.shader, work.table
+    mesh_hint = None
+    if loaded_session is None:
+        tested = model_vertex_tests(loaded.files or [shader], work.defines)
         mesh_hint = _mesh_hint(tested) if tested else None
-    _check_vertex(work)
-    table, source = work.table, work.shader
+    _check_vertex(loaded, work.vertex)
     if as_json:
         doc = table.to_json(shader)
         if not show_all:
             doc["excluded"] = []
-        doc["language"] = {"version": source.version, "profile": source.profile, "es": source.es,
-                           "assumed": source.assumed is not None, "text": source.language}
+        doc["language"] = {"version": loaded.version, "profile": loaded.profile, "es": loaded.es,
+                           "assumed": loaded.assumed is not None, "text": loaded.language}
         doc["hint"] = mesh_hint
         click.echo(json.dumps(doc, indent=2))
     else:
         click.echo(format_table(table, show_all))
-        click.echo(f"read as {source.language}")
+        click.echo(f"read as {loaded.language}")
         if mesh_hint:
             click.echo(f"hint: {mesh_hint}")

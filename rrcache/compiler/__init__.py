@@ -68,9 +68,8 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     ``payload_dtype`` the cache precision (``f4``, or ``f2`` for half floats), recorded for the
     runtime. ``vertex`` is the user's vertex shader (a
     :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
-    :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a
-    node that cannot be cached, or that the node table says ``algorithm`` cannot cache
-    (:func:`check_algorithm`).
+    :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
+    be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")

@@ -168,8 +168,8 @@ def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[
 def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping[str, str]] = None,
                  include_dirs=(), vertex=None) -> PreparedShader:
     """:func:`load_for_meshes`, then :func:`prepare`; ``vertex`` is the path of the user's vertex
-    shader (None: the session's ``"vertex"`` when ``session_or_attributes`` is a session that
-    names one, else the harness generates it).
+    shader (None: the session's ``"vertex"`` when ``session_or_attributes`` is a session that has
+    one, else generated).
 
     >>> prepare_file("marble.frag", {"normal", "texcoord"}).defines     # doctest: +SKIP
     {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
