@@ -43,7 +43,7 @@ from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS
 
-__all__ = ["instance", "check_algorithm", "Variant", "PassSource"]
+__all__ = ["instance", "instance_nodes", "check_algorithm", "Variant", "PassSource"]
 
 
 def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: str) -> None:
@@ -105,3 +105,6 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
         vertex_path=getattr(user_vertex, "path", None))
+
+
+from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)

@@ -62,10 +62,12 @@ class CachedRenderer:
     order for the cache to mean anything (frame ``i`` reprojects from the last rendered frame);
     a jump resets the cache (every pixel misses, as after a camera cut). ``window`` (x, y, w, h)
     renders only that rectangle at full pixel density (see :mod:`rrcache.gl.window`).
+    A variant of several nodes (:func:`rrcache.compiler.instance_nodes`) takes one ``period`` per
+    node (a sequence in the variant's node order; one int: every node).
     """
 
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
-                 period: int = DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+                 period=DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
                  depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None):
@@ -89,6 +91,8 @@ class CachedRenderer:
             for program in self.programs.values():
                 self.drawer.add_program(program)
             self.notes = self.drawer.notes
+            if hasattr(variant, "periods"):  # several nodes: one period each (a tuple)
+                period = tuple(variant.periods(period))
             self.runtime = CacheRuntime(
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
@@ -114,9 +118,10 @@ class CachedRenderer:
         ``payload_note``; else switch the cache to 16 bits. Later frames are not checked."""
         self._check_half = False
         rt = self.runtime
-        payload = rt.read_payload()[..., :rt.payload_components]
+        payloads = ([p[..., :c] for p, c in zip(rt.read_payloads(), rt.node_components)]
+                    if hasattr(rt, "read_payloads") else [rt.read_payload()[..., :rt.payload_components]])
         covered = rt.read_depth() < 1.0
-        values = np.abs(payload[covered])
+        values = np.concatenate([np.abs(p[covered]).ravel() for p in payloads])
         finite = values[np.isfinite(values)]
         largest = float(finite.max()) if finite.size else 0.0
         if largest <= HALF_MAX:
@@ -313,7 +318,7 @@ class Comparison:
         }
 
 
-def compare(variant, session, prepared: PreparedShader, frames, period: int = DEFAULT_PERIOD,
+def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_PERIOD,
             resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
             depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,

@@ -108,6 +108,9 @@ class CacheRuntime:
     ``depth_epsilon`` can be changed between frames (they are uniforms or small textures).
     ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
     the application's culling state alone (the draw callback may set it per object).
+    ``period`` given as a list or tuple (one Δn per node, with ``payload_components`` one count
+    per node) makes the cache of a multi-node variant, a
+    :class:`rrcache.runtime.multi.MultiCacheRuntime`.
 
     Example, inside a render loop (``draw`` renders the scene with the given program)::
 
@@ -116,6 +119,14 @@ class CacheRuntime:
             stats = rt.frame(draw)
             image = rt.read_color()
     """
+
+    def __new__(cls, *args, **kwargs):
+        # several periods (one per node): the cache of a multi-node variant
+        if cls is CacheRuntime and isinstance(kwargs.get("period"), (list, tuple)):
+            from rrcache.runtime.multi import MultiCacheRuntime
+
+            return super().__new__(MultiCacheRuntime)
+        return super().__new__(cls)
 
     def __init__(
         self,

@@ -1,0 +1,86 @@
+"""Compile a variant caching k ≥ 2 nodes: :func:`instance_nodes`.
+
+The passes are those of the one-node compiler's algorithms, assembled for several nodes by
+:mod:`rrcache.compiler.multi_passes` (what each pass does, and what a nested pair means, is
+explained there) from the unit of :mod:`rrcache.compiler.multi_locate`; printing and the vertex
+shaders are the one-node emitter's. One node is :func:`rrcache.compiler.instance` (the k = 1
+variant's text is unchanged by any of this).
+"""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+from rrcache.deep import deep
+from rrcache.compiler.emit import (
+    fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
+)
+from rrcache.compiler.multi_locate import prepare_nodes
+from rrcache.compiler.multi_passes import build_multi_pass
+from rrcache.compiler.multi_variant import MultiVariant
+from rrcache.compiler.variant import PassSource
+from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.glsl import FILTERS
+
+
+def _table_entry(analysed: Any, node_id: Any):
+    for n in getattr(analysed, "nodes", None) or ():
+        if n.id == node_id or n.node is node_id:
+            return n
+    return None
+
+
+@deep
+def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "three-pass",
+                   filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> MultiVariant:
+    """Compile the variant of ``analysed`` that caches every node of ``node_ids`` (at least two;
+    ids of the node table, or expression nodes), each with its own payload and, at run time, its
+    own period (:class:`rrcache.runtime.CacheRuntime` with ``period=(Δn_0, Δn_1, …)`` in this
+    order). Raises :class:`~rrcache.errors.UnsupportedShaderError` for a node that cannot be
+    cached, or not with ``algorithm`` (:func:`rrcache.compiler.check_algorithm`), or a nest that
+    cannot be compiled."""
+    from rrcache.compiler import check_algorithm
+
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
+    if filter not in FILTERS:
+        raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
+    if payload_dtype not in PAYLOAD_DTYPES:
+        raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    node_ids = list(node_ids)
+    if len(node_ids) < 2:
+        raise ValueError("instance_nodes caches two nodes or more; use instance for one")
+    for node_id in node_ids:
+        check_algorithm(analysed, node_id, algorithm)
+    loc = prepare_nodes(analysed, node_ids)
+    # a node that needs derivatives (invalid for one-pass) is computed outside any branch
+    derivative = {j for j, node_id in enumerate(node_ids)
+                  if "one-pass" in getattr(_table_entry(analysed, node_id), "invalid", {})}
+    passes, uniforms, samplers, runtime, forms = {}, {}, {}, {}, {}
+    user_vertex = vertex
+    for name in ALGORITHMS[algorithm]:
+        built = build_multi_pass(loc, name, filter, derivative)
+        iface = interface(built.unit)
+        vertex_src = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), user_vertex)
+        fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
+        passes[name] = PassSource(vertex_src, fragment, line_map)
+        vertex_names = (user_vertex.uniform_names(built.spec.lookup) if user_vertex is not None
+                        else vertex_uniforms(vertex_src))
+        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_names))
+        samplers[name] = list(iface["sampler"])
+        runtime[name] = runtime_uniforms(built.runtime_glsl)
+        forms[name] = built.form
+    ids = [i if isinstance(i, (int, str)) else None for i in node_ids]
+    nodes = [{
+        "id": ids[n.index], "type": n.type_name, "text": n.text, "components": n.components,
+        "location": str(n.loc) if n.loc else None,
+        "inside": ids[n.parent] if n.parent is not None else None,
+    } for n in loc.nodes]
+    return MultiVariant(
+        algorithm=algorithm,
+        node_id="+".join(str(i) for i in ids) if all(i is not None for i in ids) else None,
+        node_type=", ".join(n.type_name for n in loc.nodes),
+        node_text=" + ".join(n.text for n in loc.nodes),
+        components=tuple(n.components for n in loc.nodes), filter=filter,
+        payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
+        runtime_uniforms=runtime, forms=forms, node_loc=loc.nodes[0].loc, shader_path=loc.path,
+        vertex_path=getattr(user_vertex, "path", None), nodes=nodes)
