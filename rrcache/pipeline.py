@@ -30,7 +30,7 @@ from typing import Mapping, Optional
 
 from rrcache.analysis import cacheable_nodes
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
-from rrcache.compiler import Variant, instance
+from rrcache.compiler import Variant, instance, instance_nodes
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
 from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
@@ -94,6 +94,17 @@ def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", f
                 payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``)."""
     return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex)
+
+
+def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = "bilinear",
+                      payload_dtype: str = "f4") -> Variant:
+    """Compile the variant of ``work`` caching every node of ``node_ids`` (two or more; one:
+    :func:`variant_for`), each with its own payload and period
+    (:func:`rrcache.compiler.instance_nodes`)."""
+    node_ids = list(node_ids)
+    if len(node_ids) == 1:
+        return variant_for(work, node_ids[0], algorithm, filter, payload_dtype)
+    return instance_nodes(work.table, node_ids, algorithm, filter, payload_dtype, work.vertex)
 
 
 def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:

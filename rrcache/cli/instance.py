@@ -4,19 +4,24 @@ Writes ``<pass>.vert`` and ``<pass>.frag`` for every pass of the algorithm and `
 (node, period, algorithm, filter, payload precision, the uniforms and textures each pass expects
 and the ``rr_`` uniforms the runtime sets). Load them in an application with
 :class:`rrcache.runtime.CacheRuntime`.
+
+``--node A --period 50 --node B --period 4`` caches several nodes, each at its own period (the
+periods pair with the nodes in order); the manifest then lists ``"nodes"``, each with its period.
 """
 from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, vert_option
+from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
 
 @click.command("instance")
 @click.argument("shader", type=click.Path(dir_okay=False))
-@click.option("--node", required=True, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
-@click.option("--period", type=PERIOD, default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
+@click.option("--node", required=True, multiple=True, metavar="ID",
+              help="The node to cache (an id from `rrcache nodes`); repeat it to cache several nodes.")
+@click.option("--period", type=PERIOD, multiple=True, show_default=str(DEFAULT_PERIOD),
+              help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)
@@ -28,11 +33,22 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 @vert_option
 def command(shader, node, period, algorithm, filter_, payload, session, defines, include_dirs, out_dir, vert):
     """Write the shaders of the variant of SHADER that caches --node, and a manifest."""
-    from rrcache.pipeline import load_for_session, variant_for
+    from rrcache.pipeline import load_for_session, variant_for, variant_for_nodes
     from rrcache.session import load_session
 
+    periods = pair_periods(node, period, DEFAULT_PERIOD)
     loaded = load_session(session) if session else None
     work = load_for_session(shader, loaded, parse_defines(defines), include_dirs, vertex=vert)
+    if len(node) > 1:
+        entries = [work.node(n) for n in node]
+        variant = variant_for_nodes(work, list(node), algorithm, filter_, payload)
+        written = variant.write(out_dir, period=periods)
+        click.echo(" + ".join(f"{n} ({e.type}, {shader}:{e.line}:{e.column}) at Δn={p}"
+                              for n, e, p in zip(node, entries, periods)) + f" cached with {algorithm}:")
+        for path in written:
+            click.echo(f"  {path}")
+        return
+    node, period = node[0], periods[0]
     entry = work.node(node)
     variant = variant_for(work, node, algorithm, filter_, payload)
     written = variant.write(out_dir, period=period)

@@ -51,3 +51,23 @@ vert_option = click.option(
     "--vert", "vert", type=click.Path(dir_okay=False), default=None, metavar="FILE",
     help="The vertex shader paired with SHADER (a glslViewer .vert); default: the session's "
          "\"vertex\", else a generated one.")
+
+
+def pair_periods(nodes, periods, default: int) -> list[int]:
+    """The period of each ``--node``: the ``--period`` options paired with them in order (one
+    ``--period`` serves every node; none: ``default``). Another count is a ``click.BadParameter``
+    (exit 2).
+
+    >>> pair_periods(("n1", "n2"), (50, 4), 8), pair_periods(("n1", "n2"), (), 8)
+    ([50, 4], [8, 8])
+    """
+    periods = [int(p) for p in periods]
+    if not periods:
+        return [int(default)] * len(nodes)
+    if len(periods) == 1:
+        return periods * len(nodes)
+    if len(periods) != len(nodes):
+        raise click.BadParameter(
+            f"{len(nodes)} --node but {len(periods)} --period: give one --period per --node, in the "
+            "same order (or one for all)", param_hint="--period")
+    return periods

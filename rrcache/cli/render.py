@@ -4,7 +4,8 @@
     rrcache render marble.frag session.json --resolution 64x48 --json
     rrcache render marble.frag session.json --node n2575 --period 16 --json
 
-With ``--node`` the variant caching that node is rendered beside the original, frame by frame in
+With ``--node`` the variant caching that node is rendered beside the original (``--node A --period
+50 --node B --period 4``: several nodes, each at its own period, paired in order), frame by frame in
 one run, and compared: error, PSNR, hit rate, and the speed-up as a ratio of median frame times
 (the first frame, which has no cache, is left out of the summary).
 
@@ -23,7 +24,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, resolution_option, vert_option
+from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse_defines, resolution_option, vert_option
 from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
@@ -46,8 +47,10 @@ from rrcache.session import load_session
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @include_dirs_option
-@click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
-@click.option("--period", type=PERIOD, default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
+@click.option("--node", multiple=True, metavar="ID",
+              help="Cache this node (an id from `rrcache nodes`); repeat it to cache several nodes.")
+@click.option("--period", type=PERIOD, multiple=True, show_default=str(DEFAULT_PERIOD),
+              help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--block", type=click.Choice([str(b) for b in BLOCK_SIZES]), default=str(DEFAULT_BLOCK),
               show_default=True, help="Refresh block size k (pixels).")
@@ -65,7 +68,12 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
     with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
     loaded = load_session(session)
-    if node is not None:
+    if node:
+        periods = pair_periods(node, period, DEFAULT_PERIOD)
+        if len(node) == 1:
+            node, period = node[0], periods[0]
+        else:
+            period = periods
         _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
                             filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console, vert)
@@ -123,9 +131,15 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
 def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_count, resolution, as_json, opts,
                    err_console, vert=None):
     from rrcache.harness.cached import compare
-    from rrcache.pipeline import load_for_session, variant_for
+    from rrcache.pipeline import load_for_session, variant_for, variant_for_nodes
 
     work = load_for_session(shader, loaded, defines, include_dirs, vertex=vert)
+    if not isinstance(node, str):  # several nodes, each with its period
+        entries = [work.node(n) for n in node]
+        variant = variant_for_nodes(work, list(node), opts["algorithm"], opts["filter"], opts["payload"])
+        _render_nodes(work, loaded, node, entries, variant, out_dir, frame_count, resolution, as_json, opts,
+                      err_console)
+        return
     entry = work.node(node)
     variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"])
     indices = frame_indices(loaded, frame_count)
@@ -175,3 +189,58 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
         console.print(f"NaN/Inf pixels: {summary['nonfinite_pixels']} in the variant, "
                       f"{summary['original_nonfinite_pixels']} in the original; the error leaves out "
                       f"{summary['error_left_out_pixels']} covered pixels", highlight=False)
+
+
+def _render_nodes(work, loaded, nodes, entries, variant, out_dir, frame_count, resolution, as_json, opts,
+                  err_console):
+    """``render --node A --period 50 --node B --period 4``: the variant of several nodes beside
+    the original, as for one node."""
+    from rrcache.harness.cached import compare
+
+    periods = list(opts["period"])
+    label = " + ".join(f"{n} Δn={p}" for n, p in zip(nodes, periods))
+    indices = frame_indices(loaded, frame_count)
+    out = Path(out_dir) if out_dir else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    show_progress = len(indices) > 1 and err_console.is_terminal
+    progress = Progress(TextColumn(f"caching {label}"), BarColumn(), MofNCompleteColumn(),
+                        TimeElapsedColumn(), console=err_console, transient=True, disable=not show_progress)
+    with progress:
+        task = progress.add_task("render", total=len(indices))
+
+        def done(row, got, ref):
+            if out is not None:
+                stem = out / f"frame_{row.index:04d}"
+                write_image(stem.with_suffix(".exr"), got.image)
+                write_image(stem.with_suffix(".png"), got.image)
+                write_image(out / f"original_{row.index:04d}.png", ref.image)
+            progress.advance(task)
+
+        result = compare(variant, loaded, work.prepared, indices, period=tuple(periods), resolution=resolution,
+                         block=opts["block"], refresh=opts["refresh"], depth_epsilon=opts["depth_epsilon"],
+                         on_frame=done)
+    for note in result.notes:
+        click.echo(f"note: {note}", err=True)
+    summary = result.summary()
+    if as_json:
+        click.echo(json.dumps(dict(
+            frames=len(result.frames), resolution=list(result.resolution), node="+".join(nodes),
+            nodes=list(nodes), period=periods, algorithm=opts["algorithm"],
+            covered_pixels=[f.covered for f in result.frames], **summary)))
+        return
+    console = Console()
+    table = Table(title=f"{work.prepared.path} caching {label}, {opts['algorithm']}")
+    for col in ("frame", "covered", "hit rate", "mean error", "PSNR dB", "ms", "original ms"):
+        table.add_column(col, justify="right")
+    for f in result.frames:
+        rate = "n/a" if f.hits is None else f"{f.hits / f.covered if f.covered else 0.0:.3f}"
+        table.add_row(str(f.index), str(f.covered), rate, f"{f.mean_error:.5f}",
+                      f"{min(f.psnr, 999):.1f}", f"{f.ms:.2f}", f"{f.original_ms:.2f}")
+    console.print(table)
+    for n, e in zip(nodes, entries):
+        console.print(f"node {n} ({e.type}, line {e.line}): {e.text}", highlight=False, markup=False)
+    console.print(f"speed-up {summary['speedup']:.2f}× ({summary['ms_per_frame']:.2f} ms vs "
+                  f"{summary['original_ms_per_frame']:.2f} ms, medians), hit rate (every node hits) "
+                  f"{summary['hit_rate']:.3f}, mean error {summary['mean_error']:.5f}, PSNR {summary['psnr']:.1f} dB",
+                  highlight=False)
