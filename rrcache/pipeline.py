@@ -109,11 +109,14 @@ def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass",
 
 def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:
     """The compiled variant of ``selection`` (with its ``algorithm``; three-pass when it names
-    none) and the refresh period it runs with: where each kind of choice becomes code. The
+    none) and the refresh period it runs with (for several nodes, a list of periods in the
+    order of the parts): where each kind of choice becomes code. The
     original shader (no part) has no variant: RRCacheError."""
     algorithm = selection.algorithm or "three-pass"
     if len(selection.parts) == 1 and isinstance(selection.parts[0], CachedNode):
         part = selection.parts[0]
         return variant_for(work, part.node, algorithm), int(part.period)
+    if selection.multi:  # several nodes, each at its own period (a list, in part order)
+        return variant_for_nodes(work, list(selection.nodes), algorithm), list(selection.periods)
     raise RRCacheError(f"no variant for a selection of kind {selection.kind!r}", "selection",
                        hint="the original shader needs none; other kinds are compiled where they are added")

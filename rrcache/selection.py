@@ -8,8 +8,9 @@ it knows: the model the predicted figures, the profile the label, the threshold,
 and the node's expression text, the validation (or the bench) the measured figures.
 
 *What* is chosen is a tuple of **parts**, each a small frozen dataclass tagged by its ``KIND``:
-no part is the original shader; one :class:`CachedNode` is today's choice (one node cached,
-refreshed every ``period`` frames). A new kind of choice (an amortized loop with its (m, λ),
+no part is the original shader; one :class:`CachedNode` is one node cached, refreshed every
+``period`` frames; several :class:`CachedNode` parts cache several nodes, each at its own period
+(:attr:`Selection.multi`; :meth:`Selection.describe` shows ``n12 Δn=50 + n40 Δn=4``). A new kind of choice (an amortized loop with its (m, λ),
 several nodes each with its own period) is a new part class registered in :data:`PART_KINDS`
 (its JSON and its validation come with it); the store, the document, the report and the bench
 carry it without change, and :func:`rrcache.pipeline.variant_for_selection` is where a kind
@@ -188,9 +189,36 @@ class Selection:
         part = self._single()
         return part.text if part is not None else None
 
+    @property
+    def multi(self) -> bool:
+        """Whether several nodes are cached, each at its own period (parts: two or more
+        :class:`CachedNode`); :attr:`node`/:attr:`period`/:attr:`text` then raise: read
+        :attr:`nodes`/:attr:`periods`, or show :meth:`describe`."""
+        return len(self.parts) >= 2 and all(isinstance(p, CachedNode) for p in self.parts)
+
+    @property
+    def nodes(self) -> tuple:
+        """The cached nodes' ids, in part order (empty for the original shader).
+
+        >>> Selection((CachedNode("n12", 50), CachedNode("n40", 4)), 0.01, 2.0, 1.5).nodes
+        ('n12', 'n40')
+        """
+        return tuple(p.node for p in self.parts if isinstance(p, CachedNode))
+
+    @property
+    def periods(self) -> tuple:
+        """The cached nodes' refresh periods, in part order."""
+        return tuple(int(p.period) for p in self.parts if isinstance(p, CachedNode))
+
     def describe(self) -> str:
-        """``n12 Δn=16``, or ``the original shader``."""
-        return ", ".join(p.describe() for p in self.parts) if self.parts else "the original shader"
+        """``n12 Δn=16``; several nodes ``n12 Δn=50 + n40 Δn=4``; or ``the original shader``.
+
+        >>> Selection((CachedNode("n12", 50), CachedNode("n40", 4)), 0.01, 2.0, 1.5).describe()
+        'n12 Δn=50 + n40 Δn=4'
+        """
+        if not self.parts:
+            return "the original shader"
+        return (" + " if self.multi else ", ").join(p.describe() for p in self.parts)
 
     def with_texts(self, texts: dict) -> "Selection":
         """This selection with each part's ``text`` looked up in ``texts`` (node id → expression)."""

@@ -33,13 +33,22 @@ def command(profile_path, max_error, as_json, out_dir, include_dirs):
     choice = prof.select(max_error)
     written = prof.write_variant(choice, out_dir) if out_dir else []
     if as_json:
-        data = {"node": choice.node, "period": None if choice.period is None else int(choice.period),
-                "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
-                "predicted_speedup": float(choice.predicted_speedup)}
+        if choice.multi:  # several nodes: "n12+n40" and one period each
+            data = {"node": "+".join(choice.nodes), "period": list(choice.periods), "nodes": list(choice.nodes),
+                    "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
+                    "predicted_speedup": float(choice.predicted_speedup)}
+        else:
+            data = {"node": choice.node, "period": None if choice.period is None else int(choice.period),
+                    "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
+                    "predicted_speedup": float(choice.predicted_speedup)}
         click.echo(json.dumps({k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                                for k, v in data.items()}))
         return
-    if choice.node is None:
+    if choice.multi:
+        texts = "; ".join(prof.node(n).text for n in choice.nodes)
+        click.echo(f"cache {choice.describe()} ({texts}): predicted error {choice.predicted_error:.4g}, "
+                   f"{choice.predicted_ms:.3f} ms per frame, {choice.predicted_speedup:.2f}× the original")
+    elif choice.node is None:
         click.echo(f"the original shader: nothing is predicted faster within error {max_error:g} "
                    f"({choice.predicted_ms:.3f} ms per frame)")
     else:

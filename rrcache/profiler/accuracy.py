@@ -112,8 +112,9 @@ def nodes_that_matter(profile, limit: int = MAX_NODES) -> tuple[list[str], str]:
     front = [p.node for p in sorted(pareto_front(profile.table), key=lambda p: p.predicted_ms) if p.node]
     distinct = _spread(list(dict.fromkeys(front)), limit)
     for sel in profile.selections:
-        if sel.node and sel.node not in distinct:
-            distinct.append(sel.node)
+        for node in sel.nodes:
+            if node not in distinct:
+                distinct.append(node)
     if distinct:
         return distinct, FRONT
     by_cost = [n.id for n in sorted(profile.trained_nodes, key=lambda n: -n.cost)]

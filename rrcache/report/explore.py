@@ -79,9 +79,9 @@ def tradeoff_figure(prof, log_error: bool = True, highlight: Optional[str] = Non
             alpha=0.5, label="Pareto front")
     ax.axvline(prof.original_ms, ls="--", color="gray", label=f"original ({prof.original_ms:.3g} ms)")
     for sel in prof.selections:
-        if sel.node is not None:
+        if sel.parts:
             ax.plot(sel.predicted_ms, sel.predicted_error, "s", mfc="none", mec="crimson", ms=8, mew=1.8)
-            ax.annotate(f"{sel.label}: {sel.node} Δn={sel.period}", (sel.predicted_ms, sel.predicted_error),
+            ax.annotate(f"{sel.label}: {sel.describe()}", (sel.predicted_ms, sel.predicted_error),
                         textcoords="offset points", xytext=(7, 4), fontsize=8, color="crimson")
     if log_error:
         ax.set_yscale("log")
@@ -147,6 +147,12 @@ def selections_figure(prof, shots: FrameShots):
     fig, axes = plt.subplots(len(prof.selections), len(names), figsize=(2.4 * len(names), 2.2 * len(prof.selections)),
                              dpi=100, squeeze=False)
     for row, sel in zip(axes, prof.selections):
+        if sel.multi:  # several nodes: no frames (the shots render one cached node)
+            for ax in row:
+                ax.axis("off")
+            row[0].text(-0.08, 0.5, f"{sel.label}: {sel.describe()}", transform=row[0].transAxes, rotation=90,
+                        ha="right", va="center", fontsize=8)
+            continue
         images = shots.images(sel.node, sel.period)
         for ax, name in zip(row, names):
             ax.axis("off")
@@ -165,7 +171,7 @@ def default_choice(prof) -> tuple:
     """``(node, Δn)`` worth a first look: the last selection that caches something, else the
     costliest trained node at the largest trained period."""
     for sel in reversed(prof.selections):
-        if sel.node is not None:
+        if sel.parts and not sel.multi:
             return sel.node, int(sel.period)
     node = prof.trained_nodes[0]
     return node.id, int(max(node.periods))
@@ -205,7 +211,9 @@ def selections_html(prof) -> str:
             "pred. speed-up", "meas. speed-up", "PSNR", "hit rate"]
     rows = []
     for s in prof.selections:
-        cells = [s.label, _f(s.max_error), s.node or "original", s.period or "–", _f(s.predicted_error),
+        node_cell = " + ".join(s.nodes) if s.multi else (s.node or "original")
+        period_cell = " + ".join(str(p) for p in s.periods) if s.multi else (s.period or "–")
+        cells = [s.label, _f(s.max_error), node_cell, period_cell, _f(s.predicted_error),
                  _f(s.measured_error), _f(s.predicted_ms), _f(s.measured_ms), _f(s.predicted_speedup, 3),
                  _f(s.measured_speedup, 3), _f(s.measured_psnr, 3), _f(s.hit_rate, 3)]
         rows.append("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>")
@@ -220,6 +228,8 @@ def measure_choice(prof, node: Optional[str], period: Optional[int], shots: Fram
     frames) and return ``{"error", "psnr", "speedup", "ms", "original_ms", "hit_rate", "frames"}``.
     A choice the profile validated is not rendered again: its stored figures are returned."""
     for sel in prof.selections:
+        if sel.multi:
+            continue
         if sel.node == node and sel.period == period and sel.measured_error is not None and (node or sel.frames):
             return {"error": sel.measured_error, "psnr": sel.measured_psnr, "speedup": sel.measured_speedup,
                     "ms": sel.measured_ms, "original_ms": sel.measured_original_ms, "hit_rate": sel.hit_rate,

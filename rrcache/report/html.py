@@ -118,7 +118,28 @@ def _source(prof, lines: list[str]) -> str:
     return legend + '<div class="src">' + "".join(rows) + "</div>"
 
 
+def _multi_selection(sel) -> str:
+    """A selection of several nodes: what each caches at which period and its figures (its frames
+    are not rendered here: the report's images show one cached node)."""
+    what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
+                                 + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
+    rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
+            ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
+            ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
+            ("PSNR", "", _f(sel.measured_psnr, 3, " dB")),
+            ("hit rate", "", _f(sel.hit_rate, 3))]
+    table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
+             + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
+             + "</table>")
+    files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
+    return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
+            f"<h3>{_e(sel.label)}: error ≤ {_f(sel.max_error)}</h3><p>{what}{files}</p>{table}"
+            '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
+
+
 def _selection(prof, sel, shots: FrameShots) -> str:
+    if sel.multi:
+        return _multi_selection(sel)
     images = shots.images(sel.node, sel.period)
     what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
             if sel.node else "keep the original shader (nothing is predicted faster within this error)")

@@ -74,12 +74,12 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
         ax.axvline(prof.original_ms, ls="--", color="gray", label=f"original ({prof.original_ms:.2f} ms)")
     groups: dict = {}
     for sel in prof.selections:  # selections that coincide share one mark and one label
-        groups.setdefault((sel.node, sel.period), []).append(sel)
-    for k, ((node_id, period), sels) in enumerate(sorted(groups.items(), key=lambda g: g[1][0].label)):
+        groups.setdefault(sel.key, []).append(sel)
+    for k, (_key, sels) in enumerate(sorted(groups.items(), key=lambda g: g[1][0].label)):
         first = sels[0]
         ax.plot([first.predicted_ms], [first.predicted_error], "s", color="crimson", ms=7, mfc="none", mew=1.8)
         labels = ",".join(s.label for s in sels)
-        text = f"{labels}: " + (f"{node_id} Δn={period}" if node_id else "original")
+        text = f"{labels}: " + (first.describe() if first.parts else "original")
         ax.annotate(text, (first.predicted_ms, first.predicted_error), textcoords="offset points",
                     xytext=(8, 4 + 11 * (k % 4)), fontsize=8, color="crimson")
     ax.plot([], [], "o-", color="gray", ms=3, lw=1.0, label="node over Δn = 1..50 (dots: trained Δn)")
