@@ -120,12 +120,16 @@ class CacheRuntime:
             image = rt.read_color()
     """
 
+    #: the class made for several periods (one per node): rrcache.runtime.multi registers
+    #: MultiCacheRuntime here (the package imports it), so this module need not import it
+    multi_class: Optional[type] = None
+
     def __new__(cls, *args, **kwargs):
         # several periods (one per node): the cache of a multi-node variant
         if cls is CacheRuntime and isinstance(kwargs.get("period"), (list, tuple)):
-            from rrcache.runtime.multi import MultiCacheRuntime
-
-            return super().__new__(MultiCacheRuntime)
+            if CacheRuntime.multi_class is None:
+                raise ValueError("several periods need rrcache.runtime.multi (import rrcache.runtime)")
+            return super().__new__(CacheRuntime.multi_class)
         return super().__new__(cls)
 
     def __init__(

@@ -198,3 +198,5 @@ class MultiCacheRuntime(CacheRuntime):
         index = self._index if current else 1 - self._index
         return self._read(self._invdepths[node][index], 1)[..., 0]
 
+
+CacheRuntime.multi_class = MultiCacheRuntime
