@@ -18,7 +18,7 @@ from rrcache.compiler import Variant, instance
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader, load_shader
 from rrcache.harness.prepare import PreparedShader, prepare
-from rrcache.harness.vertex import mesh_defines, session_attributes
+from rrcache.harness.vertex import session_defines
 
 
 @dataclass
@@ -47,7 +47,7 @@ def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, s
                      include_dirs=()) -> ShaderWork:
     """Load, prepare and analyse ``shader_path``; with a ``session`` its meshes' attributes set
     the ``MODEL_VERTEX_*`` defines (``defines`` win over them)."""
-    all_defines = mesh_defines(session_attributes(session)) if session is not None else {}
+    all_defines = session_defines(session) if session is not None else {}
     all_defines.update(defines or {})
     shader = load_shader(shader_path, defines=all_defines, include_dirs=include_dirs)
     return ShaderWork(shader, prepare(shader, all_defines), cacheable_nodes(shader), all_defines)

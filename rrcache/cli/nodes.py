@@ -79,10 +79,10 @@ def command(shader, as_json, show_all, define, max_unroll, session):
     """List the nodes of SHADER that a reprojection cache can hold."""
     defines = parse_defines(define)
     if session is not None:
-        from rrcache.harness.vertex import mesh_defines, session_attributes
+        from rrcache.harness.vertex import session_defines
         from rrcache.session import load_session
 
-        defines = {**mesh_defines(session_attributes(load_session(session))), **defines}
+        defines = {**session_defines(load_session(session)), **defines}
     loaded = load_shader(shader, defines)
     table = cacheable_nodes(loaded, max_iterations=max_unroll)
     if as_json:

@@ -135,6 +135,7 @@ class CachedRenderer:
     def _frame(self, index: int, hit_box: Optional[dict]):
         def read_hits():
             hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
+        self.drawer.render_shadow_map()  # the light's depth pass is part of the frame
         return self.runtime.frame(self.drawer.draw, after_first_pass=read_hits if hit_box is not None else None)
 
     def render_frame(self, index: int) -> CachedFrame:
@@ -197,6 +198,7 @@ class CachedRenderer:
                     between()
                 self.ctx.finish()
                 start = time.perf_counter()
+                self.drawer.render_shadow_map()
                 stats = self.runtime.frame(self.drawer.draw)
                 self.ctx.finish()
                 if i >= 2:

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Mapping, Optional, Sequence
 
 from rrcache.errors import SourceLoc
-from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes
+from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes, shadow_defines
 
 
 @dataclass(frozen=True)
@@ -124,8 +124,8 @@ def prepare(shader, defines: Optional[Mapping[str, str]] = None) -> PreparedShad
 
 def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping[str, str]] = None,
                  include_dirs=()) -> PreparedShader:
-    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes and
-    prepare it.
+    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes (and
+    a session's ``LIGHT_SHADOWMAP*``) and prepare it.
 
     ``session_or_attributes`` is a session (the union of its meshes' attributes counts) or an
     iterable of attribute names (``normal texcoord color tangent``). ``extra_defines`` (e.g. from
@@ -137,11 +137,13 @@ def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping
     """
     from rrcache.glsl.frontend import load_shader
 
+    extra = {}
     if hasattr(session_or_attributes, "objects"):
         attrs = session_attributes(session_or_attributes)
+        extra = shadow_defines(session_or_attributes)
     else:
         attrs = frozenset(session_or_attributes)
-    defines = mesh_defines(attrs)
+    defines = {**mesh_defines(attrs), **extra}
     defines.update(extra_defines or {})
     shader = load_shader(path, defines=defines, include_dirs=include_dirs)
     return prepare(shader, defines)

@@ -147,6 +147,11 @@ class Renderer:
         background = session_background(self.session)
         ctx.finish()
         start = time.perf_counter()
+        if self.drawer.shadow_map is not None:  # the light's depth pass is part of the frame
+            self.drawer.render_shadow_map()
+            ctx.depth_func = "<"
+            self.fbo.use()
+            self.fbo.viewport = (0, 0, *self.size)
         self.fbo.clear(*background, depth=1.0)
         with self._query:
             self.drawer.draw(self.program)
