@@ -8,7 +8,12 @@ The table shows each node's id (for ``rrcache`` commands that take a node), GLSL
 line:column, estimated cost (the work a cache hit saves, see ``rrcache.analysis.cost``), the
 inlined call chain and the expression. ``--all`` adds the nodes left out, with the reason
 (``type dynamic derivative uniform duplicate cheap``). ``--json`` prints
-``{"shader", "nodes": [...], "excluded": [...]}``; ``excluded`` is empty unless ``--all``.
+``{"shader", "nodes": [...], "excluded": [...], "estimators": [...], "not_estimators": [...]}``;
+``excluded`` is empty unless ``--all``. ``estimators`` are the loops that sum independent samples
+(``{"id", "line", "column", "samples", "text", "accumulators", "pragma"}``, see
+:mod:`rrcache.analysis.estimators`; ``#pragma rrcache estimator`` before a loop marks one the
+analysis cannot prove) and ``not_estimators`` the other loops with the reason. The text table
+ends with the estimators.
 """
 from __future__ import annotations
 
@@ -17,6 +22,7 @@ import json
 import click
 
 from rrcache.analysis.cacheable import cacheable_nodes
+from rrcache.analysis.estimators import display_name, find_estimators
 from rrcache.cli.options import parse_defines
 from rrcache.glsl.frontend import load_shader
 
@@ -63,6 +69,22 @@ def format_table(table, show_all: bool) -> str:
     return "\n".join(lines)
 
 
+def format_estimators(estimators, show_all: bool) -> str:
+    """The estimator lines of the text table (with ``show_all``, the other loops and why)."""
+    lines = []
+    for e in estimators.estimators:
+        accs = ", ".join(display_name(a) for a in e.accumulators)
+        lines.append(f"estimator {e.id}  {e.line}:{e.column}  {e.samples} samples into {accs}"
+                     f"{'  (pragma)' if e.pragma else ''}  {_short(display_name(e.text))}")
+    if show_all:
+        for r in estimators.rejected:
+            lines.append(f"loop {r.id}  {r.line}:{r.column}  not an estimator: {r.reason}  "
+                         f"{_short(display_name(r.text))}")
+    if not lines:
+        return ""
+    return "\n" + "\n".join(lines)
+
+
 @click.command("nodes")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
@@ -85,10 +107,13 @@ def command(shader, as_json, show_all, define, max_unroll, session):
         defines = {**session_defines(load_session(session)), **defines}
     loaded = load_shader(shader, defines)
     table = cacheable_nodes(loaded, max_iterations=max_unroll)
+    estimators = find_estimators(loaded)
     if as_json:
         doc = table.to_json(shader)
         if not show_all:
             doc["excluded"] = []
+        doc.update(estimators.to_json())
         click.echo(json.dumps(doc, indent=2))
     else:
         click.echo(format_table(table, show_all))
+        click.echo(format_estimators(estimators, show_all))

@@ -64,6 +64,7 @@ class Shader:
     outputs: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
     defines: dict[str, object] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
+    pragmas: list = field(default_factory=list)  # (text after #pragma, SourceLoc) in source order
 
     @property
     def varyings(self) -> dict[str, tuple[Type, SourceLoc]]:
@@ -108,7 +109,7 @@ def parse_shader(source: str, filename: str = "<string>",
                   if s.type.contains_opaque()},
         inputs={n: (s.type, s.loc) for n, s in info.inputs.items() if n in info.used_globals},
         outputs={n: (s.type, s.loc) for n, s in info.outputs.items()},
-        defines=defines, files=files)
+        defines=defines, files=files, pragmas=list(pp.pragmas))
 
 
 def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, object]] = None,
