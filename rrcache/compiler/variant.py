@@ -66,6 +66,9 @@ class Variant:
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
     period: Optional[int] = None  # the refresh period Δn chosen for this variant (None: runtime default)
+    # an amortized estimator (rrcache.compiler.amortize): {"estimator", "samples" (m), "of" (N),
+    # "lambda", "accumulators"}; None for a cached node
+    amortized: Optional[dict] = None
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -106,6 +109,7 @@ class Variant:
             },
             "uniforms": sorted({u for names in self.uniforms.values() for u in names}),
             "textures": sorted({s for names in self.samplers.values() for s in names}),
+            **({"amortized": dict(self.amortized)} if self.amortized else {}),
         }
 
     def write(self, out_dir: "str | os.PathLike[str]") -> list[str]:

@@ -91,7 +91,8 @@ class CachedRenderer:
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
-                clear_color=session_background(session))
+                clear_color=session_background(session),
+                blend=(variant.amortized or {}).get("lambda", 0.0) if getattr(variant, "amortized", None) else 0.0)
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:

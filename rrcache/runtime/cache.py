@@ -118,6 +118,7 @@ class CacheRuntime:
         depth_epsilon: float = 1e-3,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
         cull_back_faces: Optional[bool] = None,
+        blend: float = 0.0,
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -140,6 +141,7 @@ class CacheRuntime:
         self.clear_color = clear_color
         self.cull_back_faces = cull_back_faces
         self.depth_epsilon = float(depth_epsilon)
+        self.blend = float(blend)  # λ of an amortized variant: c = λ·c_prev + (1-λ)·x at hits
         self.seed = seed
         self._period = 1
         self.period = period
@@ -284,6 +286,9 @@ class CacheRuntime:
             self._set(program, name, value)
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
+        # amortized sampling (rrcache.compiler.amortize): the frame picks the subset, λ the blend
+        self._set(program, "rr_amortFrame", self.clock)
+        self._set(program, "rr_lambda", self.blend)
 
     def _run(self, pass_name: str, draw: DrawCallback, query: Optional[moderngl.Query] = None) -> None:
         program = self.programs[pass_name]

@@ -107,6 +107,17 @@ vec4 rr_current() {
 """
 
 
+AMORTIZE_GLSL = """
+// ---- amortized sampling (rrcache.compiler.amortize) ----
+uniform int rr_amortFrame;
+uniform float rr_lambda;
+int rr_amortPhase(int period) {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    return (rr_amortFrame + p.x + 2 * p.y) % period;
+}
+"""
+
+
 def lookup_glsl(filter: str = "bilinear") -> str:
     """Declarations and functions for a pass that reads the *previous* frame's cache:
     ``rr_hit()``, ``rr_refreshNow()`` and ``rr_previous()`` (valid after ``rr_hit()`` returned

@@ -1,0 +1,343 @@
+"""Amortized sampling (Nehab et al. 2007 §6): an estimator's samples spread over frames.
+
+The cached value is the estimator's accumulators right after its loop (:mod:`rrcache.analysis.
+estimators`: ``a0 + Σ_i t(i)`` over ``N`` iterations), packed into the payload. Per frame:
+
+- at a **hit**, ``m`` of the ``N`` iterations run: with ``N = s·m`` a stratified subset
+  ``i_j = j·s + φ`` (``j = 0..m-1``), else the window ``i_j = (φ·m + j) mod N``; the phase
+  ``φ = (frame + x + 2y) mod s`` (or ``mod N``) changes every frame and from pixel to pixel
+  (``x, y`` the pixel), so every index is used over ``N/m`` frames and the 2×2 pixels the cache's
+  bilinear reconstruction mixes use different subsets. The subset sum, scaled by ``N/m`` around
+  the start value (``x = a0 + N/m · (acc − a0)``), estimates the full sum; it is blended with the
+  reprojected running estimate: ``acc = λ·c_prev + (1 − λ)·x`` (``λ`` is the runtime's
+  ``blend``, uniform ``rr_lambda``).
+- at a **miss** (disocclusion) all ``N`` iterations run, as in the original.
+
+``m = N`` emits the original loop unchanged and ``λ = 0`` makes the blend ``0·c_prev + 1·x``: the
+variant then computes exactly what the original does. The refresh rule is not used: every hit
+takes fresh samples, and ``λ`` sets how fast old ones are forgotten.
+
+The passes are those of :mod:`rrcache.compiler.passes` (three-pass ``reproject``/``payload``/
+``shade``, two-pass ``hit``/``miss``, one-pass ``single``), with the loop in the place of the
+node: pass 1 computes the blended estimate at hits and discards at misses, pass 2 runs the whole
+loop where pass 1 left no depth, pass 3 reads the accumulators back from this frame's payload.
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> s = parse_shader("#version 330\\nin vec2 v_texcoord; out vec4 c;\\nvoid main() { float s = 0.0;"
+...                  " for (int i = 0; i < 8; i++) s += sin(v_texcoord.x * float(i)); c = vec4(s); }")
+>>> v = instance_amortized(s, "e1", samples=2, blend=0.6)
+>>> sorted(v.passes), v.amortized["samples"], v.amortized["of"], v.components
+(['payload', 'reproject', 'shade'], 2, 8, 1)
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import Any, Optional
+
+from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
+from rrcache.glsl import ast as A
+from rrcache.glsl.legacy import to_core
+from rrcache.glsl.parser import parse_source
+from rrcache.glsl.semantic import check
+from rrcache.analysis._tree import clone, written_roots
+from rrcache.analysis.estimators import Estimator, EstimatorTable, display_name, find_estimators
+from rrcache.compiler._ast import main_function, walk
+from rrcache.compiler.emit import (
+    fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
+)
+from rrcache.compiler.outputs import cache_init, cache_writes, float_lit, set_color_output
+from rrcache.compiler.passes import PASS_SPECS, PassUnit, runtime_snippets
+from rrcache.compiler.prune import prune
+from rrcache.compiler.variant import PassSource, Variant
+from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.glsl import AMORTIZE_GLSL, FILTERS
+
+__all__ = ["instance_amortized", "LocatedLoop", "prepare_loop", "subset_indices"]
+
+_MARKER = "rr_estimatorMarker"
+_SWIZZLE = "xyzw"
+
+
+@dataclass
+class LocatedLoop:
+    """The estimator's loop, ready for the passes: ``unit`` is the core-profile inlined program
+    with a marker statement right before the loop; ``names``/``types`` the accumulators (as
+    named in ``unit``), ``estimator`` the analysis record."""
+
+    unit: A.TranslationUnit
+    estimator: Estimator
+    names: list[str]
+    types: list[str]
+    path: str
+
+    @property
+    def components(self) -> int:
+        return sum(int(t[-1]) if t != "float" else 1 for t in self.types)
+
+
+def subset_indices(total: int, samples: int, frame: int, pixel: tuple[int, int] = (0, 0)) -> list[int]:
+    """The iteration numbers (0-based, in loop order) a hit evaluates at ``frame`` and ``pixel``:
+    what the emitted GLSL computes (for tests and documentation).
+
+    >>> subset_indices(16, 4, 0), subset_indices(16, 4, 1), subset_indices(6, 4, 1)
+    ([0, 4, 8, 12], [1, 5, 9, 13], [4, 5, 0, 1])
+    """
+    if samples >= total:
+        return list(range(total))
+    if total % samples == 0:
+        stride = total // samples
+        phase = (frame + pixel[0] + 2 * pixel[1]) % stride
+        return [j * stride + phase for j in range(samples)]
+    phase = (frame + pixel[0] + 2 * pixel[1]) % total
+    return [(phase * samples + j) % total for j in range(samples)]
+
+
+def _parent_slot(root: A.Node, target: A.Node):
+    """(parent, field name, list index or None) holding ``target``."""
+    from dataclasses import fields
+
+    for node in walk(root):
+        for f in fields(node):
+            value = getattr(node, f.name, None)
+            if value is target:
+                return node, f.name, None
+            if isinstance(value, list):
+                for i, item in enumerate(value):
+                    if item is target:
+                        return node, f.name, i
+    return None
+
+
+def prepare_loop(shader_or_table: Any, estimator_id: str) -> LocatedLoop:
+    """Find estimator ``estimator_id`` and build the marked core-profile unit."""
+    table = shader_or_table if isinstance(shader_or_table, EstimatorTable) else find_estimators(shader_or_table)
+    est = table.find(estimator_id)
+    unit = table.shader.unit
+    memo: dict[int, Any] = {}
+    work = copy.deepcopy(unit, memo)
+    loop = memo[id(est.loop)]
+    main = main_function(work)
+    slot = _parent_slot(main.body, loop)
+    if slot is None:
+        raise UnsupportedShaderError("the estimator's loop is not in main()", est.loop.loc)
+    parent, name, index = slot
+    marker = A.ExprStmt(A.Ident(_MARKER))
+    if isinstance(parent, A.Compound) and index is not None:
+        parent.stmts.insert(index, marker)
+    else:
+        setattr(parent, name, A.Compound([marker, loop], loc=loop.loc))
+    core = to_core(work)
+    block, i = _find(core, remove=False)
+    core_loop = block.stmts[i + 1]
+    names = _accumulator_names(core_loop)
+    if len(names) != len(est.accumulators):
+        raise UnsupportedShaderError("the estimator's accumulators changed in the core-profile rewrite",
+                                     est.loop.loc, "this is a bug in rrcache; please report it")
+    path = getattr(table.shader, "path", None) or "<shader>"
+    return LocatedLoop(core, est, names, list(est.types), path)
+
+
+def _accumulator_names(loop: A.For) -> list[str]:
+    locals_ = {n.name for n in walk(loop.body) if isinstance(n, A.Declarator)}
+    order: list[str] = []
+    for n in walk(loop.body):
+        if isinstance(n, A.Expr):
+            for root in written_roots(n):
+                if root.name not in locals_ and root.name not in order:
+                    order.append(root.name)
+    return order
+
+
+def _find(unit: A.TranslationUnit, remove: bool = True) -> tuple[A.Compound, int]:
+    """The block holding the marker and the marker's index (removed with ``remove``: the index
+    is then the loop's)."""
+    for node in walk(main_function(unit).body):
+        if isinstance(node, A.Compound):
+            for i, s in enumerate(node.stmts):
+                if isinstance(s, A.ExprStmt) and isinstance(s.expr, A.Ident) and s.expr.name == _MARKER:
+                    if remove:
+                        del node.stmts[i]
+                    return node, i
+    raise UnsupportedShaderError("the estimator's loop was lost while preparing the passes", None,
+                                 "this is a bug in rrcache; please report it")
+
+
+# ----------------------------------------------------------------------------- statements
+
+def _ident(name: str) -> A.Ident:
+    return A.Ident(name)
+
+
+def _set(name: str, value: A.Expr) -> A.ExprStmt:
+    return A.ExprStmt(A.Assign("=", _ident(name), value))
+
+
+def _decl(type_name: str, name: str, init: Optional[A.Expr] = None) -> A.DeclStmt:
+    return A.DeclStmt(A.VariableDecl(A.FullType([], A.TypeSpecifier(type_name)), [A.Declarator(name, None, init)]))
+
+
+def _offsets(loc: LocatedLoop) -> list[tuple[int, int]]:
+    out, at = [], 0
+    for t in loc.types:
+        n = 1 if t == "float" else int(t[-1])
+        out.append((at, n))
+        at += n
+    return out
+
+
+def _pack(loc: LocatedLoop) -> A.Expr:
+    if len(loc.names) == 1 and loc.types[0] == "vec4":
+        return _ident(loc.names[0])
+    args: list[A.Expr] = [_ident(n) for n in loc.names]
+    args += [float_lit(0.0) for _ in range(4 - loc.components)]
+    return A.Call("vec4", args)
+
+
+def _unpack(payload: A.Expr, offset: int, size: int) -> A.Expr:
+    if offset == 0 and size == 4:
+        return payload
+    return A.Field(payload, _SWIZZLE[offset:offset + size])
+
+
+def _statement(text: str) -> A.Stmt:
+    """One statement parsed from GLSL text (the first statement of a throw-away ``main``)."""
+    unit = parse_source("#version 330 core\nvoid main() {\n" + text + "\n}\n", "<rrcache amortize>")
+    return unit.decls[-1].body.stmts[0]
+
+
+def _subset_loop(loop: A.For, samples: int, total: int, start: int, step: int) -> list[A.Stmt]:
+    """``int rr_phase = ...; for (int rr_j = 0; rr_j < m; rr_j++) { int i = ...; { body } }``"""
+    index = loop.init.decl.declarators[0].name
+    if total % samples == 0:
+        stride = total // samples
+        phase = f"int rr_phase = rr_amortPhase({stride});"
+        k = f"rr_j * {stride} + rr_phase"
+    else:
+        phase = f"int rr_phase = rr_amortPhase({total});"
+        k = f"(rr_phase * {samples} + rr_j) % {total}"
+    head = _statement(f"for (int rr_j = 0; rr_j < {samples}; rr_j++) {{ int {index} = {start} + {step} * ({k}); }}")
+    body = clone(loop.body)
+    head.body.stmts.append(body if isinstance(body, A.Compound) else A.Compound([body], loc=body.loc))
+    head.loc = loop.loc
+    return [_statement(phase), head]
+
+
+def _hit_statements(loc: LocatedLoop, loop: A.For, samples: int) -> list[A.Stmt]:
+    """The loop of a hit: ``m`` iterations scaled to the full sum, blended with the cache."""
+    est = loc.estimator
+    total = est.samples
+    out: list[A.Stmt] = []
+    if samples >= total:
+        out.append(clone(loop))
+    else:
+        for name, t in zip(loc.names, loc.types):
+            out.append(_decl(t, f"rr_start_{name}", _ident(name)))
+        out += _subset_loop(loop, samples, total, est.start, est.step)
+        scale = float_lit(total / samples)
+        for name in loc.names:
+            start = _ident(f"rr_start_{name}")
+            # the printer parenthesises by precedence: a0 + N/m * (acc - a0)
+            out.append(_set(name, A.Binary("+", start, A.Binary(
+                "*", scale, A.Binary("-", _ident(name), _ident(f"rr_start_{name}"))))))
+    out.append(_decl("vec4", "rr_prev", A.Call("rr_previous", [])))
+    for name, (offset, size) in zip(loc.names, _offsets(loc)):
+        prev = _unpack(_ident("rr_prev"), offset, size)
+        out.append(_set(name, A.Binary("+", A.Binary("*", _ident("rr_lambda"), prev), A.Binary(
+            "*", A.Binary("-", float_lit(1.0), _ident("rr_lambda")), _ident(name)))))
+    return out
+
+
+def transform(loc: LocatedLoop, name: str, samples: int) -> A.TranslationUnit:
+    """The transformed (not yet checked or pruned) unit of pass ``name``."""
+    spec = PASS_SPECS[name]
+    unit = clone(loc.unit)
+    block, i = _find(unit)
+    loop = block.stmts[i]
+    writes = cache_writes(_pack(loc))
+    if name in ("reproject", "hit"):
+        block.stmts[i:i + 1] = [_statement("if (!rr_hit()) discard;"), *_hit_statements(loc, loop, samples), *writes]
+    elif name in ("payload", "miss"):
+        block.stmts[i + 1:i + 1] = writes
+    elif name == "shade":
+        current = A.Call("rr_current", [])
+        block.stmts[i:i + 1] = [_decl("vec4", "rr_cur", current)] + [
+            _set(n, _unpack(_ident("rr_cur"), offset, size)) for n, (offset, size) in zip(loc.names, _offsets(loc))]
+    else:  # single
+        branch = A.If(A.Call("rr_hit", []), A.Compound(_hit_statements(loc, loop, samples)), A.Compound([loop]))
+        block.stmts[i:i + 1] = [branch, *writes]
+    if spec.cache:
+        main_function(unit).body.stmts[0:0] = cache_init()
+    set_color_output(unit, keep=spec.color, location=spec.color_location)
+    return unit
+
+
+def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinear") -> PassUnit:
+    """Transform, type-check and prune pass ``name`` of the amortized variant."""
+    spec = PASS_SPECS[name]
+    unit = transform(loc, name, samples)
+    runtime = runtime_snippets(spec, filter)
+    if spec.lookup:
+        runtime += AMORTIZE_GLSL
+    snippet_decls = parse_source("#version 330 core\n" + runtime, "<rrcache runtime>").decls
+    unit.decls[0:0] = snippet_decls
+    try:
+        check(unit, loc.path)
+    except GLSLError as err:
+        raise UnsupportedShaderError(
+            f"the {name} pass amortizing '{display_name(loc.estimator.text)}' does not type-check: {err.message}",
+            err.loc or loc.estimator.loop.loc,
+            "names starting with 'rr_' are reserved for rrcache; rename any such name in the shader") from None
+    prune(unit, keep=snippet_decls)
+    ids = {id(d) for d in snippet_decls}
+    unit.decls = [d for d in unit.decls if id(d) not in ids]
+    return PassUnit(name, unit, runtime, spec, "amortize")
+
+
+def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-pass", samples: int = 4,
+                       blend: float = 0.6, filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
+    """Compile the variant of ``shader`` that amortizes estimator ``estimator_id`` (``e1``...):
+    ``samples`` (m) of its N iterations per frame at hits, blended with weight ``blend`` (λ,
+    kept in the variant for the runtime; it can be changed there between frames).
+
+    ``shader`` is a checked :class:`~rrcache.glsl.frontend.Shader` (not the analysed one: the
+    loop must still be there) or an :class:`~rrcache.analysis.estimators.EstimatorTable`.
+    """
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
+    if filter not in FILTERS:
+        raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
+    if payload_dtype not in PAYLOAD_DTYPES:
+        raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+        raise ValueError(f"samples must be a positive int, not {samples!r}")
+    if not 0.0 <= float(blend) < 1.0:
+        raise ValueError(f"blend (lambda) must be in [0, 1), not {blend!r}")
+    loc = prepare_loop(shader, estimator_id)
+    est = loc.estimator
+    if samples > est.samples:
+        raise ValueError(f"estimator {est.id} has {est.samples} samples; cannot evaluate {samples} per frame")
+    passes: dict[str, PassSource] = {}
+    uniforms: dict[str, list[str]] = {}
+    samplers: dict[str, list[str]] = {}
+    runtime: dict[str, list[str]] = {}
+    forms: dict[str, str] = {}
+    for name in ALGORITHMS[algorithm]:
+        built = build_pass(loc, name, samples, filter)
+        iface = interface(built.unit)
+        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit))
+        fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
+        passes[name] = PassSource(vertex, fragment, line_map)
+        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_uniforms(vertex)))
+        samplers[name] = list(iface["sampler"])
+        runtime[name] = runtime_uniforms(built.runtime_glsl)
+        forms[name] = built.form
+    text = display_name(est.text)
+    loop_loc: Optional[SourceLoc] = est.loop.loc if est.loop is not None else None
+    return Variant(
+        algorithm=algorithm, node_id=est.id, node_type="estimator", node_text=text,
+        components=loc.components, filter=filter, payload_dtype=payload_dtype, passes=passes,
+        uniforms=uniforms, samplers=samplers, runtime_uniforms=runtime, forms=forms,
+        node_loc=loop_loc, shader_path=loc.path,
+        amortized={"estimator": est.id, "samples": samples, "of": est.samples, "lambda": float(blend),
+                   "accumulators": [display_name(a) for a in est.accumulators]})
