@@ -44,14 +44,26 @@ const vec2 POISSON[16] = vec2[16](
     vec2(-0.24188840, 0.99706507), vec2(-0.81409955, 0.91437590),
     vec2(0.19984126, 0.78641367), vec2(0.14383161, -0.14100790));
 
-// A random angle per surface point (stable while the camera moves).
+// A random angle per surface point (stable while the camera moves; a hash without sine).
 float rotationAngle(vec3 p) {
-    return fract(sin(dot(floor(p * 211.0), vec3(12.9898, 78.233, 37.719))) * 43758.5453) * TWO_PI;
+    vec3 q = fract(floor(p * 211.0) * 0.1031);
+    q += dot(q, q.yzx + 33.33);
+    return fract((q.x + q.y) * q.z) * TWO_PI;
 }
 
-// 1 where the tap at shadow-map position uv sees the light, 0 where something is closer to it.
+// How much of the light the shadow-map position uv sees at this depth: the comparisons with the
+// four nearest texels, interpolated bilinearly (glslViewer/lygia's textureShadowLerp), so the
+// filtered shadow has no texel steps.
 float shadowTap(vec2 uv, float depth) {
-    return depth > texture2D(u_lightShadowMap, uv).r ? 0.0 : 1.0;
+    vec2 size = vec2(LIGHT_SHADOWMAP_SIZE);
+    vec2 texel = uv * size - 0.5;
+    vec2 f = fract(texel);
+    vec2 base = (floor(texel) + 0.5) / size;
+    float lb = depth > texture2D(u_lightShadowMap, base).r ? 0.0 : 1.0;
+    float rb = depth > texture2D(u_lightShadowMap, base + vec2(1.0, 0.0) / size).r ? 0.0 : 1.0;
+    float lt = depth > texture2D(u_lightShadowMap, base + vec2(0.0, 1.0) / size).r ? 0.0 : 1.0;
+    float rt = depth > texture2D(u_lightShadowMap, base + vec2(1.0, 1.0) / size).r ? 0.0 : 1.0;
+    return mix(mix(lb, rb, f.x), mix(lt, rt, f.x), f.y);
 }
 
 // The fraction of the disc around coord.xy that sees the light.
@@ -85,5 +97,5 @@ void main() {
     vec3 h = normalize(l + v);
     float spec = pow(max(dot(n, h), 0.0), 40.0) * 0.25;
     vec3 color = albedo * (0.18 + 0.82 * ndotl * lit * u_lightColor) + spec * lit * u_lightColor;
-    gl_FragColor = vec4(pow(color, vec3(1.0 / 2.2)), 1.0);
+    gl_FragColor = vec4(sqrt(color), 1.0);  // gamma 2
 }
