@@ -62,15 +62,17 @@ def test_pragma_loop_reproduces_the_original(gl_ctx, tmp_path, algorithm):
     assert all(f.mean_error <= 1e-6 for f in result.frames)
 
 
-@pytest.mark.parametrize("name,samples,algorithm", [("blur", 2, "two-pass"), ("blur", 3, "three-pass"),
-                                                    ("weighted", 4, "two-pass"), ("conditional", 4, "one-pass")])
-def test_subsets_cover_every_sample_once_per_cycle(gl_ctx, tmp_path, name, samples, algorithm):
+@pytest.mark.parametrize("name,samples,algorithm,phase", [
+    ("blur", 2, "two-pass", "frame"), ("blur", 3, "three-pass", "frame"), ("blur", 2, "one-pass", "pixel"),
+    ("blur", 3, "two-pass", "pixel"), ("weighted", 4, "two-pass", "frame"), ("conditional", 4, "one-pass", "frame"),
+    ("conditional", 4, "three-pass", "pixel")])
+def test_subsets_cover_every_sample_once_per_cycle(gl_ctx, tmp_path, name, samples, algorithm, phase):
     source, (total,) = ESTIMATORS[name]
     cycle = total // samples if total % samples == 0 else total
     loaded, prepared, session = _setup(tmp_path, source, moving=False, frames=cycle + 1)
     with Renderer(prepared, session) as original:
         ref = original.render_frame(0)
-    variant = instance_amortized(loaded, "e1", algorithm, samples=samples, blend=0.0)
+    variant = instance_amortized(loaded, "e1", algorithm, samples=samples, blend=0.0, phase=phase)
     with CachedRenderer(variant, session, prepared, period=1000) as cached:
         frames = [cached.render_frame(i) for i in range(cycle + 1)]
     if algorithm != "one-pass":
@@ -117,8 +119,9 @@ def test_subset_indices_cover_all_indices():
     for total, m in ((16, 4), (16, 16), (12, 5), (8, 3)):
         cycle = total // m if total % m == 0 else total
         for pixel in ((0, 0), (3, 7)):
-            seen = [i for f in range(cycle) for i in subset_indices(total, m, f, pixel)]
-            assert sorted(seen) == sorted(list(range(total)) * (len(seen) // total))
+            for phase in ("frame", "pixel"):
+                seen = [i for f in range(cycle) for i in subset_indices(total, m, f, pixel, phase)]
+                assert sorted(seen) == sorted(list(range(total)) * (len(seen) // total))
 
 
 def test_bad_arguments():
@@ -130,5 +133,7 @@ def test_bad_arguments():
         instance_amortized(s, "e1", samples=9)
     with pytest.raises(ValueError, match="lambda"):
         instance_amortized(s, "e1", samples=2, blend=1.0)
+    with pytest.raises(ValueError, match="phase"):
+        instance_amortized(s, "e1", samples=2, phase="random")
     with pytest.raises(RRCacheError, match="no loop"):
         instance_amortized(s, "e7", samples=2)

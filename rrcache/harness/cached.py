@@ -51,6 +51,7 @@ class CachedFrame:
     ms: float
     hit_map: Optional[np.ndarray] = None
     payload: Optional[np.ndarray] = None
+    cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
 
 
 class CachedRenderer:
@@ -92,7 +93,8 @@ class CachedRenderer:
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
                 clear_color=session_background(session),
-                blend=(variant.amortized or {}).get("lambda", 0.0) if getattr(variant, "amortized", None) else 0.0)
+                blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
+                phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1))
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:
@@ -155,10 +157,12 @@ class CachedRenderer:
             self._warm = True
         hit_box = {} if self.hit_maps else None
         ctx.finish()
+        cpu_start = time.process_time()
         start = time.perf_counter()
         stats = self._frame(index, hit_box)
         ctx.finish()
         ms = (time.perf_counter() - start) * 1000.0
+        cpu_ms = (time.process_time() - cpu_start) * 1000.0
         self._last = index
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0
@@ -173,7 +177,7 @@ class CachedRenderer:
         else:  # one-pass: a dynamic branch, nothing for a query to count
             hits = misses = None
         payload = self.runtime.read_payload() if self.keep_payload else None
-        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
+        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload, cpu_ms)
 
     def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None) -> float:
         """The cached pipeline's best case: frame ``index`` shown again and again with nothing
