@@ -10,8 +10,10 @@ frame of the first repeat; the error of each image against it is the paper's (me
 L2 over covered pixels, :func:`rrcache.harness.metrics.mean_l2`). The first frame is left out of
 the summary (the cache is empty there, so the amortized frame is the original).
 
-The speed-up of a repeat is the ratio of the median frame times; the result gives the median
-over repeats and their range.
+The speed-up of a repeat is the ratio of the median frame times (wall time, and the process's
+CPU time over the same span: on a shared machine the wall time of llvmpipe's frames is inflated
+by other processes, the CPU time much less); the result gives the median over repeats and their
+range.
 
 >>> result = run("shaders/pcf_shadows.glsl", "sessions/temple.json", "e1", samples=4,
 ...              blend=0.6, reference_defines={"PCF_SAMPLES": "256"}, frames=30)  # doctest: +SKIP
@@ -42,6 +44,8 @@ class AmortizedRun:
 
     estimator: str
     samples: int
+    phase: str
+    history: str
     total: int
     blend: float
     algorithm: str
@@ -50,6 +54,8 @@ class AmortizedRun:
     errors: dict[int, tuple[float, float]] = field(default_factory=dict)
     original_ms: list[list[float]] = field(default_factory=list)
     amortized_ms: list[list[float]] = field(default_factory=list)
+    original_cpu_ms: list[list[float]] = field(default_factory=list)
+    amortized_cpu_ms: list[list[float]] = field(default_factory=list)
     reference_defines: dict = field(default_factory=dict)
 
     def _steady(self, values: list) -> list:
@@ -60,17 +66,27 @@ class AmortizedRun:
         return [statistics.median(self._steady(o)) / statistics.median(self._steady(a))
                 for o, a in zip(self.original_ms, self.amortized_ms)]
 
+    def cpu_speedups(self) -> list[float]:
+        """As :meth:`speedups` with the process CPU time of the frames (less sensitive to other
+        processes on a shared machine than wall time)."""
+        return [statistics.median(self._steady(o)) / statistics.median(self._steady(a))
+                for o, a in zip(self.original_cpu_ms, self.amortized_cpu_ms)]
+
     def summary(self) -> dict:
         """Median speed-up over repeats with its range, median frame times, mean errors."""
         rows = [(f, e) for f, e in sorted(self.errors.items()) if f != self.frames[0]] or sorted(self.errors.items())
         speedups = self.speedups()
+        cpu = self.cpu_speedups()
         return {
             "estimator": self.estimator, "samples": self.samples, "of": self.total, "lambda": self.blend,
-            "algorithm": self.algorithm, "frames": len(self.frames), "resolution": list(self.resolution),
+            "phase": self.phase, "history": self.history, "algorithm": self.algorithm, "frames": len(self.frames), "resolution": list(self.resolution),
             "repeats": len(speedups), "speedup": statistics.median(speedups),
             "speedup_range": [min(speedups), max(speedups)],
             "original_ms": statistics.median(statistics.median(self._steady(o)) for o in self.original_ms),
             "amortized_ms": statistics.median(statistics.median(self._steady(a)) for a in self.amortized_ms),
+            "cpu_speedup": statistics.median(cpu), "cpu_speedup_range": [min(cpu), max(cpu)],
+            "original_cpu_ms": statistics.median(statistics.median(self._steady(o)) for o in self.original_cpu_ms),
+            "amortized_cpu_ms": statistics.median(statistics.median(self._steady(a)) for a in self.amortized_cpu_ms),
             "error_frames": len(rows),
             "original_error": float(np.mean([e[0] for _, e in rows])),
             "amortized_error": float(np.mean([e[1] for _, e in rows])),
@@ -79,7 +95,8 @@ class AmortizedRun:
 
 
 def run(shader, session, estimator: str, samples: int, blend: float, reference_defines: Mapping[str, str],
-        frames=None, repeats: int = 3, error_every: int = 5, algorithm: str = "two-pass",
+        frames=None, repeats: int = 3, error_every: int = 5, algorithm: str = "two-pass", phase: str = "frame",
+        history: str = "blend",
         resolution: Optional[tuple[int, int]] = None, defines: Optional[Mapping[str, str]] = None,
         on_frame: Optional[Callable[[int, int, object, object, object], None]] = None) -> AmortizedRun:
     """Measure (see the module doc). ``session`` is a path or a loaded session; ``frames`` as
@@ -88,14 +105,15 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
     if isinstance(session, str) or hasattr(session, "__fspath__"):
         session = load_session(session)
     work = load_for_session(shader, session, defines)
-    variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend)
+    variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend, phase=phase,
+                                 history=history)
     reference = prepare_file(shader, session, {**dict(defines or {}), **dict(reference_defines)})
     indices = frame_indices(session, frames)
     amort = variant.amortized
-    out = AmortizedRun(estimator, samples, amort["of"], float(blend), algorithm, indices,
+    out = AmortizedRun(estimator, samples, phase, history, amort["of"], float(blend), algorithm, indices,
                        tuple(resolution or session.resolution), reference_defines=dict(reference_defines))
     for repeat in range(repeats):
-        o_ms, a_ms = [], []
+        o_ms, a_ms, o_cpu, a_cpu = [], [], [], []
         with Renderer(work.prepared, session, resolution) as original, \
                 CachedRenderer(variant, session, work.prepared, resolution, period=2 ** 30) as cached, \
                 Renderer(reference, session, resolution) as ref_renderer:
@@ -104,6 +122,8 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
                 got_a = cached.render_frame(index)
                 o_ms.append(got_o.ms)
                 a_ms.append(got_a.ms)
+                o_cpu.append(got_o.cpu_ms)
+                a_cpu.append(got_a.cpu_ms)
                 ref = None
                 if repeat == 0 and (k % error_every == 0 or k == len(indices) - 1):
                     ref = ref_renderer.render_frame(index)
@@ -114,4 +134,32 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
                     on_frame(repeat, index, got_o, got_a, ref)
         out.original_ms.append(o_ms)
         out.amortized_ms.append(a_ms)
+        out.original_cpu_ms.append(o_cpu)
+        out.amortized_cpu_ms.append(a_cpu)
     return out
+
+
+def write_images(out_dir: str, shader, session, result: AmortizedRun, kept: dict,
+                 also: Optional[Mapping[str, str]] = None) -> dict:
+    """PNGs of the last frame of the first repeat: ``original.png``, ``amortized.png`` (from
+    ``kept``), ``reference.png``, and ``also.png`` (the shader with the ``also`` defines); returns
+    name → path."""
+    import os
+
+    from rrcache.harness.images import write_image
+
+    if isinstance(session, str) or hasattr(session, "__fspath__"):
+        session = load_session(session)
+    index = result.frames[-1]
+    paths = {}
+    renders = {"reference": result.reference_defines}
+    if also:
+        renders["also"] = dict(also)
+    for name, defines in renders.items():
+        with Renderer(prepare_file(shader, session, defines), session, result.resolution) as r:
+            kept[name] = r.render_frame(index).image
+    for name, image in kept.items():
+        path = os.path.join(out_dir, f"{name}.png")
+        write_image(path, image)
+        paths[name] = path
+    return paths

@@ -26,6 +26,15 @@ estimators`: ``a0 + Σ_i t(i)`` over ``N`` iterations), packed into the payload.
   ``blend``, uniform ``rr_lambda``).
 - at a **miss** (disocclusion) all ``N`` iterations run, as in the original.
 
+``history="slots"`` (with the ``frame`` phase and ``N = s·m``, when ``s`` times the
+accumulators fit in the payload's 4 components): the payload keeps the ``s`` subset sums
+apart. A hit recomputes its phase's sum (blended with that slot's reprojected value by ``λ``;
+``λ = 0`` replaces it) and the value is the start plus all ``s`` slots, so on a still image the
+full sum is back after one cycle, exactly; a miss computes the ``s`` sums (all ``N``
+iterations). The paper's blend weighs the phases unequally (``λ = 3/5``, 4 phases: 0.46, 0.28,
+0.17, 0.10 of the estimate) and a stratified pattern's subsets differ much more than
+independent samples do, so its error stays above the original's (measured on the PCF scene).
+
 ``m = N`` emits the original loop unchanged and ``λ = 0`` makes the blend ``0·c_prev + 1·x``: the
 variant then computes exactly what the original does. The refresh rule is not used: every hit
 takes fresh samples, and ``λ`` sets how fast old ones are forgotten.
@@ -66,7 +75,7 @@ from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import AMORTIZE_GLSL, AMORTIZE_PIXEL_GLSL, FILTERS
 
-__all__ = ["instance_amortized", "LocatedLoop", "PHASES", "prepare_loop", "subset_indices"]
+__all__ = ["instance_amortized", "LocatedLoop", "HISTORIES", "PHASES", "prepare_loop", "subset_indices"]
 
 _MARKER = "rr_estimatorMarker"
 _SWIZZLE = "xyzw"
@@ -90,6 +99,7 @@ class LocatedLoop:
 
 
 PHASES = ("frame", "pixel")
+HISTORIES = ("blend", "slots")
 
 
 def _cycle(total: int, samples: int) -> int:
@@ -302,7 +312,92 @@ def _hit_statements(loc: LocatedLoop, loop: A.For, samples: int, phase) -> list[
     return out
 
 
-def transform(loc: LocatedLoop, name: str, samples: int, phase=0) -> A.TranslationUnit:
+# ----------------------------------------------------------------------------- "slots" history
+
+def _zero(type_name: str) -> A.Expr:
+    return A.Call(type_name, [float_lit(0.0)])
+
+
+def _slot_field(loc: LocatedLoop, payload: str, slot: int, k: int) -> A.Expr:
+    offset, size = _offsets(loc)[k]
+    return _unpack(_ident(payload), slot * loc.components + offset, size)
+
+
+def _slot_vector(loc: LocatedLoop, parts: list[list[A.Expr]]) -> A.Expr:
+    """``vec4(slot 0's accumulators, slot 1's, ..., zeros)``"""
+    args = [e for slot in parts for e in slot]
+    args += [float_lit(0.0) for _ in range(4 - len(parts) * loc.components)]
+    return A.Call("vec4", args) if len(args) > 1 else args[0]
+
+
+def _sum(terms: list[A.Expr]) -> A.Expr:
+    out = terms[0]
+    for t in terms[1:]:
+        out = A.Binary("+", out, t)
+    return out
+
+
+def _slots_hit(loc: LocatedLoop, loop: A.For, samples: int, phase: int) -> list[A.Stmt]:
+    """Hit, "slots" history: this frame's subset sum replaces (blended by λ) its own slot; the
+    value is the start plus every slot (the other phases' sums reprojected)."""
+    est = loc.estimator
+    cycle = _cycle(est.samples, samples)
+    out: list[A.Stmt] = []
+    for name, t in zip(loc.names, loc.types):
+        out += [_decl(t, f"rr_start_{name}", _ident(name)), _set(name, _zero(t))]
+    out.append(_unrolled(loop, _subset(est.samples, samples, phase), est.start, est.step))
+    out.append(_decl("vec4", "rr_prev", A.Call("rr_previous", [])))
+    for k, (name, t) in enumerate(zip(loc.names, loc.types)):
+        prev = _slot_field(loc, "rr_prev", phase, k)
+        out.append(_decl(t, f"rr_new_{name}", A.Binary("+", A.Binary("*", _ident("rr_lambda"), prev), A.Binary(
+            "*", A.Binary("-", float_lit(1.0), _ident("rr_lambda")), _ident(name)))))
+        others = [_slot_field(loc, "rr_prev", j, k) for j in range(cycle) if j != phase]
+        out.append(_set(name, _sum([_ident(f"rr_start_{name}"), *others, _ident(f"rr_new_{name}")])))
+    parts = [[_ident(f"rr_new_{n}") if j == phase else _slot_field(loc, "rr_prev", j, k)
+              for k, n in enumerate(loc.names)] for j in range(cycle)]
+    out.append(_set("rr_slots", _slot_vector(loc, parts)))
+    return out
+
+
+def _slots_miss(loc: LocatedLoop, loop: A.For, samples: int) -> list[A.Stmt]:
+    """Miss, "slots" history: every subset's sum on its own (all N iterations), the value their
+    total plus the start."""
+    est = loc.estimator
+    cycle = _cycle(est.samples, samples)
+    out: list[A.Stmt] = [_decl(t, f"rr_start_{n}", _ident(n)) for n, t in zip(loc.names, loc.types)]
+    for j in range(cycle):
+        out += [_set(n, _zero(t)) for n, t in zip(loc.names, loc.types)]
+        out.append(_unrolled(loop, _subset(est.samples, samples, j), est.start, est.step))
+        out += [_decl(t, f"rr_slot{j}_{n}", _ident(n)) for n, t in zip(loc.names, loc.types)]
+    for n in loc.names:
+        out.append(_set(n, _sum([_ident(f"rr_start_{n}")] + [_ident(f"rr_slot{j}_{n}") for j in range(cycle)])))
+    parts = [[_ident(f"rr_slot{j}_{n}") for n in loc.names] for j in range(cycle)]
+    out.append(_set("rr_slots", _slot_vector(loc, parts)))
+    return out
+
+
+def _slots_transform(loc: LocatedLoop, name: str, samples: int, phase: int, block: A.Compound, i: int) -> None:
+    loop = block.stmts[i]
+    writes = cache_writes(_ident("rr_slots"))
+    declare = _decl("vec4", "rr_slots")
+    cycle = _cycle(loc.estimator.samples, samples)
+    if name in ("reproject", "hit"):
+        block.stmts[i:i + 1] = [_statement("if (!rr_hit()) discard;"), declare,
+                                *_slots_hit(loc, loop, samples, phase), *writes]
+    elif name in ("payload", "miss"):
+        block.stmts[i:i + 1] = [declare, *_slots_miss(loc, loop, samples), *writes]
+    elif name == "shade":
+        stmts: list[A.Stmt] = [_decl("vec4", "rr_cur", A.Call("rr_current", []))]
+        for k, n in enumerate(loc.names):
+            stmts.append(_set(n, _sum([_ident(n)] + [_slot_field(loc, "rr_cur", j, k) for j in range(cycle)])))
+        block.stmts[i:i + 1] = stmts
+    else:  # single
+        branch = A.If(A.Call("rr_hit", []), A.Compound(_slots_hit(loc, loop, samples, phase)),
+                      A.Compound(_slots_miss(loc, loop, samples)))
+        block.stmts[i:i + 1] = [declare, branch, *writes]
+
+
+def transform(loc: LocatedLoop, name: str, samples: int, phase=0, history: str = "blend") -> A.TranslationUnit:
     """The transformed (not yet checked or pruned) unit of pass ``name``; ``phase`` is
     ``"pixel"`` or the phase number of a ``"frame"``-mode program."""
     spec = PASS_SPECS[name]
@@ -310,7 +405,9 @@ def transform(loc: LocatedLoop, name: str, samples: int, phase=0) -> A.Translati
     block, i = _find(unit)
     loop = block.stmts[i]
     writes = cache_writes(_pack(loc))
-    if name in ("reproject", "hit"):
+    if history == "slots":
+        _slots_transform(loc, name, samples, int(phase), block, i)
+    elif name in ("reproject", "hit"):
         block.stmts[i:i + 1] = [_statement("if (!rr_hit()) discard;"), *_hit_statements(loc, loop, samples, phase), *writes]
     elif name in ("payload", "miss"):
         block.stmts[i + 1:i + 1] = writes
@@ -328,10 +425,10 @@ def transform(loc: LocatedLoop, name: str, samples: int, phase=0) -> A.Translati
 
 
 def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinear",
-               phase=0) -> PassUnit:
+               phase=0, history: str = "blend") -> PassUnit:
     """Transform, type-check and prune pass ``name`` of the amortized variant."""
     spec = PASS_SPECS[name]
-    unit = transform(loc, name, samples, phase)
+    unit = transform(loc, name, samples, phase, history)
     runtime = runtime_snippets(spec, filter)
     if spec.lookup:
         runtime += AMORTIZE_GLSL + (AMORTIZE_PIXEL_GLSL if phase == "pixel" else "")
@@ -352,11 +449,13 @@ def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinea
 
 def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-pass", samples: int = 4,
                        blend: float = 0.6, filter: str = "bilinear", payload_dtype: str = "f4",
-                       phase: str = "frame") -> Variant:
+                       phase: str = "frame", history: str = "blend") -> Variant:
     """Compile the variant of ``shader`` that amortizes estimator ``estimator_id`` (``e1``...):
     ``samples`` (m) of its N iterations per frame at hits, blended with weight ``blend`` (λ,
     kept in the variant for the runtime; it can be changed there between frames). ``phase``:
-    how the subset changes (``frame`` or ``pixel``, see the module doc).
+    how the subset changes (``frame`` or ``pixel``, see the module doc); ``history``: ``blend``
+    (the paper's running estimate) or ``slots`` (one reprojected sum per subset, see the module
+    doc).
 
     ``shader`` is a checked :class:`~rrcache.glsl.frontend.Shader` (not the analysed one: the
     loop must still be there) or an :class:`~rrcache.analysis.estimators.EstimatorTable`.
@@ -377,6 +476,17 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
     est = loc.estimator
     if samples > est.samples:
         raise ValueError(f"estimator {est.id} has {est.samples} samples; cannot evaluate {samples} per frame")
+    if history not in HISTORIES:
+        raise ValueError(f"history must be one of {HISTORIES}, not {history!r}")
+    payload_components = loc.components
+    if history == "slots":
+        if phase != "frame" or samples >= est.samples or est.samples % samples:
+            raise ValueError("the 'slots' history needs the 'frame' phase and m < N dividing N "
+                             f"(estimator {est.id}: N = {est.samples}, m = {samples})")
+        payload_components = (est.samples // samples) * loc.components
+        if payload_components > 4:
+            raise ValueError(f"the 'slots' history keeps N/m = {est.samples // samples} sums of "
+                             f"{loc.components} component(s): more than the payload's 4")
     passes: dict[str, PassSource] = {}
     uniforms: dict[str, list[str]] = {}
     samplers: dict[str, list[str]] = {}
@@ -388,7 +498,7 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         # runtime runs "<pass>@<k>" at frames with clock % cycle == k (k = 0: "<pass>")
         phases = range(cycle) if PASS_SPECS[name].lookup else range(1)
         for k in phases:
-            built = build_pass(loc, name, samples, filter, "pixel" if phase == "pixel" else k)
+            built = build_pass(loc, name, samples, filter, "pixel" if phase == "pixel" else k, history)
             key = name if k == 0 else f"{name}@{k}"
             iface = interface(built.unit)
             vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit))
@@ -402,8 +512,8 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
     loop_loc: Optional[SourceLoc] = est.loop.loc if est.loop is not None else None
     return Variant(
         algorithm=algorithm, node_id=est.id, node_type="estimator", node_text=text,
-        components=loc.components, filter=filter, payload_dtype=payload_dtype, passes=passes,
+        components=payload_components, filter=filter, payload_dtype=payload_dtype, passes=passes,
         uniforms=uniforms, samplers=samplers, runtime_uniforms=runtime, forms=forms,
         node_loc=loop_loc, shader_path=loc.path,
         amortized={"estimator": est.id, "samples": samples, "of": est.samples, "lambda": float(blend),
-                   "phase": phase, "cycle": cycle, "accumulators": [display_name(a) for a in est.accumulators]})
+                   "phase": phase, "cycle": cycle, "history": history, "accumulators": [display_name(a) for a in est.accumulators]})
