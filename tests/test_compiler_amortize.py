@@ -137,3 +137,28 @@ def test_bad_arguments():
         instance_amortized(s, "e1", samples=2, phase="random")
     with pytest.raises(RRCacheError, match="no loop"):
         instance_amortized(s, "e7", samples=2)
+
+
+@pytest.mark.parametrize("name,samples,algorithm", [("blur", 2, "three-pass"), ("conditional", 4, "two-pass"),
+                                                    ("conditional", 4, "one-pass")])
+def test_slots_history_is_exact_on_a_still_camera(gl_ctx, tmp_path, name, samples, algorithm):
+    """Each slot holds one subset's sum: a still image is the original at every frame, with
+    m of N samples computed per frame after the first."""
+    source, (total,) = ESTIMATORS[name]
+    loaded, prepared, session = _setup(tmp_path, source, moving=False, frames=6)
+    variant = instance_amortized(loaded, "e1", algorithm, samples=samples, blend=0.0, history="slots")
+    assert variant.components == total // samples and variant.amortized["cycle"] == total // samples
+    result = compare(variant, session, prepared, range(6), period=1000)
+    assert all(f.mean_error <= 1e-5 for f in result.frames), [f.mean_error for f in result.frames]
+    if algorithm != "one-pass":
+        assert result.hit_rate == 1.0
+
+
+def test_slots_history_needs_room_in_the_payload():
+    from rrcache.glsl.frontend import parse_shader
+
+    s = parse_shader(ESTIMATORS["weighted"][0], "w.frag")
+    with pytest.raises(ValueError, match="payload"):
+        instance_amortized(s, "e1", samples=6, history="slots")  # 2 slots of 4 components
+    with pytest.raises(ValueError, match="frame"):
+        instance_amortized(s, "e1", samples=6, history="slots", phase="pixel")
