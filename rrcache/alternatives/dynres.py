@@ -11,9 +11,13 @@ covers both: clear, scene draws, upsample draw and ``ctx.finish()``.
 measured side by side with the original (:func:`rrcache.alternatives.measure.compare_renderers`)
 and searched by :func:`rrcache.alternatives.search.match_scale`.
 
->>> with DynresRenderer(work.prepared, session, (640, 480), scale=0.5) as r:   # doctest: +SKIP
+>>> from rrcache.pipeline import load_for_session
+>>> from rrcache.session import load_session
+>>> session = load_session("sessions/marble.json")
+>>> work = load_for_session("shaders/glslviewer_basic.glsl", session)
+>>> with DynresRenderer(work.prepared, session, (64, 48), scale=0.5) as r:
 ...     r.low_size, r.render_frame(0).image.shape
-((320, 240), (480, 640, 4))
+((32, 24), (48, 64, 4))
 """
 from __future__ import annotations
 

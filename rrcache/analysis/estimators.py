@@ -46,7 +46,9 @@ from typing import Any, Optional
 
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
-from rrcache.analysis._tree import paused_gc, walk, written_roots
+from rrcache.glsl.ast import walk
+from rrcache.glsl.rewrite import paused_gc
+from rrcache.glsl.writes import written_roots
 
 __all__ = ["Estimator", "NotEstimator", "EstimatorTable", "find_estimators", "estimator_loops",
            "loop_header", "display_name", "ACCUMULATOR_TYPES", "MAX_SAMPLES", "PRAGMA"]
@@ -168,7 +170,7 @@ def estimator_loops(unit: A.TranslationUnit) -> list[tuple[A.For, int]]:
 
 
 def _child_nodes(node):
-    from rrcache.analysis._tree import children
+    from rrcache.glsl.ast import children
 
     return [c for c in children(node) if isinstance(c, A.Stmt)]
 

@@ -134,15 +134,18 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
                        compare_period=compare_period)
 
     plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
+    # only the algorithms the node table allows for this node (one-pass cannot cache a value
+    # that needs screen-space derivatives)
     plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period)
-             for algorithm in ("three-pass", "two-pass", "one-pass")]
+             for algorithm in ("three-pass", "two-pass", "one-pass")
+             if algorithm in getattr(entry, "algorithms", ("three-pass", "two-pass", "one-pass"))]
     plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period) for block in blocks]
     if periods:
         plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH))
     variants = {}
     for _group, _label, algorithm, period, _block, _run in plan:
         if algorithm not in variants:
-            variants[algorithm] = variant_for(work, node_id, period, algorithm)
+            variants[algorithm] = variant_for(work, node_id, algorithm)
     runs: list[list] = [[] for _ in plan]
     for repeat in range(repeats):
         for i, (_group, label, algorithm, period, block, run_period) in enumerate(plan):
@@ -161,7 +164,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
 
     say("limit: every pixel hits")
     probe = list(indices)[:: max(1, len(indices) // 5)][:5]
-    variant = variant_for(work, node_id, compare_period, limit_algorithm)
+    variant = variant_for(work, node_id, limit_algorithm)
     cached_ms, original_ms = [], []
     with Renderer(work.prepared, session, resolution) as original, \
             CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:

@@ -7,13 +7,16 @@
 The table shows each node's id (for ``rrcache`` commands that take a node), GLSL type, source
 line:column, estimated cost (the work a cache hit saves, see ``rrcache.analysis.cost``), the
 inlined call chain and the expression. ``--all`` adds the nodes left out, with the reason
-(``type dynamic derivative uniform duplicate cheap``). ``--json`` prints
-``{"shader", "nodes": [...], "excluded": [...], "estimators": [...], "not_estimators": [...]}``;
-``excluded`` is empty unless ``--all``. ``estimators`` are the loops that sum independent samples
-(``{"id", "line", "column", "samples", "text", "accumulators", "pragma"}``, see
-:mod:`rrcache.analysis.estimators`; ``#pragma rrcache estimator`` before a loop marks one the
-analysis cannot prove) and ``not_estimators`` the other loops with the reason. The text table
-ends with the estimators.
+(``type dynamic screen derivative uniform duplicate cheap``). A node that only some cache
+algorithms can hold (one that needs screen-space derivatives cannot be cached by one-pass) gets
+an ``algorithms`` column naming those, with the reason for the others under the table.
+``--json`` prints ``{"shader", "nodes": [...], "excluded": [...], "estimators": [...],
+"not_estimators": [...]}``; every node has ``algorithms`` (the valid ones) and ``not_valid``
+(algorithm -> reason); ``excluded`` is empty unless ``--all``. ``estimators`` are the loops that
+sum independent samples (``{"id", "line", "column", "samples", "text", "accumulators",
+"pragma"}``, see :mod:`rrcache.analysis.estimators`; ``#pragma rrcache estimator`` before a loop
+marks one the analysis cannot prove) and ``not_estimators`` the other loops with the reason. The
+text table ends with the estimators.
 """
 from __future__ import annotations
 
@@ -21,10 +24,10 @@ import json
 
 import click
 
-from rrcache.analysis.cacheable import cacheable_nodes
+from rrcache.analysis.cacheable import REASONS
 from rrcache.analysis.estimators import display_name, find_estimators
 from rrcache.cli.options import parse_defines
-from rrcache.glsl.frontend import load_shader
+from rrcache.pipeline import load_for_session
 
 _TEXT_WIDTH = 70
 
@@ -41,8 +44,9 @@ def _chain(chain: list[str], width: int = 36) -> str:
 def format_table(table, show_all: bool) -> str:
     """The readable text table of a :class:`NodeTable` (with ``show_all``, the nodes left out
     too, in id order, with their reason)."""
-    header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + [
-        "inlined from", "expression"]
+    restricted = any(n.invalid for n in table.nodes)
+    header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + (
+        ["algorithms"] if restricted else []) + ["inlined from", "expression"]
     entries = [(n, "final" if n.final else "") for n in table.nodes]
     if show_all:
         entries += [(x, x.reason) for x in table.excluded]
@@ -54,14 +58,19 @@ def format_table(table, show_all: bool) -> str:
             row.append(reason)
         elif reason:
             row[0] += "*"
+        if restricted:
+            valid = getattr(n, "algorithms", [])
+            row.append("all" if len(valid) == 3 else ",".join(valid) or "-")
         rows.append(row + [_chain(n.call_chain), _short(n.text)])
     widths = [max(len(r[i]) for r in rows) for i in range(len(header) - 1)]
     lines = ["  ".join(r[i].rjust(w) if i == 3 else r[i].ljust(w)
                        for i, w in enumerate(widths)) + "  " + r[-1] for r in rows]
     counts = table.counts()
-    left = ", ".join(f"{counts[k]} {k}" for k in ("type", "dynamic", "derivative", "uniform",
-                                                     "duplicate", "cheap") if counts[k])
+    left = ", ".join(f"{counts[k]} {k}" for k in REASONS if counts[k])
     lines.append("")
+    reasons = sorted({(a, why) for n in table.nodes for a, why in n.invalid.items()})
+    for a, why in reasons:
+        lines.append(f"not {a}: {why}")
     if not show_all and any(n.final for n in table.nodes):
         lines.append("* the final colour")
     lines.append(f"{counts['listed']} cacheable nodes" + (f"; left out: {left}" if left else "")
@@ -99,15 +108,14 @@ def format_estimators(estimators, show_all: bool) -> str:
                    "and `rrcache profile` do (node ids depend on the defines).")
 def command(shader, as_json, show_all, define, max_unroll, session):
     """List the nodes of SHADER that a reprojection cache can hold."""
-    defines = parse_defines(define)
+    loaded = None
     if session is not None:
-        from rrcache.harness.vertex import session_defines
         from rrcache.session import load_session
 
-        defines = {**session_defines(load_session(session)), **defines}
-    loaded = load_shader(shader, defines)
-    table = cacheable_nodes(loaded, max_iterations=max_unroll)
-    estimators = find_estimators(loaded)
+        loaded = load_session(session)
+    work = load_for_session(shader, loaded, parse_defines(define), max_unroll=max_unroll)
+    table = work.table
+    estimators = find_estimators(work.shader)
     if as_json:
         doc = table.to_json(shader)
         if not show_all:

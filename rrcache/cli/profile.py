@@ -23,8 +23,10 @@ from rich.table import Table
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
 from rrcache.errors import RRCacheError
-from rrcache.profile.profile import STORE_NAME, algorithm_line, default_out_dir, profile
-from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
+from rrcache.profiler.run import default_out_dir, profile
+from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.store import STORE_NAME
+from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
 
 
 def _periods(ctx, param, value):
@@ -118,7 +120,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
 def _interrupted(out, err_console) -> None:
     from pathlib import Path
 
-    from rrcache.profile.store import read_store
+    from rrcache.profiles.store import read_store
 
     err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
     path = Path(out) / STORE_NAME

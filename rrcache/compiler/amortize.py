@@ -62,9 +62,10 @@ from rrcache.glsl import ast as A
 from rrcache.glsl.legacy import to_core
 from rrcache.glsl.parser import parse_source
 from rrcache.glsl.semantic import check
-from rrcache.analysis._tree import clone, rewrite_scoped, written_roots
+from rrcache.glsl.rewrite import clone, rewrite_scoped
+from rrcache.glsl.writes import written_roots
 from rrcache.analysis.estimators import Estimator, EstimatorTable, display_name, find_estimators
-from rrcache.compiler._ast import main_function, walk
+from rrcache.glsl.ast import main_function, walk
 from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
 )

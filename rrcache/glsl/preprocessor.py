@@ -979,9 +979,9 @@ def preprocess_file(path: str | os.PathLike, defines: Mapping[str, object] | Non
                     include_dirs: Sequence[str] = ()) -> Preprocessed:
     """Read and preprocess the shader file ``path`` (see :func:`preprocess`).
 
-    >>> pp = preprocess_file("shaders/fog.frag", defines={"USE_FOG": None})  # doctest: +SKIP
-    >>> pp.files[0]  # doctest: +SKIP
-    'shaders/fog.frag'
+    >>> pp = preprocess_file("shaders/glslviewer_basic.glsl", defines={"MODEL_VERTEX_NORMAL": None})
+    >>> pp.files[0], "v_normal" in [t.text for t in pp.tokens]
+    ('shaders/glslviewer_basic.glsl', True)
     """
     path = os.fspath(path)
     return preprocess(_read_text(path, None), path, defines, include_dirs)

@@ -2,7 +2,7 @@
 
 :func:`plan_bindings` checks the shader against the session once, before any frame is drawn:
 
-- a uniform or sampler the program uses that neither the harness (DESIGN.md §4 built-ins) nor
+- a uniform or sampler the program uses that neither the harness (docs/design.md §4 built-ins) nor
   the session supplies is an error naming the declaration (``shader.frag:line:col``) and the
   session file, saying what to add;
 - a session uniform or texture the shader does not declare is a *note*, never an error (sessions

@@ -3,13 +3,23 @@ renderer and the cached one (one program per pass).
 
 :class:`SceneDrawer` uploads meshes and textures once, checks each program it is given against
 the session (:func:`rrcache.harness.bindings.plan_bindings`), and per frame sets the built-in
-uniforms of DESIGN.md §4 (camera, light, time, matrices, the previous frame's
+uniforms of docs/design.md §4 (camera, light, time, matrices, the previous frame's
 model-view-projection for reprojection), the session's uniforms and samplers, and renders every
 object, culling back faces unless the object is ``double_sided``.
 
->>> drawer = SceneDrawer(ctx, session, prepared, (640, 480), scope)    # doctest: +SKIP
->>> drawer.add_program(program)                                         # doctest: +SKIP
->>> drawer.set_frame(10); drawer.draw(program)                          # doctest: +SKIP
+>>> from rrcache.gl import GLScope, build_program, get_context
+>>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.harness.vertex import vertex_source
+>>> from rrcache.session import load_session
+>>> ctx, scope = get_context(), GLScope()
+>>> session = load_session("sessions/marble.json")
+>>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+>>> program = scope.own(build_program(ctx, vertex_source({n: d.type for n, d in prepared.inputs.items()}),
+...                                   prepared.source))
+>>> drawer = SceneDrawer(ctx, session, prepared, (32, 24), scope)
+>>> _ = drawer.add_program(program)
+>>> drawer.set_frame(10); drawer.draw(program)
+>>> scope.release()
 """
 from __future__ import annotations
 
@@ -211,7 +221,7 @@ class SceneDrawer:
             raise UnsupportedShaderError(
                 f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
                 decl.loc if decl is not None else None,
-                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
+                hint=f"declare `uniform {BUILTINS[name]} {name};` (docs/design.md §4)") from None
 
     def draw(self, program: moderngl.Program, _pass_name: str = "") -> None:
         """Draw every object of the current frame with ``program`` into the bound framebuffer

@@ -9,11 +9,11 @@ samples that passed the depth test (an occlusion query: shaded fragments, overdr
 the wall time of the draws (``time.perf_counter()`` around clear, draws and ``ctx.finish()``,
 after one untimed warm-up draw of the program, since llvmpipe compiles on the first draw).
 
->>> from rrcache.session import load_session                      # doctest: +SKIP
->>> session = load_session("scenes/marble/session.json")          # doctest: +SKIP
->>> result = render("scenes/marble/marble.frag", session, frames=3)  # doctest: +SKIP
->>> result.frames[0].image.shape, result.ms_per_frame > 0          # doctest: +SKIP
-((480, 640, 4), True)
+>>> from rrcache.session import load_session
+>>> session = load_session("sessions/marble.json")
+>>> result = render("shaders/glslviewer_basic.glsl", session, frames=3, resolution=(64, 48))
+>>> result.frames[0].image.shape, result.ms_per_frame > 0, result.frames[0].covered_pixels > 0
+((48, 64, 4), True, True)
 """
 from __future__ import annotations
 
@@ -91,8 +91,14 @@ class Renderer:
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
     images and masks are then of the window's size.
 
-    >>> with Renderer(prepared, session) as r:                # doctest: +SKIP
+    >>> from rrcache.harness.prepare import prepare_file
+    >>> from rrcache.session import load_session
+    >>> session = load_session("sessions/marble.json")
+    >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+    >>> with Renderer(prepared, session, (32, 24)) as r:
     ...     first = r.render_frame(0)
+    >>> first.image.shape
+    (24, 32, 4)
     """
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
@@ -246,8 +252,10 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
     called with each :class:`FrameResult` as it is done.
 
-    >>> result = render("marble.frag", load_session("session.json"), frames=2)   # doctest: +SKIP
-    >>> [f.index for f in result.frames]                                          # doctest: +SKIP
+    >>> from rrcache.session import load_session
+    >>> result = render("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"),
+    ...                 frames=2, resolution=(32, 24))
+    >>> [f.index for f in result.frames]
     [0, 1]
     """
     prepared = as_prepared(shader, session, defines)

@@ -1,7 +1,7 @@
 """The generated vertex shader and the mesh-attribute defines.
 
 The harness draws every mesh with a vertex shader written here (``#version 330 core``) that
-outputs the glslViewer varyings a fragment shader may read (DESIGN.md §4), in world space:
+outputs the glslViewer varyings a fragment shader may read (docs/design.md §4), in world space:
 
 =====================  ======  =========================================================
 ``v_position``         vec4    world position (``u_modelMatrix * position``)
@@ -143,7 +143,7 @@ def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optiona
             raise UnsupportedShaderError(
                 f"fragment input `{name}` is not a varying the harness supplies",
                 locs.get(name),
-                hint=f"use one of {', '.join(VARYINGS)} (DESIGN.md §4)",
+                hint=f"use one of {', '.join(VARYINGS)} (docs/design.md §4)",
             )
         if declared not in _FLOAT_TYPES:
             raise UnsupportedShaderError(

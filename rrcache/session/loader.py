@@ -21,6 +21,7 @@ from typing import Any
 
 from rrcache.errors import AssetError, SessionError
 from rrcache.session import procedural, textures as tex
+from rrcache.session.model import DEFAULT_FILTER
 from rrcache.session.meshes import MeshLoadError, load_mesh_file
 from rrcache.session.model import MeshData, SceneObject, Session, TextureAsset
 from rrcache.session.scene import camera_function, light_function, model_function
@@ -197,7 +198,7 @@ def _textures(doc: dict, file: str, assets: _Assets) -> dict[str, TextureAsset]:
                 except tex.ImageLoadError as e:
                     raise AssetError(f"{e}: {path}", file, at) from None
         out[name] = TextureAsset(name=name, path=files[0], kind=kind, data=data,
-                                 filter=spec.get("filter", "linear"),
+                                 filter=spec.get("filter", DEFAULT_FILTER),
                                  wrap=spec.get("wrap", "clamp" if kind == "cube" else "repeat"),
                                  files=tuple(files))
     return out

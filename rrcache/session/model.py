@@ -122,6 +122,10 @@ class SceneObject:
         return self._model(check_frame(frame))
 
 
+#: the filter of a session texture that names none (see :class:`TextureAsset`)
+DEFAULT_FILTER = "mipmap"
+
+
 @dataclass(eq=False)
 class TextureAsset:
     """An image bound to a sampler uniform.
@@ -131,7 +135,10 @@ class TextureAsset:
     kept bit-exact. Row 0 is the image's *top* row: for a 2D texture the harness must flip rows
     (``data[::-1]``) before upload so that texcoord v = 0 samples the image's bottom row as GL
     expects; cube-map faces are uploaded as stored (GL's cube-map convention has row 0 at the top).
-    ``filter`` is ``linear|nearest|mipmap``, ``wrap`` ``repeat|clamp|mirror``. ``path`` is the
+    ``filter`` is ``linear|nearest|mipmap``, ``wrap`` ``repeat|clamp|mirror``; a texture given
+    without a filter gets :data:`DEFAULT_FILTER` (``mipmap``: mipmaps generated and trilinear
+    filtering, as an application sets up a texture its shader samples with an implicit level of
+    detail; without mipmaps a minified ``texture()`` lookup aliases). ``path`` is the
     resolved file (the +X face for a cube map given as six files); ``files`` lists every file read.
     """
 
@@ -139,7 +146,7 @@ class TextureAsset:
     path: str
     kind: str
     data: np.ndarray
-    filter: str = "linear"
+    filter: str = DEFAULT_FILTER
     wrap: str = "repeat"
     files: tuple[str, ...] = ()
 
