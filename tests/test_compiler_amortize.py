@@ -162,3 +162,24 @@ def test_slots_history_needs_room_in_the_payload():
         instance_amortized(s, "e1", samples=6, history="slots")  # 2 slots of 4 components
     with pytest.raises(ValueError, match="frame"):
         instance_amortized(s, "e1", samples=6, history="slots", phase="pixel")
+
+
+def test_an_amortized_choice_is_a_kind_of_selection(tmp_path):
+    """Selection(parts=(AmortizedLoop(...),)) round-trips through JSON and compiles through
+    pipeline.variant_for_selection, like a cached node."""
+    from rrcache.pipeline import load_for_session, variant_for_selection
+    from rrcache.selection import AmortizedLoop, Selection, parts_from_json, parts_to_json
+
+    part = AmortizedLoop("e1", 4, 0.6, history="slots")
+    sel = Selection((part,), predicted_error=0.01, predicted_ms=3.0, predicted_speedup=2.0, algorithm="two-pass")
+    assert sel.kind == "amortize" and sel.describe() == "e1 m=4 λ=0.6 slots/frame"
+    assert parts_from_json(parts_to_json(sel.parts), "parts") == sel.parts
+    with pytest.raises(Exception, match="blend"):
+        parts_from_json([{"kind": "amortize", "estimator": "e1", "samples": 4, "blend": 1.5}], "parts")
+    path = tmp_path / "c.frag"
+    path.write_text(ESTIMATORS["conditional"][0])
+    work = load_for_session(str(path))
+    variant, _period = variant_for_selection(work, sel)
+    assert variant.algorithm == "two-pass"
+    assert variant.amortized == {"estimator": "e1", "samples": 4, "of": 16, "lambda": 0.6, "phase": "frame",
+                                 "cycle": 4, "history": "slots", "accumulators": ["hits"]}
