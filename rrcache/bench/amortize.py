@@ -6,7 +6,8 @@ variant, alternating frame by frame so that machine noise touches both alike (th
 pass, when the session has one, is inside both measured frames), ``repeats`` times over the same
 frames. The *reference* is the shader loaded with ``reference_defines`` (for
 ``shaders/pcf_shadows.glsl``: ``PCF_SAMPLES=256``), rendered untimed every ``error_every``-th
-frame of the first repeat; the error of each image against it is the paper's (mean per-pixel RGB
+frame of the first repeat (with no defines: the original itself, the error rrcache's profiles
+measure); the error of each image against it is the paper's (mean per-pixel RGB
 L2 over covered pixels, :func:`rrcache.harness.metrics.mean_l2`). The first frame is left out of
 the summary (the cache is empty there, so the amortized frame is the original).
 
@@ -30,7 +31,7 @@ import numpy as np
 
 from rrcache.compiler.amortize import instance_amortized
 from rrcache.harness.cached import CachedRenderer
-from rrcache.harness.metrics import mean_l2
+from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import Renderer, frame_indices
 from rrcache.pipeline import load_for_session
@@ -52,6 +53,7 @@ class AmortizedRun:
     frames: list[int]
     resolution: tuple[int, int]
     errors: dict[int, tuple[float, float]] = field(default_factory=dict)
+    psnrs: dict[int, tuple[float, float]] = field(default_factory=dict)
     original_ms: list[list[float]] = field(default_factory=list)
     amortized_ms: list[list[float]] = field(default_factory=list)
     original_cpu_ms: list[list[float]] = field(default_factory=list)
@@ -90,6 +92,9 @@ class AmortizedRun:
             "error_frames": len(rows),
             "original_error": float(np.mean([e[0] for _, e in rows])),
             "amortized_error": float(np.mean([e[1] for _, e in rows])),
+            # PSNR against the reference (capped at 100 dB where an image equals it), mean over frames
+            "original_psnr": float(np.mean([min(self.psnrs[f][0], 100.0) for f, _ in rows])),
+            "amortized_psnr": float(np.mean([min(self.psnrs[f][1], 100.0) for f, _ in rows])),
             "reference_defines": dict(self.reference_defines),
         }
 
@@ -130,6 +135,7 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
                     e_o, _ = mean_l2(got_o.image, ref.image, ref.mask)
                     e_a, _ = mean_l2(got_a.image, ref.image, ref.mask)
                     out.errors[index] = (float(e_o), float(e_a))
+                    out.psnrs[index] = (float(psnr(got_o.image, ref.image)), float(psnr(got_a.image, ref.image)))
                 if on_frame is not None:
                     on_frame(repeat, index, got_o, got_a, ref)
         out.original_ms.append(o_ms)

@@ -31,8 +31,8 @@ from rrcache.cli.options import parse_defines, resolution_option as _resolution
 @click.option("--phase", type=click.Choice(["frame", "pixel"]), default="frame", show_default=True)
 @click.option("--algorithm", type=click.Choice(["three-pass", "two-pass", "one-pass"]), default="two-pass",
               show_default=True)
-@click.option("--reference", "reference", multiple=True, required=True, metavar="NAME=VALUE",
-              help="Define(s) that make the shader the reference (e.g. PCF_SAMPLES=256).")
+@click.option("--reference", "reference", multiple=True, metavar="NAME=VALUE",
+              help="Define(s) that make the shader the reference (e.g. PCF_SAMPLES=256); none: the original.")
 @click.option("--also", multiple=True, metavar="NAME=VALUE", help="Another define for an extra image.")
 @click.option("--frames", default=60, show_default=True, type=click.IntRange(2))
 @click.option("--repeats", default=3, show_default=True, type=click.IntRange(1, 50))
@@ -70,8 +70,10 @@ def command(shader, session, estimator, samples, blend, history, phase, algorith
     click.echo(f"{estimator}: {s['samples']} of {s['of']} samples per frame, λ = {s['lambda']}, "
                f"{s['history']} history, {s['phase']} phase, {s['algorithm']}, {s['frames']} frames "
                f"at {s['resolution'][0]}x{s['resolution'][1]}, {s['repeats']} repeats")
+    ratio = f" ({s['amortized_error'] / s['original_error']:.2f}x)" if s["original_error"] > 0 else ""
     click.echo(f"error against the reference ({s['error_frames']} frames): original {s['original_error']:.6f}, "
-               f"amortized {s['amortized_error']:.6f} ({s['amortized_error'] / s['original_error']:.2f}x)")
+               f"amortized {s['amortized_error']:.6f}{ratio}; PSNR {s['original_psnr']:.1f} / "
+               f"{s['amortized_psnr']:.1f} dB")
     click.echo(f"speed-up (wall): {s['speedup']:.2f}x (range {s['speedup_range'][0]:.2f}-{s['speedup_range'][1]:.2f}); "
                f"{s['original_ms']:.1f} / {s['amortized_ms']:.1f} ms")
     click.echo(f"speed-up (CPU time): {s['cpu_speedup']:.2f}x (range {s['cpu_speedup_range'][0]:.2f}-"
