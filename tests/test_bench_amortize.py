@@ -38,3 +38,16 @@ def test_bench_amortize_unknown_estimator(tmp_path):
     assert run.returncode == 2
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and "e9" in lines[0] and "pcf_shadows.glsl" in lines[0]
+
+
+def test_instance_writes_an_amortized_variant(tmp_path):
+    out = CliRunner().invoke(cli, [
+        "instance", str(ROOT / "shaders" / "pcf_shadows.glsl"), "--session", str(ROOT / "sessions" / "temple.json"),
+        "--estimator", "e1", "--samples", "4", "--lambda", "0.6", "--algorithm", "two-pass", "--out", str(tmp_path)])
+    assert out.exit_code == 0, out.output
+    manifest = json.loads((tmp_path / "manifest.json").read_text())
+    assert manifest["amortized"]["cycle"] == 4 and manifest["algorithm"] == "two-pass"
+    assert sorted(manifest["passes"]) == ["hit", "hit@1", "hit@2", "hit@3", "miss"]
+    assert "rr_lambda" in (tmp_path / "hit@2.frag").read_text()
+    both = CliRunner().invoke(cli, ["instance", str(ROOT / "shaders" / "pcf_shadows.glsl"), "--out", str(tmp_path)])
+    assert both.exit_code == 2 and "--node or --estimator" in both.output
