@@ -64,6 +64,7 @@ from rrcache.glsl.parser import parse_source
 from rrcache.glsl.semantic import check
 from rrcache.glsl.rewrite import clone, rewrite_scoped
 from rrcache.glsl.writes import written_roots
+from rrcache.analysis.unroll import fold_copy
 from rrcache.analysis.estimators import Estimator, EstimatorTable, display_name, find_estimators
 from rrcache.glsl.ast import main_function, walk
 from rrcache.compiler.emit import (
@@ -261,14 +262,20 @@ def _subset_loop(loop: A.For, samples: int, total: int, start: int, step: int) -
     return [_statement(phase), head]
 
 
-def _unrolled(loop: A.For, indices: list[int], start: int, step: int) -> A.Compound:
-    """The loop body once per iteration number in ``indices``, its index a constant in each."""
+def _unrolled(loop: A.For, indices: list[int], start: int, step: int,
+              unit: Optional[A.TranslationUnit] = None) -> A.Compound:
+    """The loop body once per iteration number in ``indices``, its index a constant in each;
+    what the constant decides (``if (i > 0)``, ``i < 8 ? ... : ...``) is folded as the unroller
+    does, since the branch not taken may index an array out of range."""
     index = loop.init.decl.declarators[0].name
     copies: list[A.Stmt] = []
     for k in indices:
         body = clone(loop.body)
         body = body if isinstance(body, A.Compound) else A.Compound([body], loc=body.loc)
         rewrite_scoped(body, {index: _int_literal(start + step * k)})
+        if unit is not None:
+            stmts = fold_copy(body, unit)
+            body = stmts[0] if len(stmts) == 1 and isinstance(stmts[0], A.Compound) else A.Compound(stmts, loc=body.loc)
         if any(isinstance(n, A.Continue) for n in walk(body)):
             # `continue` ends this iteration: a loop run once keeps that meaning
             once = _statement("for (int rr_once = 0; rr_once < 1; rr_once++) {}")
@@ -298,7 +305,7 @@ def _hit_statements(loc: LocatedLoop, loop: A.For, samples: int, phase) -> list[
         if phase == "pixel":
             out += _subset_loop(loop, samples, total, est.start, est.step)
         else:  # one phase of the "frame" mode: its subset unrolled, the indices constants
-            out.append(_unrolled(loop, _subset(total, samples, int(phase)), est.start, est.step))
+            out.append(_unrolled(loop, _subset(total, samples, int(phase)), est.start, est.step, loc.unit))
         scale = float_lit(total / samples)
         for name in loc.names:
             start = _ident(f"rr_start_{name}")
@@ -346,7 +353,7 @@ def _slots_hit(loc: LocatedLoop, loop: A.For, samples: int, phase: int) -> list[
     out: list[A.Stmt] = []
     for name, t in zip(loc.names, loc.types):
         out += [_decl(t, f"rr_start_{name}", _ident(name)), _set(name, _zero(t))]
-    out.append(_unrolled(loop, _subset(est.samples, samples, phase), est.start, est.step))
+    out.append(_unrolled(loop, _subset(est.samples, samples, phase), est.start, est.step, loc.unit))
     out.append(_decl("vec4", "rr_prev", A.Call("rr_previous", [])))
     for k, (name, t) in enumerate(zip(loc.names, loc.types)):
         prev = _slot_field(loc, "rr_prev", phase, k)
@@ -368,7 +375,7 @@ def _slots_miss(loc: LocatedLoop, loop: A.For, samples: int) -> list[A.Stmt]:
     out: list[A.Stmt] = [_decl(t, f"rr_start_{n}", _ident(n)) for n, t in zip(loc.names, loc.types)]
     for j in range(cycle):
         out += [_set(n, _zero(t)) for n, t in zip(loc.names, loc.types)]
-        out.append(_unrolled(loop, _subset(est.samples, samples, j), est.start, est.step))
+        out.append(_unrolled(loop, _subset(est.samples, samples, j), est.start, est.step, loc.unit))
         out += [_decl(t, f"rr_slot{j}_{n}", _ident(n)) for n, t in zip(loc.names, loc.types)]
     for n in loc.names:
         out.append(_set(n, _sum([_ident(f"rr_start_{n}")] + [_ident(f"rr_slot{j}_{n}") for j in range(cycle)])))
