@@ -102,3 +102,17 @@ def test_cached_variants_receive_the_shadow_map(gl_ctx, tmp_path, algorithm):
     assert all(f.mean_error <= 1e-6 for f in result.frames)
     # and the shadow is there in the cached frames too (the original's image is the reference)
     assert result.frames[-1].covered > 1000
+
+
+@pytest.mark.parametrize("spec,where", [({"size": 8}, "light.shadow_map.size"),
+                                         ({"size": 64, "extent": -1}, "light.shadow_map.extent"),
+                                         ({"size": 64, "blur": 1}, "light.shadow_map")])
+def test_bad_shadow_map_settings_name_the_json_path(tmp_path, spec, where):
+    session = write_session(tmp_path)
+    doc = dict(session.document)
+    doc["light"] = {**doc["light"], "shadow_map": spec}
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(SessionError) as err:
+        load_session(path)
+    assert where in str(err.value)
