@@ -32,7 +32,7 @@ from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 from rrcache.compiler import Variant, instance
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
-from rrcache.harness.prepare import PreparedShader, load_for_meshes, prepare
+from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
 from rrcache.selection import AmortizedLoop, CachedNode, Selection
 
 
@@ -45,9 +45,17 @@ class ShaderWork:
     table: object
     defines: dict
 
+    #: the user's vertex shader (``UserVertex``), or None when the harness generates it
+    vertex: object = None
+
     @cached_property
     def prepared(self) -> PreparedShader:
-        return prepare(self.shader, self.defines)
+        return prepare(self.shader, self.defines, self.vertex)
+
+    @property
+    def hash(self) -> str:
+        """The fragment shader's hash, covering the user's vertex shader too when there is one."""
+        return combined_hash(self.shader.hash, self.vertex)
 
     def node(self, node_id: str):
         """The table entry (listed or excluded) with this id; an unknown id raises the analysis'
@@ -62,18 +70,20 @@ class ShaderWork:
 
 
 def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, str]] = None,
-                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS) -> ShaderWork:
+                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None) -> ShaderWork:
     """Load and analyse ``shader_path`` (loops of at most ``max_unroll`` iterations unrolled);
     with a ``session`` its meshes' attributes set the ``MODEL_VERTEX_*`` defines (``defines``
-    win over them)."""
+    win over them). ``vertex`` is the path of the user's vertex shader (None: the session's
+    ``"vertex"``, else a generated one)."""
     shader, all_defines = load_for_meshes(shader_path, session, defines, include_dirs)
-    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines)
+    user = load_user_vertex(vertex, session, all_defines, include_dirs)
+    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user)
 
 
 def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",
                 payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``)."""
-    return instance(work.table, node_id, algorithm, filter, payload_dtype)
+    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex)
 
 
 def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:
@@ -90,7 +100,8 @@ def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Varia
 
         part = selection.parts[0]
         variant = instance_amortized(work.shader, part.estimator, algorithm, samples=part.samples,
-                                     blend=part.blend, phase=part.phase, history=part.history)
+                                     blend=part.blend, phase=part.phase, history=part.history,
+                                     vertex=work.vertex)
         # an amortized variant does not use the refresh rule: the period is the runtime's default
         return variant, DEFAULT_PERIOD
     raise RRCacheError(f"no variant for a selection of kind {selection.kind!r}", "selection",

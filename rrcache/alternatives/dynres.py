@@ -33,7 +33,7 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import FrameResult, Renderer, check_frame_index, session_background
-from rrcache.harness.vertex import vertex_source
+from rrcache.harness.vertex import vertex_for
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, match_scale
 
@@ -92,7 +92,7 @@ class DynresRenderer:
         ctx, scope = self.ctx, self._scope
         inputs = {name: d.type for name, d in prepared.inputs.items()}
         locs = {name: d.loc for name, d in prepared.inputs.items()}
-        self.program = scope.own(build_program(ctx, vertex_source(inputs, locs), prepared.source, prepared.line_map,
+        self.program = scope.own(build_program(ctx, vertex_for(inputs, locs, getattr(prepared, "vertex", None)), prepared.source, prepared.line_map,
                                                fragment_name=prepared.path))
         self.drawer = SceneDrawer(ctx, self.session, prepared, self.low_size, scope)
         self.drawer.add_program(self.program)

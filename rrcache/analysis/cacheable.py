@@ -84,6 +84,7 @@ from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
 from rrcache.glsl.writes import written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
+from rrcache.analysis.source_text import attach_source_text
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
 __all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "cacheable_nodes",
@@ -114,6 +115,7 @@ class CacheableNode:
     call_chain: list[str]
     node: A.Expr = field(repr=False, compare=False)
     final: bool = False
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
     #: the algorithms that cannot cache this node, each with the reason
     invalid: dict = field(default_factory=dict)
 
@@ -130,7 +132,7 @@ class CacheableNode:
         return {"id": self.id, "type": self.type, "line": self.line, "column": self.column,
                 "text": self.text, "cost": self.cost, "call_chain": list(self.call_chain),
                 "final": self.final, "algorithms": self.algorithms,
-                "not_valid": dict(self.invalid)}
+                "not_valid": dict(self.invalid), "file": self.file}
 
 
 @dataclass
@@ -146,6 +148,7 @@ class ExcludedNode:
     type: str = ""
     cost: int = 0
     call_chain: list[str] = field(default_factory=list)
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
 
     #: a node left out is valid for no algorithm
     algorithms = property(lambda self: [])
@@ -154,7 +157,7 @@ class ExcludedNode:
     def to_json(self) -> dict:
         return {"id": self.id, "reason": self.reason, "line": self.line, "column": self.column,
                 "text": self.text, "type": self.type, "cost": self.cost,
-                "call_chain": list(self.call_chain), "algorithms": []}
+                "call_chain": list(self.call_chain), "algorithms": [], "file": self.file}
 
 
 @dataclass
@@ -228,7 +231,10 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     """
     with paused_gc():
         target = shader if analysed else analyse(shader, max_iterations)
-        return _Classifier(target, cheap_below).run()
+        table = _Classifier(target, cheap_below).run()
+        if not analysed:  # the text as written, and the file, of nodes from inlined code
+            attach_source_text(table, shader.unit)
+        return table
 
 
 # ----------------------------------------------------------------------------- classification
@@ -420,7 +426,7 @@ class _Classifier:
             if reason is None:
                 invalid = {"one-pass": ONE_PASS_DERIVATIVE} if r.flags & _DERIV else {}
                 nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
-                                           chain, e, is_final, invalid))
+                                           chain, e, is_final, invalid=invalid))
             else:
                 excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
                                              tname, cost, chain))

@@ -111,7 +111,7 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
         session = load_session(session)
     work = load_for_session(shader, session, defines)
     variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend, phase=phase,
-                                 history=history)
+                                 history=history, vertex=work.vertex)
     reference = prepare_file(shader, session, {**dict(defines or {}), **dict(reference_defines)})
     indices = frame_indices(session, frames)
     amort = variant.amortized

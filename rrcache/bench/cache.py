@@ -120,13 +120,14 @@ class CacheBench:
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
         progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
-        limit_algorithm: str = "three-pass") -> CacheBench:
+        limit_algorithm: str = "three-pass", vertex: Optional[str] = None) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
-    ``limit_algorithm``."""
+    ``limit_algorithm``. ``vertex``: the user's vertex shader (None: the session's, else
+    generated)."""
     say = progress or (lambda _msg: None)
     session = load_session(session_path)
-    work = load_for_session(shader_path, session)
+    work = load_for_session(shader_path, session, vertex=vertex)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import parse_defines
+from rrcache.cli.options import parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
 
@@ -36,8 +36,9 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
               help="Take the MODEL_VERTEX_* defines from this session's meshes.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
+@vert_option
 def command(shader, node, estimator, samples, blend, history, period, algorithm, filter_, payload, session, defines,
-            out_dir):
+            out_dir, vert):
     """Write the shaders of the variant of SHADER that caches --node (or amortizes --estimator),
     and a manifest."""
     from rrcache.pipeline import load_for_session, variant_for
@@ -46,12 +47,12 @@ def command(shader, node, estimator, samples, blend, history, period, algorithm,
     if (node is None) == (estimator is None):
         raise click.UsageError("give either --node or --estimator")
     loaded = load_session(session) if session else None
-    work = load_for_session(shader, loaded, parse_defines(defines))
+    work = load_for_session(shader, loaded, parse_defines(defines), vertex=vert)
     if estimator is not None:
         from rrcache.compiler.amortize import instance_amortized
 
         variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend,
-                                     filter=filter_, payload_dtype=payload, history=history)
+                                     filter=filter_, payload_dtype=payload, history=history, vertex=work.vertex)
         written = variant.write(out_dir)
         a = variant.amortized
         click.echo(f"{estimator} ({variant.node_text}, {variant.node_loc}) amortized with {algorithm}: "

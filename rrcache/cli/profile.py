@@ -21,7 +21,7 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, 
                            TimeRemainingColumn)
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.cli.options import parse_defines, resolution_option as _resolution, vert_option
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
 from rrcache.profiles.document import algorithm_line
@@ -75,8 +75,9 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@vert_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines, vert):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -104,7 +105,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         with bar, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh)
+                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh,
+                               vertex=vert)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

@@ -457,13 +457,15 @@ def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinea
 
 def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-pass", samples: int = 4,
                        blend: float = 0.6, filter: str = "bilinear", payload_dtype: str = "f4",
-                       phase: str = "frame", history: str = "blend") -> Variant:
+                       phase: str = "frame", history: str = "blend", vertex=None) -> Variant:
     """Compile the variant of ``shader`` that amortizes estimator ``estimator_id`` (``e1``...):
     ``samples`` (m) of its N iterations per frame at hits, blended with weight ``blend`` (λ,
     kept in the variant for the runtime; it can be changed there between frames). ``phase``:
     how the subset changes (``frame`` or ``pixel``, see the module doc); ``history``: ``blend``
     (the paper's running estimate) or ``slots`` (one reprojected sum per subset, see the module
-    doc).
+    doc). ``vertex`` is the user's vertex shader (a
+    :class:`rrcache.harness.user_vertex.UserVertex`; None: generated), as for
+    :func:`rrcache.compiler.instance`.
 
     ``shader`` is a checked :class:`~rrcache.glsl.frontend.Shader` (not the analysed one: the
     loop must still be there) or an :class:`~rrcache.analysis.estimators.EstimatorTable`.
@@ -509,10 +511,12 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
             built = build_pass(loc, name, samples, filter, "pixel" if phase == "pixel" else k, history)
             key = name if k == 0 else f"{name}@{k}"
             iface = interface(built.unit)
-            vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit))
+            vertex_text = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), vertex)
             fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
-            passes[key] = PassSource(vertex, fragment, line_map)
-            uniforms[key] = sorted(set(iface["uniform"]) | set(vertex_uniforms(vertex)))
+            passes[key] = PassSource(vertex_text, fragment, line_map)
+            vertex_names = (vertex.uniform_names(built.spec.lookup) if vertex is not None
+                            else vertex_uniforms(vertex_text))
+            uniforms[key] = sorted(set(iface["uniform"]) | set(vertex_names))
             samplers[key] = list(iface["sampler"])
             runtime[key] = runtime_uniforms(built.runtime_glsl)
             forms[key] = built.form
@@ -522,6 +526,6 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         algorithm=algorithm, node_id=est.id, node_type="estimator", node_text=text,
         components=payload_components, filter=filter, payload_dtype=payload_dtype, passes=passes,
         uniforms=uniforms, samplers=samplers, runtime_uniforms=runtime, forms=forms,
-        node_loc=loop_loc, shader_path=loc.path,
+        node_loc=loop_loc, shader_path=loc.path, vertex_path=getattr(vertex, "path", None),
         amortized={"estimator": est.id, "samples": samples, "of": est.samples, "lambda": float(blend),
                    "phase": phase, "cycle": cycle, "history": history, "accumulators": [display_name(a) for a in est.accumulators]})

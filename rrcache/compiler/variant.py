@@ -64,6 +64,7 @@ class Variant:
     forms: dict[str, str] = field(default_factory=dict)
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
+    vertex_path: Optional[str] = None  # the user's vertex shader (None: generated)
     # an amortized estimator (rrcache.compiler.amortize): {"estimator", "samples" (m), "of" (N),
     # "lambda", "phase", "cycle", "history", "accumulators"}; None for a cached node
     amortized: Optional[dict] = None
@@ -95,6 +96,7 @@ class Variant:
                 "location": str(self.node_loc) if self.node_loc else None,
             },
             "shader": self.shader_path,
+            "vertex": self.vertex_path,  # the user's vertex shader the passes' .vert derive from (None: generated)
             "algorithm": self.algorithm,
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
@@ -147,7 +149,8 @@ class Variant:
                 programs[name] = build_program(
                     ctx, src.vertex, src.fragment, src.fragment_line_map,
                     fragment_name=f"{shader} ({name} pass)",
-                    vertex_name=f"<generated vertex shader of the {name} pass>")
+                    vertex_name=(f"{self.vertex_path} ({name} pass)" if self.vertex_path
+                                 else f"<generated vertex shader of the {name} pass>"))
             except GLError as err:
                 for prog in programs.values():
                     prog.release()

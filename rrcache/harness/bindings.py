@@ -24,7 +24,7 @@ BUILTINS = {
     "u_camera": "vec3", "u_light": "vec3", "u_lightColor": "vec3", "u_resolution": "vec2",
     "u_time": "float", "u_frame": "int", "u_modelMatrix": "mat4", "u_viewMatrix": "mat4",
     "u_projectionMatrix": "mat4", "u_modelViewProjectionMatrix": "mat4", "u_normalMatrix": "mat3",
-    "u_prevModelViewProjectionMatrix": "mat4", "u_lightMatrix": "mat4",
+    "u_prevModelViewProjectionMatrix": "mat4", "u_reprojectionMatrix": "mat4", "u_lightMatrix": "mat4",
 }
 
 #: the sampler of the light's shadow map (a depth texture, sampled ``texture(...).r``)

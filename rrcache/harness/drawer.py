@@ -64,6 +64,23 @@ def normal_matrix(model: np.ndarray) -> np.ndarray:
         return m3
 
 
+def reprojection_matrix(mvp: np.ndarray, prev_mvp: np.ndarray) -> np.ndarray:
+    """This frame's clip position → the previous frame's, for one object:
+    ``prev_mvp @ inverse(mvp)`` in double precision (what a user's vertex shader multiplies
+    ``gl_Position`` by to find ``rr_prevClip``; see :mod:`rrcache.harness.user_vertex`).
+
+    >>> m = np.diag([2.0, 2.0, 2.0, 1.0])
+    >>> bool(np.allclose(reprojection_matrix(m, m), np.eye(4)))
+    True
+    """
+    mvp = np.asarray(mvp, dtype=np.float64)
+    try:
+        inv = np.linalg.inv(mvp)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(mvp)
+    return np.asarray(prev_mvp, dtype=np.float64) @ inv
+
+
 class SceneDrawer:
     """Draws the objects of ``session`` at ``size`` with programs registered by
     :meth:`add_program`. GL objects are owned by ``scope``."""
@@ -76,7 +93,7 @@ class SceneDrawer:
         self.size = size
         self.scope = scope
         self.cull_back_faces = cull_back_faces
-        self.notes: list[str] = []
+        self.notes: list[str] = list(getattr(session, "notes", None) or [])
         self._plans: dict[int, BindingPlan] = {}
         self._vaos: dict[int, list] = {}
         self._buffers: dict[tuple[int, str], moderngl.Buffer] = {}
@@ -160,8 +177,9 @@ class SceneDrawer:
         for obj in session.objects:
             model = obj.model_matrix(index)
             cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
-            self._per_object.append((model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev),
-                                     normal_matrix(model), cull))
+            mvp, prev_mvp = view_proj @ model, prev_view_proj @ obj.model_matrix(prev)
+            self._per_object.append((model, mvp, prev_mvp, normal_matrix(model), cull,
+                                     reprojection_matrix(mvp, prev_mvp)))
 
     # ------------------------------------------------------------------ shadow map
     def _shadow_resources(self):
@@ -202,7 +220,8 @@ class SceneDrawer:
         ctx.depth_func = "<"
         ctx.cull_face = "back"
         mvp_uniform = program["rr_lightModelViewProjection"]
-        for vao, mvp, (_m, _mvp, _prev, _n, cull) in zip(vaos, self._light_mvps, self._per_object):
+        for vao, mvp, per_object in zip(vaos, self._light_mvps, self._per_object):
+            cull = per_object[4]
             if cull:
                 ctx.enable(moderngl.CULL_FACE)
             else:
@@ -250,7 +269,7 @@ class SceneDrawer:
             self._shadow_resources()[1].use(location=SHADOW_UNIT)
         set_builtin(plan, "u_lightMatrix", self._light_matrix)
         ctx.cull_face = "back"
-        for vao, (model, mvp, prev_mvp, nmat, cull) in zip(self._vaos[id(program)], self._per_object):
+        for vao, (model, mvp, prev_mvp, nmat, cull, reproject) in zip(self._vaos[id(program)], self._per_object):
             if cull:
                 ctx.enable(moderngl.CULL_FACE)
             else:
@@ -259,4 +278,5 @@ class SceneDrawer:
             set_builtin(plan, "u_modelViewProjectionMatrix", mvp)
             set_builtin(plan, "u_normalMatrix", nmat)
             set_builtin(plan, "u_prevModelViewProjectionMatrix", prev_mvp)
+            set_builtin(plan, "u_reprojectionMatrix", reproject)
             vao.render(moderngl.TRIANGLES)

@@ -32,8 +32,8 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
-from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
-from rrcache.harness.vertex import vertex_source
+from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare, prepare_file
+from rrcache.harness.vertex import vertex_for
 
 #: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
 #: and flipped (32), the depth read back (4) and the coverage mask (1); checked before allocating
@@ -126,9 +126,11 @@ class Renderer:
         check_target_size(ctx, self.size, TARGET_BYTES_PER_PIXEL, where)
         inputs = {name: d.type for name, d in prepared.inputs.items()}
         locs = {name: d.loc for name, d in prepared.inputs.items()}
-        self.vertex_source = vertex_source(inputs, locs)
+        user = getattr(prepared, "vertex", None)
+        self.vertex_source = vertex_for(inputs, locs, user)
         self.program = self._scope.own(build_program(
-            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path))
+            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path,
+            vertex_name=user.path if user is not None else "<generated vertex shader>"))
         self.drawer = SceneDrawer(ctx, self.session, prepared, self.size, self._scope, self.cull_back_faces)
         self.plan = self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
@@ -237,11 +239,12 @@ def frame_indices(session, frames=None) -> list[int]:
 
 def as_prepared(shader, session, defines=None) -> PreparedShader:
     """A :class:`PreparedShader` from a prepared shader, a front-end ``Shader`` or a shader path
-    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``)."""
+    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``), with the session's
+    ``"vertex"`` shader when it names one."""
     if isinstance(shader, PreparedShader):
         return shader
     if hasattr(shader, "unit"):
-        return prepare(shader, defines)
+        return prepare(shader, defines, load_user_vertex(None, session, shader.defines or defines))
     return prepare_file(shader, session, defines)
 
 

@@ -17,11 +17,13 @@ and nothing below imports it. Into the output folder it writes:
 """
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.glsl.frontend import file_records
 from rrcache.profiler.train import ProgressFn, TrainingResult, train
 from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
@@ -39,12 +41,13 @@ def default_out_dir(shader_path, session_path) -> Path:
 
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
-            fresh: bool = False, plots: bool = True) -> Profile:
+            fresh: bool = False, plots: bool = True, vertex=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
     moves it aside first. ``progress`` receives :class:`~rrcache.profiler.train.ProgressEvent`
-    objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
+    objects; ``vertex`` is the user's vertex shader file (None: the session's ``"vertex"``, else
+    generated). A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
@@ -54,12 +57,12 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     from rrcache.session import load_session
 
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, defines)
+    work = load_for_session(shader_path, session, defines, vertex=vertex)
     resolved = (settings or TrainingSettings()).resolved(session)
     out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
-    key = StoreKey(work.shader.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
+    key = StoreKey(work.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
     store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
     started = time.time()
     try:
@@ -104,7 +107,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     for nid in result.order:
         entry = by_id[nid]
         node = NodeProfile(nid, entry.type, entry.line, entry.column, entry.text, list(entry.call_chain),
-                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid))
+                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid),
+                           file=getattr(entry, "file", None))
         runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
         node.periods = [r.period for r in runs]
         node.errors = [r.mean_error for r in runs]
@@ -121,7 +125,10 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     plan = result.plan
     draft = Profile(
         shader=str(Path(shader_path).resolve()), session=str(Path(session_path).resolve()),
-        shader_hash=work.shader.hash, session_hash=session.hash, settings=settings,
+        shader_hash=work.hash, session_hash=session.hash, settings=settings,
+        shader_files=file_records(work.shader),
+        vertex=os.path.abspath(work.vertex.path) if work.vertex is not None else None,
+        vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
         nodes=nodes, defines=dict(work.defines), plan=plan.to_json() if plan is not None else None,

@@ -240,9 +240,16 @@ def load_session(path: str | os.PathLike) -> Session:
     objects = _objects(doc, file, assets)
     uniforms = _uniforms(doc, file)
     textures = _textures(doc, file, assets)
+    vertex = None
+    if "vertex" in doc:
+        vertex = assets.resolve(doc["vertex"])
+        if not os.path.isfile(vertex):
+            raise AssetError(f"cannot find the vertex shader {vertex}", file, "vertex",
+                             "the path is relative to the session file's folder")
     return Session(
         path=file, resolution=(int(doc["resolution"][0]), int(doc["resolution"][1])),
         frames=int(doc["frames"]), fps=float(doc.get("fps", 30)), objects=objects, textures=textures,
         hash=assets.digest(doc), name=doc.get("name", ""), description=doc.get("description", ""),
         background=tuple(float(c) for c in doc.get("background", (0.0, 0.0, 0.0, 0.0))), document=doc,
-        _camera=camera, _light=light, _uniforms=uniforms)
+        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex,
+        notes=[f"{path}: {note}" for path, mesh in assets.meshes.items() for note in mesh.notes])

@@ -40,6 +40,8 @@ class MeshData:
     texcoords: np.ndarray | None = None
     colors: np.ndarray | None = None
     tangents: np.ndarray | None = None
+    #: one line per complaint of the mesh file's loader (e.g. a missing texture it names)
+    notes: tuple = ()
 
     @property
     def vertex_count(self) -> int:
@@ -190,6 +192,10 @@ class Session:
     description: str = ""
     background: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     document: dict = field(default_factory=dict, repr=False)
+    #: the user's vertex shader file (``"vertex"``, resolved), or None for a generated one
+    vertex: str | None = None
+    #: what loading the session's assets had to say that is not an error (one line each)
+    notes: list = field(default_factory=list)
     _camera: Callable[[int], Camera] | None = field(default=None, repr=False)
     _light: Callable[[int], Light] | None = field(default=None, repr=False)
     _uniforms: Callable[[int], dict[str, Any]] | None = field(default=None, repr=False)
