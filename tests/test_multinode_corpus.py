@@ -4,7 +4,8 @@ For every corpus shader (the session as in :mod:`tests.test_corpus`), the nodes 
 that test picks (``COSTLIEST`` = 4 costliest and ``SAMPLED`` = 2 seeded others). The pairs
 tested are every pair among the ``PAIR_COSTLIEST`` = 3 costliest of them (3 pairs) and
 ``PAIR_SAMPLED`` = 2 more drawn with a fixed seed from the remaining pairs of the six (so 5 pairs
-per shader), plus the triple of the 3 costliest; each is compiled in each algorithm that every
+per shader), plus the triple of the 3 costliest (three-pass in the per-node layout, or the union
+layout where the shader can discard or a node needs derivatives); each is compiled in each algorithm that every
 node of it allows, rendered at Δn = 1 for every node on a 64×64 frame for ``FRAMES`` = 3
 frames, and each frame must equal the original's within the corpus tolerance. Pairs in which one
 node lies inside the other (nested) are tested like the others; how many there were is printed.
@@ -54,7 +55,7 @@ def test_node_sets_reproduce_the_original_at_period_one(gl_ctx, shader):
     sets = picked_sets(work.table)
     if not sets:
         pytest.skip(f"{shader.name} lists fewer than two nodes")
-    done = 0
+    done, per_node = 0, 0
     nests = sum(nested(work, a, b) for s in sets for a, b in itertools.combinations(s, 2))
     for nodes in sets:
         ids = [n.id for n in nodes]
@@ -62,6 +63,7 @@ def test_node_sets_reproduce_the_original_at_period_one(gl_ctx, shader):
             if any(algorithm not in n.algorithms for n in nodes):
                 continue
             variant = variant_for_nodes(work, ids, algorithm)
+            per_node += "node_0" in variant.passes
             for name, source in variant.passes.items():
                 assert not untidy_blocks(source.fragment), (shader.name, ids, algorithm, name)
             with CachedRenderer(variant, session, work.prepared, SIZE, period=[1] * len(ids)) as cached:
@@ -70,5 +72,6 @@ def test_node_sets_reproduce_the_original_at_period_one(gl_ctx, shader):
                     err = float(np.abs(got.image - ref.image)[ref.mask].max())
                     assert err <= TOLERANCE, (shader.name, ids, algorithm, ref.index, err)
             done += 1
-    print(f"{shader.name}: {done} variants of {len(sets)} node sets ({nests} nested pairs) exact at Δn=1")
+    print(f"{shader.name}: {done} variants of {len(sets)} node sets ({nests} nested pairs, {per_node} "
+          "three-pass variants in the per-node layout) exact at Δn=1")
     assert done >= len(sets)

@@ -20,7 +20,12 @@ node I (nested in its expression, or through a variable), from the singles' meas
   model at hit rate 1); a pixel where O misses costs what it costs with I alone cached (O's
   outer part computed from I's cache, I recomputed where I misses): ``t_I``. ``h_O`` is O's hit
   rate as a single node. The second cache's own reprojection and writes are in neither single,
-  so the rule is optimistic by about that overhead.
+  so the rule is optimistic by about that overhead. This holds where a pixel that misses only O
+  does not pay for I's computation: on hardware whose branches skip work for coherent pixels.
+- **time, lock-step branches** (llvmpipe, whose fragment shader runs both sides of a branch for
+  its SIMD lanes): every pixel where some node misses pays the whole pass 2, so
+  ``t_pair ≈ h_U · t_O^hit + (1 − h_U) · T_0`` with ``h_U ≈ h_O · h_I`` the share of pixels where
+  both hit (independent refresh phases; shared disocclusions make it a lower bound).
 
 For two disjoint nodes A and B the same reasoning gives ``e ≈ e_A + e_B`` and
 ``t ≈ t_A + t_B − T_0`` (each saves what it saves alone); this module measures the nested kind.
@@ -122,15 +127,22 @@ def _all_hit_ratio(variant, session, work, resolution, index: int) -> float:
 
 
 def predict(outer_error: float, inner_error: float, outer_all_hit_ratio: float, inner_ratio: float,
-            outer_hit_rate: float) -> tuple[float, float]:
+            outer_hit_rate: float, inner_hit_rate: Optional[float] = None) -> tuple[float, float]:
     """The pair's (error, time as a fraction of the original's) from the singles' (see the module
-    docstring; ``*_ratio`` = ms / the original's ms).
+    docstring; ``*_ratio`` = ms / the original's ms). With ``inner_hit_rate`` the time is the
+    lock-step rule's.
 
     >>> predict(0.01, 0.002, 0.3, 0.7, 0.8)
     (0.012, 0.38)
+    >>> predict(0.01, 0.002, 0.3, 0.7, 0.8, 0.5)
+    (0.012, 0.72)
     """
     error = outer_error + inner_error
-    ratio = outer_hit_rate * outer_all_hit_ratio + (1.0 - outer_hit_rate) * inner_ratio
+    if inner_hit_rate is None:
+        ratio = outer_hit_rate * outer_all_hit_ratio + (1.0 - outer_hit_rate) * inner_ratio
+    else:
+        both = outer_hit_rate * inner_hit_rate
+        ratio = both * outer_all_hit_ratio + (1.0 - both)
     return round(error, 12), round(ratio, 12)
 
 
@@ -138,13 +150,17 @@ def summary(m: PairMeasurement) -> dict:
     """The measured figures and the rule's prediction of the pair."""
     all_hit = statistics.median(m.outer_all_hit_ratios)
     pred_error, pred_ratio = predict(m.outer.error, m.inner.error, all_hit, m.inner.ratio_ms(), m.outer.hit_rate)
+    _, lock_ratio = predict(m.outer.error, m.inner.error, all_hit, m.inner.ratio_ms(), m.outer.hit_rate,
+                            m.inner.hit_rate)
     rows = {}
     for key, res in (("pair", m.pair), ("outer", m.outer), ("inner", m.inner)):
         rows[key] = {"label": res.label, "error": res.error, "speedup": res.speedup, "hit_rate": res.hit_rate,
                      "speedups": res.speedups, "errors": res.errors}
     return {"resolution": list(m.resolution), "frames": m.frames, "repeats": m.repeats, **rows,
             "outer_all_hit_speedup": 1.0 / all_hit, "outer_all_hit_ratios": m.outer_all_hit_ratios,
-            "predicted_pair_error": pred_error, "predicted_pair_speedup": 1.0 / pred_ratio if pred_ratio > 0 else None}
+            "predicted_pair_error": pred_error, "predicted_pair_speedup": 1.0 / pred_ratio if pred_ratio > 0 else None,
+            "predicted_pair_speedup_lockstep": 1.0 / lock_ratio if lock_ratio > 0 else None,
+            "predicted_pair_hit_rate": m.outer.hit_rate * m.inner.hit_rate}
 
 
 def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measurement, run by hand

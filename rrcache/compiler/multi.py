@@ -15,7 +15,7 @@ from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
 )
 from rrcache.compiler.multi_locate import prepare_nodes
-from rrcache.compiler.multi_passes import build_multi_pass
+from rrcache.compiler.multi_passes import build_multi_pass, has_discard, node_order
 from rrcache.compiler.multi_variant import MultiVariant
 from rrcache.compiler.variant import PassSource
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
@@ -57,8 +57,19 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
                   if "one-pass" in getattr(_table_entry(analysed, node_id), "invalid", {})}
     passes, uniforms, samplers, runtime, forms = {}, {}, {}, {}, {}
     user_vertex = vertex
-    for name in ALGORITHMS[algorithm]:
-        built = build_multi_pass(loc, name, filter, derivative)
+    # three-pass: one pass per node after a cheap copy pass (llvmpipe runs both sides of a branch
+    # in lock-step, so one pass 2 over the union would pay every node wherever any node misses);
+    # a shader that can discard keeps the one pass 2 over the union
+    # (and so does a node that needs derivatives: they are undefined after a non-uniform discard)
+    layout = ("per-node" if algorithm == "three-pass" and not has_discard(loc) and not derivative
+              else "union")
+    if layout == "per-node":
+        steps = [("reproject", "reproject"), ("payload", "copy"),
+                 *[(f"node_{j}", f"node_{j}") for j in node_order(loc)], ("shade", "shade")]
+    else:
+        steps = [(name, name) for name in ALGORITHMS[algorithm]]
+    for name, kind in steps:
+        built = build_multi_pass(loc, kind, filter, derivative)
         iface = interface(built.unit)
         vertex_src = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), user_vertex)
         fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)

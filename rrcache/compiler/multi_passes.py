@@ -19,6 +19,15 @@ this frame (``!rr_refreshNow_j()``, its own period and phase); otherwise it miss
                else { rr_node_j = E_j; }`` and its cache writes; E_j in S → ``rr_node_j``. No
                colour.
 ``shade``      three-pass 3: each top-level E_j → ``<unpack>(rr_current_j())``; colour only.
+``payload``    per-node three-pass 2 (the copy pass; the layout three-pass uses unless the
+(per-node)     shader can discard or a node needs derivatives): where pass 1 left no depth, it
+               completes the depth and copies each node that hits; a node that misses gets 0.
+``node_j``     per-node three-pass, one pass per node in program order (inner nodes and nodes
+               whose statements come first before the nodes that read them), depth test ``==``
+               without writes, into node j's targets only: ``if (hit_j) discard;`` then E_j,
+               its inner nodes and the nodes before it read from this frame's payloads
+               (``rr_current_i()``). A pixel pays for node j only where node j misses (a
+               branch would not do: llvmpipe runs both sides of a branch for its SIMD lanes).
 ``hit``        two-pass 1: ``reproject`` plus the colour output (location 0, caches from 1)
 ``miss``       two-pass 2: ``payload`` plus the colour output
 ``single``     one-pass: ``payload`` plus the colour output, run at every pixel
@@ -198,6 +207,79 @@ def _compute(unit: A.TranslationUnit, loc: MultiLocated, derivative: set[int]) -
         _move_feeders(unit, site, stmts)
 
 
+def has_discard(loc: MultiLocated) -> bool:
+    """Whether ``main`` can discard (then three-pass keeps one pass 2 over the union: the copy
+    pass of the per-node layout could not tell where the shader discards)."""
+    return any(isinstance(n, A.Discard) for n in walk(main_function(loc.unit).body))
+
+
+def node_order(loc: MultiLocated) -> list[int]:
+    """The order of the per-node passes: by the place of each node's top-level statement in
+    ``main`` (a node can read only values computed before it), inner nodes before their outer."""
+    place = {}
+    for i, n in enumerate(walk(main_function(loc.unit).body)):
+        if isinstance(n, A.Ident) and n.name.startswith("rr_cachedNodePlaceholder_"):
+            place.setdefault(n.name, i)
+    return sorted(range(len(loc.nodes)),
+                  key=lambda j: (place.get(loc.nodes[loc.nodes[j].top].name, 0), -loc.depth(j)))
+
+
+def _current(node: NodeSite) -> A.Expr:
+    return unpack(_call("rr_current", node.index), node.components)
+
+
+def _copy_pass(loc: MultiLocated) -> A.TranslationUnit:
+    """Per-node three-pass, pass 2 (``payload``): where pass 1 left no depth, complete the depth
+    and copy each node that hits there; a node that misses gets 0 inverse depth (its own pass
+    fills it)."""
+    unit = clone(loc.unit)
+    body = main_function(unit).body
+    stmts: list[A.Stmt] = []
+    for j in range(len(loc.nodes)):
+        stmts.append(A.If(_hit(j), A.Compound(cache_writes(j, _call("rr_previous", j)))))
+    body.stmts = cache_init(len(loc.nodes)) + stmts
+    return unit
+
+
+def _node_pass(loc: MultiLocated, j: int) -> A.TranslationUnit:
+    """Per-node three-pass, the pass of node j (depth test ``==``, only node j's targets):
+    discard where node j hits, else compute E_j (its inner nodes and the nodes before it read
+    from this frame's payloads: their passes ran first)."""
+    unit = clone(loc.unit)
+    body = main_function(unit).body
+    node = loc.nodes[j]
+    top = loc.nodes[node.top]
+    site = find_site(unit, top.name)
+    value = clone(node.expr)
+    for child in loc.children(j):
+        c = loc.nodes[child]
+        if isinstance(value, A.Ident) and value.name == c.name:
+            value = _current(c)
+        else:
+            _replace(value, c.name, lambda c=c: _current(c))
+    writes = cache_writes(j, pack(A.Ident(node.var), node.components))
+    if _side_effect_before(site.stmt, top.name):
+        if node.top != j:
+            raise UnsupportedShaderError(
+                f"node '{top.text}' sits in a statement that changes a variable before it, so the "
+                f"nodes inside it cannot be computed before it", top.loc,
+                "cache the nodes separately (not nested), or pick another outer node")
+        insert_before(site, [declare(node.type_name, node.var)])
+        _replace(site.stmt, top.name, lambda: A.Assign("=", A.Ident(node.var), value))
+        insert_after(site, writes)
+    else:
+        insert_before(site, [declare(node.type_name, node.var, value)] + writes)
+        _replace(site.stmt, top.name, lambda: A.Ident(node.var) if node.top == j else _current(top))
+    for other in loc.nodes:  # the other top-level nodes: this frame's values (dead unless read)
+        if other.parent is None and other.index != node.top:
+            _replace(body, other.name, lambda o=other: _current(o))
+    body.stmts[0:0] = [A.If(_hit(j), A.Discard()),
+                       _set(MG.suffixed(G.OUT_INVDEPTH, j), float_lit(0.0)),
+                       _set(MG.suffixed(G.OUT_PAYLOAD, j), A.Call("vec4", [float_lit(0.0)]))]
+    set_color_output(unit, keep=False)
+    return unit
+
+
 def transform(loc: MultiLocated, name: str, derivative: set[int]) -> A.TranslationUnit:
     """The transformed (not yet checked or pruned) unit of pass ``name``."""
     spec = MULTI_PASS_SPECS[name]
@@ -241,11 +323,23 @@ def build_multi_pass(loc: MultiLocated, name: str, filter: str = "bilinear",
                      derivative: Optional[set[int]] = None) -> PassUnit:
     """Transform, type-check and prune pass ``name`` for the located nodes; ``derivative`` holds
     the indices of the nodes that need screen-space derivatives."""
-    spec = MULTI_PASS_SPECS.get(name)
-    if spec is None:
-        raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(MULTI_PASS_SPECS)}")
-    unit = transform(loc, name, set(derivative or ()))
-    runtime = runtime_snippets(spec, len(loc.nodes), filter)
+    k = len(loc.nodes)
+    if name.startswith("node_"):  # per-node three-pass: node j's own pass
+        j = int(name[5:])
+        unit = _node_pass(loc, j)
+        spec = PassSpec(lookup=True, current=True, cache=True, color=False)
+        runtime = (MG.lookup_glsl(k, filter) + MG.current_glsl(k)
+                   + MG.rename(G.output_glsl(0), j))
+    elif name == "copy":
+        unit = _copy_pass(loc)
+        spec = MULTI_PASS_SPECS["payload"]
+        runtime = runtime_snippets(spec, k, filter)
+    else:
+        spec = MULTI_PASS_SPECS.get(name)
+        if spec is None:
+            raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(MULTI_PASS_SPECS)}")
+        unit = transform(loc, name, set(derivative or ()))
+        runtime = runtime_snippets(spec, k, filter)
     snippet_decls = parse_source("#version 330 core\n" + runtime, "<rrcache runtime>").decls
     unit.decls[0:0] = snippet_decls
     texts = " + ".join(f"'{n.text}'" for n in loc.nodes)

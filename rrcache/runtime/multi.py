@@ -19,7 +19,9 @@ one-node runtime's). What differs:
 A pixel is a miss for node j when the reprojection of node j's entry fails or node j refreshes
 this frame (``rr_hit_j() && !rr_refreshNow_j()`` is its hit). The first pass of three-pass and
 two-pass keeps only the pixels where every node hits; the passes after it compute, per node,
-only the nodes that miss there (see :mod:`rrcache.compiler.multi_passes`).
+only the nodes that miss there (see :mod:`rrcache.compiler.multi_passes`). A three-pass variant
+with ``node_j`` programs runs the per-node layout (:meth:`MultiCacheRuntime.frame`): the nodes'
+passes in the order the programs are given.
 """
 from __future__ import annotations
 
@@ -83,6 +85,8 @@ class MultiCacheRuntime(CacheRuntime):
             raise ValueError(f"payload_components must be {k} counts of 1 to 4 (one per node), "
                              f"not {payload_components!r}")
         target_budget(ctx, algorithm, k)
+        # per-node three-pass layout: a program "node_j" per node, in the order they must run
+        self.node_passes = [name for name in programs if name.startswith("node_")]
         self.node_count = k
         self.node_components = comps
         self._periods = (1,) * k
@@ -141,8 +145,12 @@ class MultiCacheRuntime(CacheRuntime):
                                 for i in range(2)]
             self._out_fbo = ctx.framebuffer([self.color], self.depth)
             self._color_only_fbo = ctx.framebuffer([self.color])
+            # node j's own targets (per-node three-pass: node j's pass writes only these)
+            self._node_fbos = [[ctx.framebuffer([self._payloads[j][i], self._invdepths[j][i]], self.depth)
+                                for i in range(2)] for j in range(k)]
         self._resources = [self.depth, self.color, *[t for pair in self._payloads + self._invdepths for t in pair],
-                           *self._cache_fbos, *self._clear_fbos, self._out_fbo, self._color_only_fbo]
+                           *self._cache_fbos, *self._clear_fbos, self._out_fbo, self._color_only_fbo,
+                           *[f for pair in self._node_fbos for f in pair]]
         if self.window is not None:
             from rrcache.gl.window import check_window
             try:
@@ -152,7 +160,69 @@ class MultiCacheRuntime(CacheRuntime):
         self._apply_window()
         self.reset()
 
+    def _apply_window(self) -> None:
+        super()._apply_window()
+        for pair in getattr(self, "_node_fbos", []):
+            for fbo in pair:
+                fbo.scissor = self.window
+
     # ------------------------------------------------------------------ the frame
+
+    def frame(self, draw, count: bool = True, after_first_pass=None):
+        """As :meth:`CacheRuntime.frame`; with the per-node three-pass layout: ``reproject``
+        (every node hits: copy, depth), ``payload`` (the rest of the depth; copy the nodes that
+        hit), then each ``node_j`` (depth ``==``, no depth writes, node j's targets only:
+        computes node j where it misses), then ``shade``. ``misses`` counts the pixels of the
+        ``payload`` pass (where some node misses)."""
+        if not (self.algorithm == "three-pass" and self.node_passes):
+            return super().frame(draw, count, after_first_pass)
+        import moderngl as _mgl
+
+        from rrcache.runtime.cache import FrameStats
+
+        ctx = self.ctx
+        ctx.enable(_mgl.DEPTH_TEST)
+        if self.cull_back_faces is True:
+            ctx.enable(_mgl.CULL_FACE)
+        elif self.cull_back_faces is False:
+            ctx.disable(_mgl.CULL_FACE)
+        self._color_only_fbo.use()
+        self._color_only_fbo.clear(*self.clear_color)
+        clear_fbo = self._clear_fbos[self._index]
+        clear_fbo.depth_mask = True
+        clear_fbo.use()
+        clear_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        cache_fbo = self._cache_fbos[self._index]
+        cache_fbo.depth_mask = True
+        cache_fbo.use()
+        ctx.depth_func = "<"
+        first, second = self._queries if count else (None, None)
+        self._refresh_values = {}
+        self._run("reproject", draw)
+        if after_first_pass:
+            after_first_pass()
+            cache_fbo.use()
+        self._run("payload", draw, first)
+        ctx.depth_func = "=="
+        for name in self.node_passes:
+            fbo = self._node_fbos[int(name[5:])][self._index]
+            fbo.depth_mask = False
+            fbo.use()
+            self._run(name, draw)
+            fbo.depth_mask = True
+        self._out_fbo.depth_mask = False
+        self._out_fbo.use()
+        self._run("shade", draw, second)
+        self._out_fbo.depth_mask = True
+        covered = misses = None
+        if count:
+            misses, covered = int(first.samples), int(second.samples)
+        ctx.depth_func = "<"
+        stats = FrameStats(self.clock, covered, misses)
+        self._index = 1 - self._index
+        self._valid = True
+        self.clock += 1
+        return stats
 
     def node_refresh_values(self, j: int) -> dict:
         """The refresh rule's uniforms of node ``j`` at the current clock (its own period and
