@@ -198,13 +198,13 @@ def test_cli_render_and_instance_pair_nodes_with_periods(gl_ctx, tmp_path, capsy
 
 
 def test_three_pass_layout_per_node_unless_the_shader_discards():
-    """Three-pass runs one pass per node (after a copy pass) so a pixel pays only for the nodes
+    """Three-pass runs two passes per node (hit_j, node_j) so a pixel pays only for the nodes
     that miss there; a shader that can discard keeps one pass 2 over the union."""
     shader = parse_shader(DISJOINT, "disjoint.frag")
     v = instance_nodes(shader, _nodes(shader, "+", 2), "three-pass")
-    assert list(v.passes) == ["reproject", "payload", "node_0", "node_1", "shade"]
+    assert list(v.passes) == ["hit_0", "node_0", "hit_1", "node_1", "shade"]
     body = v.passes["node_1"].fragment.split("void main()")[1]
-    assert "discard;" in body and "rr_current_0()" not in body   # disjoint: node 1 reads no other
+    assert "discard;" not in body and "rr_current_0()" not in body   # culled by depth; disjoint
     discarding = parse_shader(DISJOINT.replace("fragColor = vec4(a, b, 0.0, 1.0);",
                                                "if (a > 0.9) discard; fragColor = vec4(a, b, 0.0, 1.0);"), "d.frag")
     v = instance_nodes(discarding, _nodes(discarding, "+", 2), "three-pass")

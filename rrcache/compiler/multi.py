@@ -64,8 +64,8 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
     layout = ("per-node" if algorithm == "three-pass" and not has_discard(loc) and not derivative
               else "union")
     if layout == "per-node":
-        steps = [("reproject", "reproject"), ("payload", "copy"),
-                 *[(f"node_{j}", f"node_{j}") for j in node_order(loc)], ("shade", "shade")]
+        steps = [(f"{kind}_{j}", f"{kind}_{j}") for j in node_order(loc) for kind in ("hit", "node")]
+        steps.append(("shade", "shade"))
     else:
         steps = [(name, name) for name in ALGORITHMS[algorithm]]
     for name, kind in steps:

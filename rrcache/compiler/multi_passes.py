@@ -19,15 +19,18 @@ this frame (``!rr_refreshNow_j()``, its own period and phase); otherwise it miss
                else { rr_node_j = E_j; }`` and its cache writes; E_j in S → ``rr_node_j``. No
                colour.
 ``shade``      three-pass 3: each top-level E_j → ``<unpack>(rr_current_j())``; colour only.
-``payload``    per-node three-pass 2 (the copy pass; the layout three-pass uses unless the
-(per-node)     shader can discard or a node needs derivatives): where pass 1 left no depth, it
-               completes the depth and copies each node that hits; a node that misses gets 0.
-``node_j``     per-node three-pass, one pass per node in program order (inner nodes and nodes
-               whose statements come first before the nodes that read them), depth test ``==``
-               without writes, into node j's targets only: ``if (hit_j) discard;`` then E_j,
-               its inner nodes and the nodes before it read from this frame's payloads
-               (``rr_current_i()``). A pixel pays for node j only where node j misses (a
-               branch would not do: llvmpipe runs both sides of a branch for its SIMD lanes).
+``hit_j``      per-node three-pass (the layout three-pass uses unless the shader can discard
+               or a node needs derivatives), node j's first pass, into node j's targets only
+               (the depth cleared before it): where node j hits, copy and write depth; where it
+               misses, discard.
+``node_j``     per-node three-pass, node j's second pass (depth test ``<``): runs where
+               ``hit_j`` left no depth, so early depth testing culls it where node j hits, and
+               computes E_j; its inner nodes and the nodes before it (program order: the
+               node passes run in the order of their statements, inner nodes first) are read
+               from this frame's payloads (``rr_current_i()``). A pixel pays for node j only
+               where node j misses: neither a branch nor a ``discard`` would do that on
+               llvmpipe, whose fragment shader runs both sides of a branch, and the rest of a
+               shader after a ``discard``, for its SIMD lanes.
 ``hit``        two-pass 1: ``reproject`` plus the colour output (location 0, caches from 1)
 ``miss``       two-pass 2: ``payload`` plus the colour output
 ``single``     one-pass: ``payload`` plus the colour output, run at every pixel
@@ -228,23 +231,24 @@ def _current(node: NodeSite) -> A.Expr:
     return unpack(_call("rr_current", node.index), node.components)
 
 
-def _copy_pass(loc: MultiLocated) -> A.TranslationUnit:
-    """Per-node three-pass, pass 2 (``payload``): where pass 1 left no depth, complete the depth
-    and copy each node that hits there; a node that misses gets 0 inverse depth (its own pass
-    fills it)."""
+def _hit_pass(loc: MultiLocated, j: int) -> A.TranslationUnit:
+    """Per-node three-pass, node j's first pass (``hit_j``, depth test ``<`` with writes, node j's
+    targets): where node j hits, copy its reprojected value and write depth; where it misses,
+    discard (so that node j's second pass runs there only, culled by the depth test elsewhere)."""
     unit = clone(loc.unit)
     body = main_function(unit).body
-    stmts: list[A.Stmt] = []
-    for j in range(len(loc.nodes)):
-        stmts.append(A.If(_hit(j), A.Compound(cache_writes(j, _call("rr_previous", j)))))
-    body.stmts = cache_init(len(loc.nodes)) + stmts
+    body.stmts = [_set(MG.suffixed(G.OUT_INVDEPTH, j), float_lit(0.0)),
+                  _set(MG.suffixed(G.OUT_PAYLOAD, j), A.Call("vec4", [float_lit(0.0)])),
+                  A.If(_miss(j), A.Discard()),
+                  *cache_writes(j, _call("rr_previous", j))]
     return unit
 
 
 def _node_pass(loc: MultiLocated, j: int) -> A.TranslationUnit:
-    """Per-node three-pass, the pass of node j (depth test ``==``, only node j's targets):
-    discard where node j hits, else compute E_j (its inner nodes and the nodes before it read
-    from this frame's payloads: their passes ran first)."""
+    """Per-node three-pass, node j's second pass (``node_j``, depth test ``<`` with writes, only
+    node j's targets): it runs where ``hit_j`` left no depth (node j misses) and computes E_j
+    (its inner nodes and the nodes before it read from this frame's payloads: their passes ran
+    first)."""
     unit = clone(loc.unit)
     body = main_function(unit).body
     node = loc.nodes[j]
@@ -273,8 +277,7 @@ def _node_pass(loc: MultiLocated, j: int) -> A.TranslationUnit:
     for other in loc.nodes:  # the other top-level nodes: this frame's values (dead unless read)
         if other.parent is None and other.index != node.top:
             _replace(body, other.name, lambda o=other: _current(o))
-    body.stmts[0:0] = [A.If(_hit(j), A.Discard()),
-                       _set(MG.suffixed(G.OUT_INVDEPTH, j), float_lit(0.0)),
+    body.stmts[0:0] = [_set(MG.suffixed(G.OUT_INVDEPTH, j), float_lit(0.0)),
                        _set(MG.suffixed(G.OUT_PAYLOAD, j), A.Call("vec4", [float_lit(0.0)]))]
     set_color_output(unit, keep=False)
     return unit
@@ -330,10 +333,11 @@ def build_multi_pass(loc: MultiLocated, name: str, filter: str = "bilinear",
         spec = PassSpec(lookup=True, current=True, cache=True, color=False)
         runtime = (MG.lookup_glsl(k, filter) + MG.current_glsl(k)
                    + MG.rename(G.output_glsl(0), j))
-    elif name == "copy":
-        unit = _copy_pass(loc)
-        spec = MULTI_PASS_SPECS["payload"]
-        runtime = runtime_snippets(spec, k, filter)
+    elif name.startswith("hit_"):
+        j = int(name[4:])
+        unit = _hit_pass(loc, j)
+        spec = PassSpec(lookup=True, current=False, cache=True, color=False)
+        runtime = MG.lookup_glsl(k, filter) + MG.rename(G.output_glsl(0), j)
     else:
         spec = MULTI_PASS_SPECS.get(name)
         if spec is None:

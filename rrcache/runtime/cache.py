@@ -153,7 +153,7 @@ class CacheRuntime:
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
-        missing = [p for p in ALGORITHMS[algorithm] if p not in programs]
+        missing = [p for p in self.required_passes(algorithm, programs) if p not in programs]
         if missing:
             raise ValueError(f"{algorithm} needs programs for passes {missing}")
         if payload_dtype not in PAYLOAD_DTYPES:
@@ -192,6 +192,10 @@ class CacheRuntime:
         self.size = (0, 0)
         self.window: Optional[tuple[int, int, int, int]] = None
         self.resize(size)
+
+    def required_passes(self, algorithm: str, programs) -> tuple:
+        """The programs ``algorithm`` needs (a multi-node runtime may run another layout)."""
+        return ALGORITHMS[algorithm]
 
     # ------------------------------------------------------------------ configuration
 

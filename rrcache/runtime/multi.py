@@ -85,8 +85,9 @@ class MultiCacheRuntime(CacheRuntime):
             raise ValueError(f"payload_components must be {k} counts of 1 to 4 (one per node), "
                              f"not {payload_components!r}")
         target_budget(ctx, algorithm, k)
-        # per-node three-pass layout: a program "node_j" per node, in the order they must run
+        # per-node three-pass layout: programs "hit_j" and "node_j" per node, in the order they run
         self.node_passes = [name for name in programs if name.startswith("node_")]
+        self._node_queries = [ctx.query(samples=True) for _ in self.node_passes]
         self.node_count = k
         self.node_components = comps
         self._periods = (1,) * k
@@ -148,9 +149,10 @@ class MultiCacheRuntime(CacheRuntime):
             # node j's own targets (per-node three-pass: node j's pass writes only these)
             self._node_fbos = [[ctx.framebuffer([self._payloads[j][i], self._invdepths[j][i]], self.depth)
                                 for i in range(2)] for j in range(k)]
+            self._depth_only = [ctx.framebuffer(depth_attachment=self.depth) for _ in range(2)]
         self._resources = [self.depth, self.color, *[t for pair in self._payloads + self._invdepths for t in pair],
                            *self._cache_fbos, *self._clear_fbos, self._out_fbo, self._color_only_fbo,
-                           *[f for pair in self._node_fbos for f in pair]]
+                           *[f for pair in self._node_fbos for f in pair], *self._depth_only]
         if self.window is not None:
             from rrcache.gl.window import check_window
             try:
@@ -162,18 +164,25 @@ class MultiCacheRuntime(CacheRuntime):
 
     def _apply_window(self) -> None:
         super()._apply_window()
-        for pair in getattr(self, "_node_fbos", []):
+        for pair in getattr(self, "_node_fbos", []) + [getattr(self, "_depth_only", [])]:
             for fbo in pair:
                 fbo.scissor = self.window
 
     # ------------------------------------------------------------------ the frame
 
+    def required_passes(self, algorithm: str, programs) -> tuple:
+        if algorithm == "three-pass" and any(name.startswith("node_") for name in programs):
+            return tuple(name for name in programs if name.startswith(("hit_", "node_"))) + ("shade",)
+        return super().required_passes(algorithm, programs)
+
     def frame(self, draw, count: bool = True, after_first_pass=None):
-        """As :meth:`CacheRuntime.frame`; with the per-node three-pass layout: ``reproject``
-        (every node hits: copy, depth), ``payload`` (the rest of the depth; copy the nodes that
-        hit), then each ``node_j`` (depth ``==``, no depth writes, node j's targets only:
-        computes node j where it misses), then ``shade``. ``misses`` counts the pixels of the
-        ``payload`` pass (where some node misses)."""
+        """As :meth:`CacheRuntime.frame`; with the per-node three-pass layout, per node j in the
+        order of its programs: clear the depth, ``hit_j`` (depth ``<`` with writes, node j's
+        targets: copies node j where it hits, discards where it misses), ``node_j`` (``<``: runs
+        only where node j misses, early depth testing culls the rest, and computes it); then
+        ``shade`` (``==``; the last ``node_j`` left the whole depth). ``misses`` is the most
+        misses of any one node (a lower bound of the pixels where some node misses);
+        ``after_first_pass`` runs after the first node's ``hit`` pass."""
         if not (self.algorithm == "three-pass" and self.node_passes):
             return super().frame(draw, count, after_first_pass)
         import moderngl as _mgl
@@ -192,31 +201,33 @@ class MultiCacheRuntime(CacheRuntime):
         clear_fbo.depth_mask = True
         clear_fbo.use()
         clear_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        cache_fbo = self._cache_fbos[self._index]
-        cache_fbo.depth_mask = True
-        cache_fbo.use()
         ctx.depth_func = "<"
-        first, second = self._queries if count else (None, None)
-        self._refresh_values = {}
-        self._run("reproject", draw)
-        if after_first_pass:
-            after_first_pass()
-            cache_fbo.use()
-        self._run("payload", draw, first)
-        ctx.depth_func = "=="
-        for name in self.node_passes:
-            fbo = self._node_fbos[int(name[5:])][self._index]
-            fbo.depth_mask = False
-            fbo.use()
-            self._run(name, draw)
+        queries = self._node_queries if count else [None] * len(self.node_passes)
+        for n, name in enumerate(self.node_passes):
+            j = int(name[5:])
+            fbo = self._node_fbos[j][self._index]
             fbo.depth_mask = True
+            fbo.use()
+            if n:
+                depth_only = self._depth_only[self._index]
+                depth_only.depth_mask = True
+                depth_only.use()
+                depth_only.clear(depth=1.0)
+                fbo.use()
+            self._run(f"hit_{j}", draw)
+            if after_first_pass and n == 0:
+                after_first_pass()
+                fbo.use()
+            self._run(name, draw, queries[n])
         self._out_fbo.depth_mask = False
         self._out_fbo.use()
+        ctx.depth_func = "=="
+        second = self._queries[1] if count else None
         self._run("shade", draw, second)
         self._out_fbo.depth_mask = True
         covered = misses = None
         if count:
-            misses, covered = int(first.samples), int(second.samples)
+            misses, covered = max(int(q.samples) for q in queries), int(second.samples)
         ctx.depth_func = "<"
         stats = FrameStats(self.clock, covered, misses)
         self._index = 1 - self._index
