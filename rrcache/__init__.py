@@ -3,9 +3,11 @@
 The public API; the CLI and the notebooks use nothing else.
 
 >>> import rrcache
->>> shader = rrcache.load_shader("shaders/marble.glsl")          # doctest: +SKIP
->>> session = rrcache.load_session("sessions/marble.json")       # doctest: +SKIP
->>> result = rrcache.render(shader, session, frames=[0, 1])       # doctest: +SKIP
+>>> shader = rrcache.load_shader("shaders/glslviewer_basic.glsl")
+>>> session = rrcache.load_session("sessions/marble.json")
+>>> result = rrcache.render(shader, session, frames=[0, 1], resolution=(64, 48))
+>>> [f.index for f in result.frames], result.frames[1].image.shape
+([0, 1], (48, 64, 4))
 
 Names are imported lazily so that ``import rrcache`` stays cheap.
 """
@@ -44,11 +46,11 @@ _LAZY = {
     "mean_l2": "rrcache.harness",
     "psnr": "rrcache.harness",
     "CacheRuntime": "rrcache.runtime",
-    "profile": "rrcache.profile",
-    "load_profile": "rrcache.profile",
-    "select": "rrcache.profile",
-    "TrainingSettings": "rrcache.profile",
-    "held_out": "rrcache.profile.accuracy",
+    "profile": "rrcache.profiler",
+    "load_profile": "rrcache.profiles",
+    "select": "rrcache.profiles",
+    "TrainingSettings": "rrcache.profiles",
+    "held_out": "rrcache.profiler.accuracy",
     "get_context": "rrcache.gl",
 }
 

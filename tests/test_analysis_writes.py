@@ -89,7 +89,7 @@ def test_inout_and_out_parameters_written_by_component():
     # the inliner turns the calls into component assignments of the parameters' copies
     text = print_glsl(t.shader.unit)
     assert ".rgb = _rr_c_" in text and ".xy = exp(" in text
-    shaded = entry(t, "sin(_rr_k_1) * cos(_rr_k_1)")[0]
+    shaded = entry(t, "sin(k) * cos(k)")[0]
     split = [n for n in t.excluded + t.nodes if n.text.startswith("exp(") and "* sin(" in n.text][0]
     f = final(t)
     assert f.text == "c * vec4(lo, 1.0)"
@@ -196,8 +196,8 @@ def test_cli_nodes_json_and_instance_say_which_algorithms(tmp_path, capsys):
 
 def test_a_one_pass_profile_trains_only_what_one_pass_can_cache():
     from rrcache.pipeline import load_for_session
-    from rrcache.profile.settings import TrainingSettings
-    from rrcache.profile.train import training_order
+    from rrcache.profiles.settings import TrainingSettings
+    from rrcache.profiler.train import training_order
     from rrcache.session import load_session
 
     session = load_session(CORPUS / "implicit_lod.json")
@@ -296,7 +296,7 @@ def test_every_node_after_implicit_lod_lookups_reproduces_the_original_at_period
     checked = 0
     for node in work.table.nodes:
         for algorithm in node.algorithms:
-            variant = variant_for(work, node.id, 1, algorithm)
+            variant = variant_for(work, node.id, algorithm)
             with CachedRenderer(variant, session, work.prepared, (64, 64), period=1) as cached:
                 for ref in reference:
                     got = cached.render_frame(ref.index)

@@ -27,8 +27,12 @@ The ranking is computed once from single-node replacements, not re-evaluated aft
 step as a full greedy search would: each evaluation compiles and renders a shader, and this
 keeps the cost linear in the candidates. The means are those of the original shader.
 
->>> s = simplified_shader(work, {"n12": (0.5, 0.5, 0.5)})     # doctest: +SKIP
->>> s.prepared.source.count("vec3(0.5, 0.5, 0.5)")              # doctest: +SKIP
+>>> from rrcache.pipeline import load_for_session
+>>> from rrcache.session import load_session
+>>> work = load_for_session("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"))
+>>> node = [n for n in work.table.nodes if n.type == "vec3"][0]
+>>> s = simplified_shader(work, {node.id: (0.5, 0.25, 0.125)})
+>>> s.prepared.source.count("vec3(0.5, 0.25, 0.125)")
 1
 """
 from __future__ import annotations
@@ -143,7 +147,7 @@ def node_means(work, session, node_ids: Sequence[str], frames: Sequence[int], re
 
     means = {}
     for node_id in node_ids:
-        variant = variant_for(work, node_id, 1, "one-pass")
+        variant = variant_for(work, node_id, "one-pass")
         total = np.zeros(4)
         count = 0
         with CachedRenderer(variant, session, work.prepared, resolution, period=1, keep_payload=True) as r:

@@ -75,6 +75,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
+from rrcache.deep import deep
 from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
@@ -84,6 +85,7 @@ from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
 from rrcache.glsl.writes import out_qualifiers, written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
+from rrcache.analysis.source_text import attach_source_text
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
 __all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "cacheable_nodes",
@@ -114,6 +116,7 @@ class CacheableNode:
     call_chain: list[str]
     node: A.Expr = field(repr=False, compare=False)
     final: bool = False
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
     #: the algorithms that cannot cache this node, each with the reason
     invalid: dict = field(default_factory=dict)
 
@@ -130,7 +133,7 @@ class CacheableNode:
         return {"id": self.id, "type": self.type, "line": self.line, "column": self.column,
                 "text": self.text, "cost": self.cost, "call_chain": list(self.call_chain),
                 "final": self.final, "algorithms": self.algorithms,
-                "not_valid": dict(self.invalid)}
+                "not_valid": dict(self.invalid), "file": self.file}
 
 
 @dataclass
@@ -146,6 +149,7 @@ class ExcludedNode:
     type: str = ""
     cost: int = 0
     call_chain: list[str] = field(default_factory=list)
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
 
     #: a node left out is valid for no algorithm
     algorithms = property(lambda self: [])
@@ -154,7 +158,7 @@ class ExcludedNode:
     def to_json(self) -> dict:
         return {"id": self.id, "reason": self.reason, "line": self.line, "column": self.column,
                 "text": self.text, "type": self.type, "cost": self.cost,
-                "call_chain": list(self.call_chain), "algorithms": []}
+                "call_chain": list(self.call_chain), "algorithms": [], "file": self.file}
 
 
 @dataclass
@@ -212,6 +216,7 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
                        hint="node ids look like 'n42'; list them with 'rrcache nodes SHADER'")
 
 
+@deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
                     cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
@@ -228,7 +233,10 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     """
     with paused_gc():
         target = shader if analysed else analyse(shader, max_iterations)
-        return _Classifier(target, cheap_below).run()
+        table = _Classifier(target, cheap_below).run()
+        if not analysed:  # the text as written, and the file, of nodes from inlined code
+            attach_source_text(table, shader.unit)
+        return table
 
 
 # ----------------------------------------------------------------------------- classification
@@ -245,6 +253,40 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
 
 _DERIV = 1    # the value needs screen-space derivatives (invalid under one-pass)
 _SCREEN = 2   # the value depends on the pixel's screen position
+
+#: a node's text is printed whole up to this many syntax nodes; a larger one (a generated chain of
+#: thousands of terms) is abbreviated, so that listing every node of a chain stays linear
+_TEXT_NODES = 400
+
+
+def _bounded_texts(exprs):
+    """``text(e)`` for the expressions ``exprs``: the printed expression, abbreviated to its last
+    operand when its subtree is over ``_TEXT_NODES`` nodes (sizes counted once, without recursion)."""
+    size: dict[int, int] = {}
+    for root in exprs:
+        if id(root) in size:
+            continue
+        stack = [(root, False)]
+        while stack:
+            node, done = stack.pop()
+            if done:
+                size[id(node)] = 1 + sum(size[id(c)] for c in node.children())
+                continue
+            if id(node) in size:
+                continue
+            stack.append((node, True))
+            stack.extend((c, False) for c in node.children() if id(c) not in size)
+
+    def text(e) -> str:
+        n = size.get(id(e), 0)
+        if n <= _TEXT_NODES:
+            return print_expr(e)
+        if isinstance(e, A.Binary) and size.get(id(e.right), _TEXT_NODES + 1) <= _TEXT_NODES:
+            return f"(... {n:,} nodes ...) {e.op} {print_expr(e.right)}"
+        return f"(expression of {n:,} nodes)"
+
+    return text
+
 
 
 class _Def:
@@ -398,6 +440,7 @@ class _Classifier:
         self.records.sort(key=lambda r: order[id(r.expr)])
         final, cheap_below = self.final, self.cheap_below
         type_names: dict = {}
+        text = _bounded_texts([r.expr for r in self.records])
         for r in self.records:
             e, reason, cost = r.expr, r.reason, r.cost
             is_final = e is final
@@ -419,10 +462,10 @@ class _Classifier:
             chain = list(chain_of(loc))
             if reason is None:
                 invalid = {"one-pass": ONE_PASS_DERIVATIVE} if r.flags & _DERIV else {}
-                nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
-                                           chain, e, is_final, invalid))
+                nodes.append(CacheableNode(node_id, tname, line, column, text(e), cost,
+                                           chain, e, is_final, invalid=invalid))
             else:
-                excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
+                excluded.append(ExcludedNode(node_id, reason, line, column, text(e), e,
                                              tname, cost, chain))
         return NodeTable(self.shader, nodes, excluded)
 

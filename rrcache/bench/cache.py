@@ -120,13 +120,14 @@ class CacheBench:
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
         progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
-        limit_algorithm: str = "three-pass") -> CacheBench:
+        limit_algorithm: str = "three-pass", vertex: Optional[str] = None, include_dirs=()) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
-    ``limit_algorithm``."""
+    ``limit_algorithm``. ``vertex``: the user's vertex shader (None: the session's, else
+    generated)."""
     say = progress or (lambda _msg: None)
     session = load_session(session_path)
-    work = load_for_session(shader_path, session)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
@@ -145,7 +146,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     variants = {}
     for _group, _label, algorithm, period, _block, _run in plan:
         if algorithm not in variants:
-            variants[algorithm] = variant_for(work, node_id, period, algorithm)
+            variants[algorithm] = variant_for(work, node_id, algorithm)
     runs: list[list] = [[] for _ in plan]
     for repeat in range(repeats):
         for i, (_group, label, algorithm, period, block, run_period) in enumerate(plan):
@@ -164,7 +165,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
 
     say("limit: every pixel hits")
     probe = list(indices)[:: max(1, len(indices) // 5)][:5]
-    variant = variant_for(work, node_id, compare_period, limit_algorithm)
+    variant = variant_for(work, node_id, limit_algorithm)
     cached_ms, original_ms = [], []
     with Renderer(work.prepared, session, resolution) as original, \
             CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:

@@ -8,7 +8,7 @@ import json
 import click
 from rich.console import Console
 
-from rrcache.cli.options import resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, resolution_option as _resolution, vert_option
 
 
 @click.command("bench-cache")
@@ -23,7 +23,10 @@ from rrcache.cli.options import resolution_option as _resolution
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
-def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown):
+@vert_option
+@include_dirs_option
+def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown,
+            vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import run
 
@@ -33,7 +36,8 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
     except ValueError:
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
     bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution, repeats=repeats,
-                progress=lambda msg: err.print(f"[dim]{msg}[/dim]"))
+                include_dirs=include_dirs,
+                progress=lambda msg: err.print(f"[dim]{msg}[/dim]"), vertex=vert)
     if as_json:
         click.echo(json.dumps(bench.to_json()))
     else:

@@ -12,6 +12,7 @@ four selections (node, Δn, predicted/measured speed-up and error, PSNR).
 """
 from __future__ import annotations
 
+import math
 import sys
 import warnings
 
@@ -21,16 +22,24 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, 
                            TimeRemainingColumn)
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.errors import RRCacheError
-from rrcache.profile.profile import STORE_NAME, algorithm_line, default_out_dir, profile
-from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
+from rrcache.profiler.run import default_out_dir, profile
+from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.store import STORE_NAME
+from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
 
 
 def _periods(ctx, param, value):
     if value is None:
         return None
-    return parse_periods(value, "--periods")
+    return parse_periods(value, param.opts[0])  # the option given: --periods or --timing-periods
+
+
+def _seconds(ctx, param, value):
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter(f"{value} is not a finite number of seconds (e.g. 480)")
+    return value
 
 
 def _fmt(value, spec=".3g", none="–"):
@@ -63,7 +72,7 @@ def _fmt(value, spec=".3g", none="–"):
               help="Refresh periods at which each node is timed (default: 2,8,50).")
 @click.option("--algorithm", type=click.Choice(ALGORITHM_CHOICES), default="auto", show_default=True,
               help="auto: time three-pass and two-pass on the first node and keep the faster.")
-@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
               help=f"Skip nodes whose static cost is below this share of the costliest node's "
@@ -72,9 +81,13 @@ def _fmt(value, spec=".3g", none="–"):
               help="Render each selection over the first N frames (default: all).")
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
+@click.option("--wait", is_flag=True,
+              help="If another rrcache process is profiling into the same --out, wait for it (default: exit 2).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@vert_option
+@include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, wait, defines, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -102,7 +115,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         with bar, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh)
+                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh,
+                               vertex=vert, include_dirs=include_dirs, wait=wait)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
@@ -118,7 +132,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
 def _interrupted(out, err_console) -> None:
     from pathlib import Path
 
-    from rrcache.profile.store import read_store
+    from rrcache.profiles.store import read_store
 
     err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
     path = Path(out) / STORE_NAME

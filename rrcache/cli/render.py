@@ -23,12 +23,14 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, resolution_option, vert_option
+from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, render
-from rrcache.runtime import ALGORITHMS, FILTERS, REFRESH_MODES
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD,
+                             DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 
 
@@ -43,30 +45,32 @@ from rrcache.session import load_session
               help="Render at this size instead of the session's.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@include_dirs_option
 @click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=PERIOD, default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
-@click.option("--block", type=click.Choice(["1", "2", "4", "8"]), default="4", show_default=True,
-              help="Refresh block size k (pixels).")
-@click.option("--refresh", type=click.Choice(REFRESH_MODES), default="random", show_default=True)
+@click.option("--block", type=click.Choice([str(b) for b in BLOCK_SIZES]), default=str(DEFAULT_BLOCK),
+              show_default=True, help="Refresh block size k (pixels).")
+@click.option("--refresh", type=click.Choice(REFRESH_MODES), default=DEFAULT_REFRESH, show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
               help="Payload reconstruction filter.")
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
               help="Cache precision: 32- or 16-bit float.")
-@click.option("--depth-epsilon", type=float, default=1e-3, show_default=True,
+@click.option("--depth-epsilon", type=float, default=DEFAULT_DEPTH_EPSILON, show_default=True,
               help="Relative tolerance of the reprojected depth test.")
-def command(shader, session, out_dir, frame_count, resolution, as_json, defines, node, period, algorithm,
-            block, refresh, filter_, payload, depth_epsilon):
+@vert_option
+def command(shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, node, period, algorithm,
+            block, refresh, filter_, payload, depth_epsilon, vert):
     """Render SESSION through the fragment shader SHADER and report time and coverage per frame;
     with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
     loaded = load_session(session)
     if node is not None:
-        _render_cached(shader, loaded, parse_defines(defines), node, out_dir, frame_count, resolution, as_json,
+        _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
-                            filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console)
+                            filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console, vert)
         return
-    prepared = prepare_file(shader, loaded, parse_defines(defines))
+    prepared = prepare_file(shader, loaded, parse_defines(defines), all_include_dirs(include_dirs, loaded), vertex=vert)
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:
@@ -87,10 +91,11 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                 write_image(stem.with_suffix(".png"), frame.image)
             progress.advance(task)
 
-        result = render(prepared, loaded, indices, resolution=resolution, progress=done)
+        # streamed: each frame's figures are taken (and its images written) as it is done
+        result = render(prepared, loaded, indices, resolution=resolution, progress=done, keep_images=False)
 
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     if as_json:
         click.echo(json.dumps({
             "frames": len(result.frames),
@@ -115,13 +120,14 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                   + (f"; images in {out}" if out is not None else ""), highlight=False)
 
 
-def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resolution, as_json, opts, err_console):
+def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_count, resolution, as_json, opts,
+                   err_console, vert=None):
     from rrcache.harness.cached import compare
     from rrcache.pipeline import load_for_session, variant_for
 
-    work = load_for_session(shader, loaded, defines)
+    work = load_for_session(shader, loaded, defines, include_dirs, vertex=vert)
     entry = work.node(node)
-    variant = variant_for(work, node, opts["period"], opts["algorithm"], opts["filter"], opts["payload"])
+    variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"])
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:
@@ -144,7 +150,7 @@ def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resoluti
                          block=opts["block"], refresh=opts["refresh"], depth_epsilon=opts["depth_epsilon"],
                          on_frame=done)
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     summary = result.summary()
     if as_json:
         click.echo(json.dumps(dict(

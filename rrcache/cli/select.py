@@ -15,7 +15,8 @@ import math
 
 import click
 
-from rrcache.profile.profile import load_profile
+from rrcache.cli.options import include_dirs_option
+from rrcache.profiles.document import load_profile
 
 
 @click.command("select")
@@ -24,9 +25,11 @@ from rrcache.profile.profile import load_profile
 @click.option("--json", "as_json", is_flag=True, help="Print the choice as JSON.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default=None,
               help="Write the chosen shader files here.")
-def command(profile_path, max_error, as_json, out_dir):
+@include_dirs_option
+def command(profile_path, max_error, as_json, out_dir, include_dirs):
     """Select the node and refresh period predicted fastest within --max-error."""
     prof = load_profile(profile_path)
+    prof.include_dirs = list(include_dirs) + prof.include_dirs
     choice = prof.select(max_error)
     written = prof.write_variant(choice, out_dir) if out_dir else []
     if as_json:

@@ -32,6 +32,7 @@ from __future__ import annotations
 from typing import Any, Union
 
 from rrcache.errors import UnsupportedShaderError
+from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
@@ -58,17 +59,19 @@ def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: 
                 f"use --algorithm {' or '.join(valid)}" if valid else "pick another node")
 
 
+@deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
+             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 
     ``analysed`` is what the analysis returns (a checked, inlined and unrolled shader);
     ``node_id`` an id of its node table (or the expression node itself). ``filter`` is the
     payload reconstruction filter (``nearest``, ``bilinear``, ``catmull-rom``) and
     ``payload_dtype`` the cache precision (``f4``, or ``f2`` for half floats), recorded for the
-    runtime. Raises :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a
-    node that cannot be cached, or that the node table says ``algorithm`` cannot cache
-    (:func:`check_algorithm`).
+    runtime. ``vertex`` is the user's vertex shader (a
+    :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
+    :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
+    be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -83,13 +86,16 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     samplers: dict[str, list[str]] = {}
     runtime: dict[str, list[str]] = {}
     forms: dict[str, str] = {}
+    user_vertex = vertex
     for name in ALGORITHMS[algorithm]:
         built = build_pass(loc, name, filter)
         iface = interface(built.unit)
-        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit))
+        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), user_vertex)
         fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
         passes[name] = PassSource(vertex, fragment, line_map)
-        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_uniforms(vertex)))
+        vertex_names = (user_vertex.uniform_names(built.spec.lookup) if user_vertex is not None
+                        else vertex_uniforms(vertex))
+        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_names))
         samplers[name] = list(iface["sampler"])
         runtime[name] = runtime_uniforms(built.runtime_glsl)
         forms[name] = built.form
@@ -97,4 +103,5 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         algorithm=algorithm, node_id=node_id if not isinstance(node_id, A.Node) else None,
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
-        runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path)
+        runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
+        vertex_path=getattr(user_vertex, "path", None))

@@ -71,7 +71,7 @@ def _clone_fields(cls: type) -> tuple[str, ...]:
     a copy's list can change alone)."""
     syntax = set(A.child_fields(cls, decl_types=False))
     return tuple(f.name for f in fields(cls)
-                 if f.name in syntax or (f.type.startswith("list[") and f.name not in syntax))
+                 if f.name in syntax or f.type.startswith("list["))
 
 
 def clone(node, loc_fn: Optional[Callable[[SourceLoc], SourceLoc]] = None):

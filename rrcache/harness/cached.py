@@ -24,13 +24,14 @@ from typing import Callable, Optional
 import moderngl
 import numpy as np
 
+from rrcache import watchdog
 from rrcache.gl.context import get_context
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
-from rrcache.runtime import CacheRuntime
+from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
 
 #: the largest finite 16-bit float: payload values beyond it would be stored as ±inf
 HALF_MAX = 65504.0
@@ -51,6 +52,7 @@ class CachedFrame:
     ms: float
     hit_map: Optional[np.ndarray] = None
     payload: Optional[np.ndarray] = None
+    cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
 
 
 class CachedRenderer:
@@ -64,7 +66,8 @@ class CachedRenderer:
     """
 
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
-                 period: int = 8, block: int = 4, refresh: str = "random", depth_epsilon: float = 1e-3,
+                 period: int = DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+                 depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None):
         self.ctx = ctx or get_context()
@@ -91,7 +94,9 @@ class CachedRenderer:
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
-                clear_color=session_background(session))
+                clear_color=session_background(session),
+                blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
+                phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1))
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:
@@ -132,9 +137,12 @@ class CachedRenderer:
         self.runtime.reset()
         self._last = None
 
-    def _frame(self, index: int, hit_box: Optional[dict]):
+    def _frame(self, hit_box: Optional[dict]):
+        """Run the passes of the frame set on the drawer; with ``hit_box`` the exact hit map is
+        read after the first pass into ``hit_box["map"]``."""
         def read_hits():
             hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
+        self.drawer.render_shadow_map()  # the light's depth pass is part of the frame
         return self.runtime.frame(self.drawer.draw, after_first_pass=read_hits if hit_box is not None else None)
 
     def render_frame(self, index: int) -> CachedFrame:
@@ -146,17 +154,20 @@ class CachedRenderer:
             self.runtime.reset()
         self.drawer.set_frame(index)
         if not self._warm:
-            self._frame(index, None)
+            self._frame(None)
             if self._check_half:
                 self._settle_payload()
             self.runtime.reset()
             self._warm = True
         hit_box = {} if self.hit_maps else None
-        ctx.finish()
-        start = time.perf_counter()
-        stats = self._frame(index, hit_box)
-        ctx.finish()
-        ms = (time.perf_counter() - start) * 1000.0
+        with watchdog.frame(f"frame {index} of the cached variant"):
+            ctx.finish()
+            cpu_start = time.process_time()
+            start = time.perf_counter()
+            stats = self._frame(hit_box)
+            ctx.finish()
+            ms = (time.perf_counter() - start) * 1000.0
+            cpu_ms = (time.process_time() - cpu_start) * 1000.0
         self._last = index
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0
@@ -171,7 +182,7 @@ class CachedRenderer:
         else:  # one-pass: a dynamic branch, nothing for a query to count
             hits = misses = None
         payload = self.runtime.read_payload() if self.keep_payload else None
-        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
+        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload, cpu_ms)
 
     def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None) -> float:
         """The cached pipeline's best case: frame ``index`` shown again and again with nothing
@@ -197,6 +208,7 @@ class CachedRenderer:
                     between()
                 self.ctx.finish()
                 start = time.perf_counter()
+                self.drawer.render_shadow_map()
                 stats = self.runtime.frame(self.drawer.draw)
                 self.ctx.finish()
                 if i >= 2:
@@ -308,9 +320,9 @@ class Comparison:
         }
 
 
-def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
-            resolution: Optional[tuple[int, int]] = None, block: int = 4, refresh: str = "random",
-            depth_epsilon: float = 1e-3, hit_maps: bool = False,
+def compare(variant, session, prepared: PreparedShader, frames, period: int = DEFAULT_PERIOD,
+            resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+            depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
             window: Optional[tuple[int, int, int, int]] = None) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating

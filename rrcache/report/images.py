@@ -157,7 +157,8 @@ class FrameShots:
         if work is None:
             from rrcache.pipeline import load_for_session
 
-            work = load_for_session(profile.shader, self.session, profile.defines)
+            work = load_for_session(profile.shader, self.session, profile.defines,
+                                    getattr(profile, "include_dirs", ()), vertex=profile.vertex)
         self.work = work
         self.size = image_size(self.session.resolution, max_width)
         self._originals: dict = {}
@@ -169,7 +170,7 @@ class FrameShots:
         if node not in self._variants:
             from rrcache.pipeline import variant_for
 
-            self._variants[node] = variant_for(self.work, node, None, self.profile.algorithm)
+            self._variants[node] = variant_for(self.work, node, self.profile.algorithm)
         return self._variants[node]
 
     def frame_for(self, period: Optional[int]) -> int:
@@ -202,11 +203,9 @@ class FrameShots:
         from rrcache.harness.cached import CachedRenderer
         from rrcache.harness.metrics import mean_l2
 
-        settings = self.profile.settings
         variant = self.variant(node)
         with CachedRenderer(variant, self.session, self.work.prepared, self.size, period=period,
-                            block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon,
-                            hit_maps=True, keep_payload=True) as cached:
+                            hit_maps=True, keep_payload=True, **self.profile.settings.cache_options()) as cached:
             for index in range(frame + 1):
                 got = cached.render_frame(index)
         mask = ref.mask

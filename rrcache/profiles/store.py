@@ -25,15 +25,18 @@ from pathlib import Path
 from typing import Iterable, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.selection import Selection, parts_from_json, parts_to_json
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: the store's file name in a profile folder
+STORE_NAME = "profile.sqlite"
 
 SCHEMA = """\
 -- rrcache profile store; the schema version is in meta('schema_version').
 --
 -- meta: what the file belongs to. Keys: schema_version, rrcache_version, shader_hash,
 --   session_hash, settings_json, settings_hash, created, updated (unix seconds); and, once the
---   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profile.plan),
+--   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profiler.plan),
 --   kept so that a resumed run renders exactly what the first one did.
 CREATE TABLE meta (
     key TEXT PRIMARY KEY,
@@ -136,13 +139,14 @@ CREATE TABLE overhead (
 );
 
 -- validation: a selection (label e1..e4 at max_error) rendered beside the original at full
---   resolution; predicted figures from the models, measured ones from the render. node NULL =
---   the original shader (nothing rendered: error 0, speed-up 1).
+--   resolution; predicted figures from the models, measured ones from the render. parts: what is
+--   cached, as the JSON list of rrcache.selection.parts_to_json ([] = the original shader:
+--   nothing rendered, error 0, speed-up 1); algorithm: the cache algorithm it ran with.
 CREATE TABLE validation (
     label TEXT PRIMARY KEY,
     max_error REAL NOT NULL,
-    node TEXT,
-    period INTEGER,
+    parts TEXT NOT NULL,
+    algorithm TEXT,
     predicted_error REAL NOT NULL,
     predicted_ms REAL NOT NULL,
     predicted_speedup REAL NOT NULL,
@@ -155,6 +159,10 @@ CREATE TABLE validation (
     frames INTEGER NOT NULL
 );
 """
+
+_VALIDATION_COLUMNS = ("label", "max_error", "parts", "algorithm", "predicted_error", "predicted_ms",
+                       "predicted_speedup", "measured_error", "measured_psnr", "measured_ms", "measured_original_ms",
+                       "measured_speedup", "hit_rate", "frames")
 
 _TABLES = ("meta", "run_log", "reference_frame", "error_run", "error_frame", "timing_run", "timing_frame",
            "reference_timing", "overhead", "validation")
@@ -230,22 +238,49 @@ class TimingFrame:
     original_ms: float
 
 
-@dataclass
-class ValidationRow:
-    label: str
-    max_error: float
-    node: Optional[str]
-    period: Optional[int]
-    predicted_error: float
-    predicted_ms: float
-    predicted_speedup: float
-    measured_error: float
-    measured_psnr: float
-    measured_ms: float
-    measured_original_ms: float
-    measured_speedup: float
-    hit_rate: float
-    frames: int
+_INF = float("inf")
+_REAL, _INT = "number", "integer"
+#: the columns a stored row must keep in range: (kind, low, high); None: no bound
+_RANGES: dict[str, dict[str, tuple]] = {
+    "error_run": {"period": (_INT, 1, None), "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None),
+                  "hit_rate": (_REAL, 0.0, 1.0), "hits": (_INT, 0, None), "misses": (_INT, 0, None),
+                  "covered": (_INT, 0, None), "frames": (_INT, 0, None), "wall_s": (_REAL, 0.0, None)},
+    "error_frame": {"frame": (_INT, 0, None), "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None),
+                    "hits": (_INT, 0, None), "misses": (_INT, 0, None), "covered": (_INT, 0, None),
+                    "left_out": (_INT, 0, None)},
+    "timing_frame": {"period": (_INT, 1, None), "frame": (_INT, 0, None), "hits": (_INT, 0, None),
+                     "misses": (_INT, 0, None), "ms": (_REAL, 0.0, None), "original_ms": (_REAL, 0.0, None)},
+    "reference_timing": {"frame": (_INT, 0, None), "ms": (_REAL, 0.0, None), "covered": (_INT, 0, None)},
+    "overhead": {"width": (_INT, 1, None), "height": (_INT, 1, None), "frames": (_INT, 1, None),
+                 "ms": (_REAL, 0.0, None)},
+    "validation": {"max_error": (_REAL, 0.0, None), "period": (_INT, 1, None), "predicted_error": (_REAL, 0.0, None),
+                   "predicted_ms": (_REAL, 0.0, None), "predicted_speedup": (_REAL, 0.0, None),
+                   "measured_error": (_REAL, 0.0, None), "measured_psnr": (_REAL, None, None),
+                   "measured_ms": (_REAL, 0.0, None), "measured_original_ms": (_REAL, 0.0, None),
+                   "measured_speedup": (_REAL, 0.0, None), "hit_rate": (_REAL, 0.0, 1.0), "frames": (_INT, 0, None)},
+}
+#: the columns that name a row in an error message
+_KEYS = ("node", "period", "frame", "label")
+
+
+def _out_of_range(value, kind: str, low, high) -> Optional[str]:
+    """Why ``value`` does not fit (None: it fits). NULL is allowed only where the schema allows
+    it (``validation.node/period``: the original shader)."""
+    if value is None:
+        return None if kind == _INT else "is missing"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"is not a {kind}"
+    if kind == _INT and not isinstance(value, int):
+        return "is not an integer"
+    if isinstance(value, float) and value != value:
+        return "is not a number (NaN)"
+    if isinstance(value, float) and value in (_INF, -_INF) and not (low is None and high is None):
+        return "is infinite"
+    if low is not None and value < low:
+        return f"is below {low}"
+    if high is not None and value > high:
+        return f"is above {high}"
+    return None
 
 
 def _refuse(path: Path, message: str, hint: str) -> RRCacheError:
@@ -287,7 +322,12 @@ class ProfileStore:
             conn = cls._connect_existing(path)
             store = cls(path, conn)
             try:
-                store._check(key)
+                if store._is_empty():
+                    # a run killed while it created the store (its one transaction never
+                    # committed) leaves an SQLite file with no tables: nothing to lose, start it
+                    store._create(key)
+                else:
+                    store._check(key)
             except BaseException:
                 conn.close()
                 raise
@@ -317,6 +357,12 @@ class ProfileStore:
             detail = "; ".join(str(r[0]) for r in rows[:3])
             raise _refuse(path, f"the profile store is damaged (integrity check: {detail})", _FRESH_HINT)
         return conn
+
+    def _is_empty(self) -> bool:
+        try:
+            return self.conn.execute("SELECT COUNT(*) FROM sqlite_master").fetchone()[0] == 0
+        except sqlite3.DatabaseError:
+            return False  # _check reports the damage
 
     def _create(self, key: StoreKey) -> None:
         conn = self.conn
@@ -350,6 +396,9 @@ class ProfileStore:
         except sqlite3.DatabaseError as err:
             raise _refuse(path, f"an SQLite file that is not a profile store ({err})", _FRESH_HINT) from None
         version = meta.get("schema_version")
+        if version in _MIGRATIONS and "validation" in tables:
+            _MIGRATIONS[version](self.conn)
+            version = str(SCHEMA_VERSION)
         if version != str(SCHEMA_VERSION):
             raise _refuse(path, f"profile store schema {version!r}, this rrcache reads schema {SCHEMA_VERSION}"
                           if version else "an SQLite file that is not a profile store (no schema version)", _FRESH_HINT)
@@ -362,30 +411,37 @@ class ProfileStore:
         self.conn.execute("PRAGMA journal_mode=WAL")
 
     # ------------------------------------------------------------------ transactions
-    def _write(self, statements: Iterable[tuple[str, tuple]]) -> None:
+    def _write(self, statements: Iterable[tuple[str, tuple]]) -> sqlite3.Cursor:
+        """Run ``statements`` in one transaction; a failed write (a full disk, a read-only
+        folder) rolls back and raises an :class:`RRCacheError`: every earlier run stays stored."""
         conn = self.conn
-        conn.execute("BEGIN IMMEDIATE")
+        cur = None
         try:
-            for sql, args in statements:
-                conn.execute(sql, args)
-            conn.execute("UPDATE meta SET value = ? WHERE key = 'updated'", (repr(time.time()),))
-            conn.execute("COMMIT")
-        except BaseException:
-            if conn.in_transaction:
-                conn.execute("ROLLBACK")
-            raise
+            conn.execute("BEGIN IMMEDIATE")
+            try:
+                for sql, args in statements:
+                    cur = conn.execute(sql, args)
+                last = cur
+                conn.execute("UPDATE meta SET value = ? WHERE key = 'updated'", (repr(time.time()),))
+                conn.execute("COMMIT")
+            except BaseException:
+                if conn.in_transaction:
+                    try:
+                        conn.execute("ROLLBACK")
+                    except sqlite3.Error:
+                        pass
+                raise
+        except sqlite3.IntegrityError:
+            raise  # a run stored twice: a bug of the caller, not of the disk
+        except sqlite3.Error as err:
+            raise _refuse(self.path, f"cannot write the profile store: {err}",
+                          "free disk space or make the folder writable; what was stored before is kept, "
+                          "and running the same command again resumes") from None
+        return last
 
     def begin_run(self) -> int:
         """Log the start of a ``profile`` invocation; its id tags what it computes."""
-        conn = self.conn
-        conn.execute("BEGIN IMMEDIATE")
-        try:
-            cur = conn.execute("INSERT INTO run_log(started, status) VALUES (?, 'running')", (time.time(),))
-            conn.execute("COMMIT")
-        except BaseException:
-            if conn.in_transaction:
-                conn.execute("ROLLBACK")
-            raise
+        cur = self._write([("INSERT INTO run_log(started, status) VALUES (?, 'running')", (time.time(),))])
         self.run_id = int(cur.lastrowid)
         return self.run_id
 
@@ -442,18 +498,23 @@ class ProfileStore:
         self._write([("INSERT OR REPLACE INTO overhead VALUES (1, ?, ?, ?, ?, ?)",
                       (node, int(size[0]), int(size[1]), int(frames), float(ms)))])
 
-    def add_validation(self, row: ValidationRow) -> None:
-        self._write([("INSERT OR REPLACE INTO validation VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                      (row.label, row.max_error, row.node, row.period, row.predicted_error, row.predicted_ms,
-                       row.predicted_speedup, row.measured_error, row.measured_psnr, row.measured_ms,
-                       row.measured_original_ms, row.measured_speedup, row.hit_rate, row.frames))])
+    def add_validation(self, sel: Selection) -> None:
+        """A measured selection (its ``label`` is the key; a later one replaces it)."""
+        if not sel.measured:
+            raise ValueError("add_validation needs a measured selection")
+        self._write([(f"INSERT OR REPLACE INTO validation({', '.join(_VALIDATION_COLUMNS)}) "
+                      f"VALUES ({', '.join('?' * len(_VALIDATION_COLUMNS))})",
+                      (sel.label, sel.max_error, json.dumps(parts_to_json(sel.parts)), sel.algorithm,
+                       sel.predicted_error, sel.predicted_ms, sel.predicted_speedup, sel.measured_error,
+                       sel.measured_psnr, sel.measured_ms, sel.measured_original_ms, sel.measured_speedup,
+                       sel.hit_rate, sel.frames))])
 
     # ------------------------------------------------------------------ readers
     def meta(self) -> dict:
         return dict(self.conn.execute("SELECT key, value FROM meta"))
 
     def plan(self) -> Optional[dict]:
-        """The windows the first run chose (``rrcache.profile.plan.Plan.to_json``), or None."""
+        """The windows the first run chose (``rrcache.profiler.plan.Plan.to_json``), or None."""
         row = self.conn.execute("SELECT value FROM meta WHERE key = 'plan'").fetchone()
         if row is None:
             return None
@@ -477,22 +538,44 @@ class ProfileStore:
         return self.conn.execute("SELECT 1 FROM timing_run WHERE node = ? AND period = ?",
                                  (node, int(period))).fetchone() is not None
 
+    def _rows(self, table: str, sql: str, args: tuple = ()) -> list[tuple]:
+        """The rows of ``sql``, each checked against :data:`_RANGES` for ``table``: a stored value
+        of the wrong type, not finite or out of its range (a tampered or damaged store) is refused
+        with the table, the row and the column, never used."""
+        try:
+            cur = self.conn.execute(sql, args)
+            names = [d[0] for d in cur.description]
+            rows = cur.fetchall()
+        except sqlite3.DatabaseError as err:
+            raise _refuse(self.path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+        ranges = _RANGES[table]
+        for row in rows:
+            for name, value in zip(names, row):
+                rule = ranges.get(name)
+                if rule is not None:
+                    problem = _out_of_range(value, *rule)
+                    if problem:
+                        ident = ", ".join(f"{k}={v!r}" for k, v in zip(names, row) if k in _KEYS)
+                        raise _refuse(self.path, f"stored row {table}({ident}): {name} = {value!r} {problem}",
+                                      "the store was damaged or edited; " + _FRESH_HINT)
+        return rows
+
     def error_runs(self, node: Optional[str] = None) -> list[ErrorRun]:
         sql = "SELECT node, period, mean_error, psnr, hit_rate, hits, misses, covered, frames, wall_s FROM error_run"
-        rows = self.conn.execute(sql + (" WHERE node = ?" if node else "") + " ORDER BY node, period",
-                                 (node,) if node else ())
+        rows = self._rows("error_run", sql + (" WHERE node = ?" if node else "") + " ORDER BY node, period",
+                          (node,) if node else ())
         return [ErrorRun(*r) for r in rows]
 
     def error_frames(self, node: str, period: int) -> list[ErrorFrame]:
-        rows = self.conn.execute("SELECT frame, mean_error, psnr, hits, misses, covered, left_out FROM error_frame "
-                                 "WHERE node = ? AND period = ? ORDER BY frame", (node, int(period)))
+        rows = self._rows("error_frame", "SELECT frame, mean_error, psnr, hits, misses, covered, left_out FROM "
+                          "error_frame WHERE node = ? AND period = ? ORDER BY frame", (node, int(period)))
         return [ErrorFrame(*r) for r in rows]
 
     def timing_frames(self, node: str) -> dict[int, list[TimingFrame]]:
         """Per timing period, the timed frames of ``node``."""
         out: dict[int, list[TimingFrame]] = {}
-        rows = self.conn.execute("SELECT period, frame, hits, misses, ms, original_ms FROM timing_frame "
-                                 "WHERE node = ? ORDER BY period, frame", (node,))
+        rows = self._rows("timing_frame", "SELECT period, frame, hits, misses, ms, original_ms FROM timing_frame "
+                          "WHERE node = ? ORDER BY period, frame", (node,))
         for period, *rest in rows:
             out.setdefault(int(period), []).append(TimingFrame(*rest))
         return out
@@ -501,17 +584,29 @@ class ProfileStore:
         return {r[0] for r in self.conn.execute("SELECT DISTINCT node FROM timing_run")}
 
     def reference_timing(self) -> list[tuple[int, float, int]]:
-        return [tuple(r) for r in self.conn.execute("SELECT frame, ms, covered FROM reference_timing ORDER BY frame")]
+        return [tuple(r) for r in self._rows("reference_timing",
+                                             "SELECT frame, ms, covered FROM reference_timing ORDER BY frame")]
 
     def overhead(self) -> Optional[dict]:
-        row = self.conn.execute("SELECT node, width, height, frames, ms FROM overhead WHERE id = 1").fetchone()
-        if row is None:
+        rows = self._rows("overhead", "SELECT node, width, height, frames, ms FROM overhead WHERE id = 1")
+        if not rows:
             return None
-        return dict(zip(("node", "width", "height", "frames", "ms"), row))
+        return dict(zip(("node", "width", "height", "frames", "ms"), rows[0]))
 
-    def validations(self) -> list[ValidationRow]:
-        rows = self.conn.execute("SELECT * FROM validation ORDER BY label")
-        return [ValidationRow(*r) for r in rows]
+    def validations(self) -> list[Selection]:
+        """The measured selections, in label order."""
+        rows = self._rows("validation", f"SELECT {', '.join(_VALIDATION_COLUMNS)} FROM validation ORDER BY label")
+        out = []
+        for label, max_error, parts, algorithm, *figures in rows:
+            try:
+                decoded = parts_from_json(json.loads(parts), f"validation[{label}].parts")
+            except ValueError:
+                raise _refuse(self.path, f"validation {label!r}: its parts are not JSON", _FRESH_HINT) from None
+            except RRCacheError as err:
+                raise _refuse(self.path, str(err), _FRESH_HINT) from None
+            out.append(Selection(decoded, *figures[:3], label=label, max_error=max_error,
+                                 algorithm=algorithm).with_measurement(*figures[3:]))
+        return out
 
     def spent_s(self) -> float:
         """Training seconds stored so far (error and timing runs): what the budget has spent."""
@@ -551,6 +646,35 @@ class ProfileStore:
         self.close()
 
 
+def _migrate_1(conn: sqlite3.Connection) -> None:
+    """Schema 1 → 2 in one transaction: the validation rows' ``node``/``period`` columns become
+    ``parts`` (the algorithm was not recorded: NULL)."""
+    conn.execute("BEGIN IMMEDIATE")
+    try:
+        old = conn.execute("SELECT label, max_error, node, period, predicted_error, predicted_ms, predicted_speedup, "
+                           "measured_error, measured_psnr, measured_ms, measured_original_ms, measured_speedup, "
+                           "hit_rate, frames FROM validation").fetchall()
+        conn.execute("DROP TABLE validation")
+        table = SCHEMA[SCHEMA.index("CREATE TABLE validation"):]
+        conn.execute(table[:table.index(";")])
+        for label, max_error, node, period, *figures in old:
+            parts = [] if node is None else [{"kind": "cache", "node": node, "period": int(period)}]
+            conn.execute(f"INSERT INTO validation({', '.join(_VALIDATION_COLUMNS)}) VALUES "
+                         f"({', '.join('?' * len(_VALIDATION_COLUMNS))})",
+                         (label, max_error, json.dumps(parts), None, *figures))
+        conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
+        conn.execute("COMMIT")
+    except BaseException:
+        if conn.in_transaction:
+            conn.execute("ROLLBACK")
+        raise
+
+
+#: older schema version -> the function that upgrades a store in place (schema 1 kept a
+#: validation's node and period in two columns; schema 2 keeps its parts)
+_MIGRATIONS = {"1": _migrate_1}
+
+
 def _statements(script: str) -> list[str]:
     """The statements of :data:`SCHEMA` (comments dropped)."""
     lines = [line for line in script.splitlines() if not line.lstrip().startswith("--")]
@@ -567,7 +691,11 @@ def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     store = ProfileStore(path, conn)
     try:
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-        if "meta" not in tables or dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") != str(SCHEMA_VERSION):
+        version = dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") if "meta" in tables else None
+        if version in _MIGRATIONS and "validation" in tables:
+            _MIGRATIONS[version](conn)
+            version = str(SCHEMA_VERSION)
+        if version != str(SCHEMA_VERSION):
             raise _refuse(path, "an SQLite file that is not a profile store", _FRESH_HINT)
     except sqlite3.DatabaseError as err:
         conn.close()
