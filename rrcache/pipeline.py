@@ -34,7 +34,7 @@ from rrcache.compiler import Variant, instance
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
 from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
-from rrcache.selection import CachedNode, Selection
+from rrcache.selection import AmortizedLoop, CachedNode, Selection
 
 
 @dataclass
@@ -104,5 +104,15 @@ def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Varia
     if len(selection.parts) == 1 and isinstance(selection.parts[0], CachedNode):
         part = selection.parts[0]
         return variant_for(work, part.node, algorithm), int(part.period)
+    if len(selection.parts) == 1 and isinstance(selection.parts[0], AmortizedLoop):
+        from rrcache.compiler.amortize import instance_amortized
+        from rrcache.runtime.cache import DEFAULT_PERIOD
+
+        part = selection.parts[0]
+        variant = instance_amortized(work.shader, part.estimator, algorithm, samples=part.samples,
+                                     blend=part.blend, phase=part.phase, history=part.history,
+                                     vertex=work.vertex)
+        # an amortized variant does not use the refresh rule: the period is the runtime's default
+        return variant, DEFAULT_PERIOD
     raise RRCacheError(f"no variant for a selection of kind {selection.kind!r}", "selection",
                        hint="the original shader needs none; other kinds are compiled where they are added")

@@ -115,6 +115,7 @@ class DynresRenderer:
         self.drawer.set_frame(index)
         ctx.finish()
         start = time.perf_counter()
+        self.drawer.render_shadow_map()  # the light's depth pass is part of the frame
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         self._low_fbo.use()

@@ -105,6 +105,17 @@ def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX
     return unit
 
 
+def fold_copy(body: A.Compound, unit: A.TranslationUnit) -> list:
+    """Fold what one copy of a loop body made constant once its index is a literal (an ``if`` or
+    ``?:`` on the index keeps the branch taken, inner constant loops unroll), as this pass does to
+    each iteration's copy; returns the copy's statements. Used by
+    :mod:`rrcache.compiler.amortize` for the subsets it unrolls."""
+    u = _Unroller(unit, {}, DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL)
+    while A.substitute(body, u.constant_choice, u.chosen_arm):
+        pass
+    return u.stmt(body)
+
+
 class _Unroller:
     def __init__(self, unit, consts, max_iterations, max_total, max_size=DEFAULT_MAX_SIZE):
         self.consts = consts

@@ -29,7 +29,7 @@ def main(argv=None) -> None:
     try:
         from rrcache.glsl.ast import iter_exprs
     except ImportError:      # versions before the AST traversal moved to glsl/ast.py
-        from rrcache.analysis._tree import iter_exprs
+        from rrcache.glsl.ast import iter_exprs
     from rrcache.glsl.frontend import parse_shader
 
     source = open(args.shader, encoding="utf-8").read()

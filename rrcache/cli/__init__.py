@@ -25,6 +25,7 @@ _COMMANDS = {
     "bench-frontend": "bench_frontend",
     "instance": "instance",
     "bench-cache": "bench_cache",
+    "bench-amortize": "bench_amortize",
     "bench": "bench",
     "profile": "profile",
     "select": "select",

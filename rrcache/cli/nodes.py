@@ -21,6 +21,12 @@ reason). The last line (``language`` in JSON: version, profile, ``es``, ``assume
 ``text``) says which GLSL the shader was read as; a shader without ``#version`` is GLSL ES 1.00
 when it has a ``precision`` statement or tests ``GL_ES`` (as ES sketch tools run it), else
 desktop GLSL 1.10.
+
+The JSON also has ``estimators``: the loops that sum independent samples (``{"id", "line",
+"column", "samples", "text", "accumulators", "pragma"}``, see :mod:`rrcache.analysis.estimators`;
+``#pragma rrcache estimator`` before a loop marks one the analysis cannot prove) and
+``not_estimators``, the other loops with the reason. The text table lists the estimators after
+the nodes (with ``--all``, the other loops too).
 """
 from __future__ import annotations
 
@@ -32,6 +38,7 @@ import os
 import re
 
 from rrcache.analysis.cacheable import REASONS
+from rrcache.analysis.estimators import display_name, find_estimators
 from rrcache.analysis.source_text import display_file
 from rrcache.cli.options import include_dirs_option, parse_defines, vert_option
 from rrcache.errors import RRCacheError
@@ -127,6 +134,20 @@ def _check_vertex(loaded, user) -> None:
                           {n: loc for n, (_t, loc) in loaded.inputs.items()})
 
 
+def format_estimators(estimators, show_all: bool) -> str:
+    """The estimator lines of the text table (with ``show_all``, the other loops and why)."""
+    lines = []
+    for e in estimators.estimators:
+        accs = ", ".join(display_name(a) for a in e.accumulators)
+        lines.append(f"estimator {e.id}  {e.line}:{e.column}  {e.samples} samples into {accs}"
+                     f"{'  (pragma)' if e.pragma else ''}  {_short(display_name(e.text))}")
+    if show_all:
+        for r in estimators.rejected:
+            lines.append(f"loop {r.id}  {r.line}:{r.column}  not an estimator: {r.reason}  "
+                         f"{_short(display_name(r.text))}")
+    return "\n".join(lines)
+
+
 @click.command("nodes")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
@@ -164,6 +185,7 @@ def command(shader, as_json, show_all, define, max_unroll, include_dirs, session
         tested = model_vertex_tests(loaded.files or [shader], work.defines)
         mesh_hint = _mesh_hint(tested) if tested else None
     _check_vertex(loaded, work.vertex)
+    estimators = find_estimators(loaded)
     if as_json:
         doc = table.to_json(shader)
         if not show_all:
@@ -171,9 +193,13 @@ def command(shader, as_json, show_all, define, max_unroll, include_dirs, session
         doc["language"] = {"version": loaded.version, "profile": loaded.profile, "es": loaded.es,
                            "assumed": loaded.assumed is not None, "text": loaded.language}
         doc["hint"] = mesh_hint
+        doc.update(estimators.to_json())
         click.echo(json.dumps(doc, indent=2))
     else:
         click.echo(format_table(table, show_all))
+        lines = format_estimators(estimators, show_all)
+        if lines:
+            click.echo(lines)
         click.echo(f"read as {loaded.language}")
         if mesh_hint:
             click.echo(f"hint: {mesh_hint}")

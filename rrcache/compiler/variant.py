@@ -66,6 +66,9 @@ class Variant:
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
     vertex_path: Optional[str] = None  # the user's vertex shader (None: generated)
+    # an amortized estimator (rrcache.compiler.amortize): {"estimator", "samples" (m), "of" (N),
+    # "lambda", "phase", "cycle", "history", "accumulators"}; None for a cached node
+    amortized: Optional[dict] = None
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -112,6 +115,7 @@ class Variant:
             "uniforms": sorted({u for names in self.uniforms.values() for u in names}),
             "textures": sorted({s for names in self.samplers.values() for s in names}),
             **({"runtime": dict(runtime)} if runtime else {}),
+            **({"amortized": dict(self.amortized)} if self.amortized else {}),
         }
 
     def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,

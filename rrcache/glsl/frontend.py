@@ -69,6 +69,7 @@ class Shader:
     outputs: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
     defines: dict[str, object] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
+    pragmas: list = field(default_factory=list)  # (text after #pragma, SourceLoc) in source order
     file_hashes: list[str] = field(default_factory=list)
     #: without ``#version``: the language assumed and why (``Preprocessed.assumed``)
     assumed: Optional[str] = None
@@ -134,7 +135,8 @@ def parse_shader(source: str, filename: str = "<string>",
                   if s.type.contains_opaque()},
         inputs={n: (s.type, s.loc) for n, s in info.inputs.items() if n in info.used_globals},
         outputs={n: (s.type, s.loc) for n, s in info.outputs.items()},
-        defines=defines, files=files, file_hashes=digests, assumed=pp.assumed)
+        defines=defines, files=files, file_hashes=digests, assumed=pp.assumed,
+        pragmas=list(pp.pragmas))
 
 
 def check_size(unit: A.TranslationUnit, filename: str) -> None:

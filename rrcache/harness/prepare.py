@@ -19,7 +19,7 @@ from typing import Mapping, Optional, Sequence
 
 from rrcache.deep import deep
 from rrcache.errors import SourceLoc
-from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes
+from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes, shadow_defines
 
 
 @dataclass(frozen=True)
@@ -143,8 +143,8 @@ def combined_hash(fragment_hash: str, vertex=None) -> str:
 
 def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[str, str]] = None,
                     include_dirs=()):
-    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes:
-    the one place a shader is loaded for a session. Returns ``(shader, defines)``: the front-end
+    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes (and
+    a session light's ``LIGHT_SHADOWMAP*``): the one place a shader is loaded for a session. Returns ``(shader, defines)``: the front-end
     ``Shader`` and every define it was loaded with.
 
     ``session_or_attributes`` is a session (the union of its meshes' attributes counts), an
@@ -160,7 +160,9 @@ def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[
     if session_or_attributes is None:
         all_defines = {}
     elif hasattr(session_or_attributes, "objects"):
-        all_defines = mesh_defines(session_attributes(session_or_attributes))
+        # the meshes' MODEL_VERTEX_* and, when the light has a shadow map, LIGHT_SHADOWMAP*
+        all_defines = {**mesh_defines(session_attributes(session_or_attributes)),
+                       **shadow_defines(session_or_attributes)}
     else:
         all_defines = mesh_defines(frozenset(session_or_attributes))
     all_defines.update(defines or {})

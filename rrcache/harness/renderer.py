@@ -53,6 +53,7 @@ class FrameResult:
     ms: float
     mask: np.ndarray
     samples_passed: int = 0
+    cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
 
 
 @dataclass
@@ -148,6 +149,10 @@ class Renderer:
         return check_frame_index(self.session, index)
 
     def _draw(self, index: int) -> tuple[float, int]:
+        ms, samples, self._cpu_ms = self._draw_timed(index)
+        return ms, samples
+
+    def _draw_timed(self, index: int) -> tuple[float, int, float]:
         ctx = self.ctx
         self.drawer.set_frame(index)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -156,13 +161,20 @@ class Renderer:
         self.fbo.viewport = (0, 0, *self.size)
         background = session_background(self.session)
         ctx.finish()
+        cpu_start = time.process_time()
         start = time.perf_counter()
+        if self.drawer.shadow_map is not None:  # the light's depth pass is part of the frame
+            self.drawer.render_shadow_map()
+            ctx.depth_func = "<"
+            self.fbo.use()
+            self.fbo.viewport = (0, 0, *self.size)
         self.fbo.clear(*background, depth=1.0)
         with self._query:
             self.drawer.draw(self.program)
         ctx.finish()
         ms = (time.perf_counter() - start) * 1000.0
-        return ms, int(self._query.samples)
+        cpu_ms = (time.process_time() - cpu_start) * 1000.0
+        return ms, int(self._query.samples), cpu_ms
 
     def render_frame(self, index: int) -> FrameResult:
         """Render frame ``index`` (an int in ``0..session.frames-1``) and read it back.
@@ -179,7 +191,7 @@ class Renderer:
         image = crop_rows(np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4), self.window).copy()
         depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
         mask = depth < 1.0
-        return FrameResult(index, image, int(mask.sum()), ms, mask, samples)
+        return FrameResult(index, image, int(mask.sum()), ms, mask, samples, self._cpu_ms)
 
     def frames(self, indices: Iterable[int]):
         """Yield a :class:`FrameResult` per frame index, in order."""

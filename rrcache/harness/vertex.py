@@ -10,6 +10,8 @@ outputs the glslViewer varyings a fragment shader may read (docs/design.md §4),
 ``v_color``            vec4    vertex colour (opaque white when the mesh has none)
 ``v_tangent``          vec4    world tangent, w = handedness (0 when the mesh has none)
 ``v_objectPosition``   vec3    object-space position (solid textures on moving objects)
+``v_lightCoord``       vec4    ``u_lightMatrix * v_position``: shadow-map coordinates (in
+                               [0, 1] after the divide by w) when the light has a shadow map
 ``rr_prevClip``        vec4    clip position at the previous frame (reprojection cache)
 =====================  ======  =========================================================
 
@@ -46,11 +48,13 @@ VARYINGS = {
     "v_color": (4, "a_color", ("color",), "1.0"),
     "v_tangent": (4, "vec4(normalize(mat3(u_modelMatrix) * a_tangent.xyz), a_tangent.w)", ("tangent",), "0.0"),
     "v_objectPosition": (3, "a_position", ("position",), "1.0"),
+    "v_lightCoord": (4, "u_lightMatrix * rr_world", ("position",), "1.0"),
     "rr_prevClip": (4, "u_prevModelViewProjectionMatrix * vec4(a_position, 1.0)", ("position",), "1.0"),
 }
 
 # uniforms the vertex shader reads (set per object by the renderer)
-VERTEX_UNIFORMS = ("u_modelMatrix", "u_modelViewProjectionMatrix", "u_normalMatrix", "u_prevModelViewProjectionMatrix")
+VERTEX_UNIFORMS = ("u_modelMatrix", "u_modelViewProjectionMatrix", "u_normalMatrix", "u_prevModelViewProjectionMatrix",
+                   "u_lightMatrix")
 
 _FLOAT_TYPES = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
 
@@ -91,6 +95,26 @@ def mesh_defines(attributes: Iterable[str]) -> dict[str, str]:
         if define:
             names.append(define)
     return {name: "1" for name in sorted(names)}
+
+
+def shadow_defines(session) -> dict[str, str]:
+    """``LIGHT_SHADOWMAP`` and ``LIGHT_SHADOWMAP_SIZE`` (glslViewer's) when the session's light has
+    a shadow map, else nothing.
+
+    >>> from types import SimpleNamespace
+    >>> shadow_defines(SimpleNamespace(shadow_map=SimpleNamespace(size=512)))
+    {'LIGHT_SHADOWMAP': 'u_lightShadowMap', 'LIGHT_SHADOWMAP_SIZE': '512.0'}
+    """
+    shadow = getattr(session, "shadow_map", None)
+    if shadow is None:
+        return {}
+    return {"LIGHT_SHADOWMAP": "u_lightShadowMap", "LIGHT_SHADOWMAP_SIZE": f"{float(shadow.size)!r}"}
+
+
+def session_defines(session) -> dict[str, str]:
+    """Every define a session implies: the meshes' ``MODEL_VERTEX_*`` and the light's
+    ``LIGHT_SHADOWMAP*``."""
+    return {**mesh_defines(session_attributes(session)), **shadow_defines(session)}
 
 
 def _convert(expr: str, size: int, pad: str, declared: int) -> str:
@@ -162,6 +186,8 @@ def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optiona
         lines.append("uniform mat3 u_normalMatrix;")
     if "rr_prevClip" in inputs:
         lines.append("uniform mat4 u_prevModelViewProjectionMatrix;")
+    if "v_lightCoord" in inputs:
+        lines.append("uniform mat4 u_lightMatrix;")
     lines += [f"out {declared} {name};" for name, declared, _ in outs]
     lines += ["void main() {", "    vec4 rr_world = u_modelMatrix * vec4(a_position, 1.0);"]
     lines += [f"    {name} = {value};" for name, _, value in outs]

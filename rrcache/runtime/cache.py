@@ -133,6 +133,8 @@ class CacheRuntime:
         depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
         cull_back_faces: Optional[bool] = None,
+        blend: float = 0.0,
+        phase_cycle: int = 1,
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -155,6 +157,10 @@ class CacheRuntime:
         self.clear_color = clear_color
         self.cull_back_faces = cull_back_faces
         self.depth_epsilon = float(depth_epsilon)
+        self.blend = float(blend)  # λ of an amortized variant: c = λ·c_prev + (1-λ)·x at hits
+        # an amortized variant's per-phase programs: at clock % phase_cycle == k > 0 the pass
+        # "<name>@<k>" runs in the place of "<name>" (rrcache.compiler.amortize, "frame" mode)
+        self.phase_cycle = int(phase_cycle)
         self.seed = seed
         self._period = 1
         self.period = period
@@ -300,9 +306,14 @@ class CacheRuntime:
             self._set(program, name, value)
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
+        # amortized sampling (rrcache.compiler.amortize): the frame picks the subset, λ the blend
+        self._set(program, "rr_amortFrame", self.clock)
+        self._set(program, "rr_lambda", self.blend)
 
     def _run(self, pass_name: str, draw: DrawCallback, query: Optional[moderngl.Query] = None) -> None:
         program = self.programs[pass_name]
+        if self.phase_cycle > 1 and self.clock % self.phase_cycle:
+            program = self.programs.get(f"{pass_name}@{self.clock % self.phase_cycle}", program)
         self._bind_cache_uniforms(program)
         if query is None:
             draw(program, pass_name)

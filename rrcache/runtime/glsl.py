@@ -107,6 +107,20 @@ vec4 rr_current() {
 """
 
 
+AMORTIZE_GLSL = """
+// ---- amortized sampling (rrcache.compiler.amortize) ----
+uniform float rr_lambda;
+"""
+
+#: the "pixel" phase of amortized sampling: the subset's phase from the frame and the pixel
+AMORTIZE_PIXEL_GLSL = """uniform int rr_amortFrame;
+int rr_amortPhase(int period) {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    return (rr_amortFrame + p.x + 2 * p.y) % period;
+}
+"""
+
+
 def lookup_glsl(filter: str = "bilinear") -> str:
     """Declarations and functions for a pass that reads the *previous* frame's cache:
     ``rr_hit()``, ``rr_refreshNow()`` and ``rr_previous()`` (valid after ``rr_hit()`` returned

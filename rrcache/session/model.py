@@ -82,12 +82,25 @@ class Camera:
         return perspective(self.fov, aspect, self.near, self.far)
 
 
+@dataclass(frozen=True)
+class ShadowMap:
+    """A session light's shadow map: ``size`` texels square, the light looking at ``target``
+    (None: the centre of the scene's bounds) over ``extent`` either side (None: their radius);
+    see :mod:`rrcache.session.shadow`."""
+
+    size: int
+    target: tuple[float, float, float] | None = None
+    extent: float | None = None
+
+
 @dataclass(eq=False)
 class Light:
-    """A point light at one frame: world ``position`` and linear RGB ``color`` (float64 3-vectors)."""
+    """A point light at one frame: world ``position`` and linear RGB ``color`` (float64 3-vectors),
+    and its ``shadow_map`` (None when the session asks for none)."""
 
     position: np.ndarray
     color: np.ndarray
+    shadow_map: ShadowMap | None = None
 
 
 @dataclass(eq=False)
@@ -230,6 +243,11 @@ class Session:
     def light_at(self, frame: int) -> Light:
         """The :class:`Light` at ``frame``."""
         return self._light(check_frame(frame))
+
+    @property
+    def shadow_map(self) -> ShadowMap | None:
+        """The light's :class:`ShadowMap` settings (None when the session has no shadow map)."""
+        return self.light_at(0).shadow_map if self._light is not None else None
 
     def uniform_values(self, frame: int) -> dict[str, Any]:
         """Session uniforms at ``frame``: name → int, bool, float or numpy array.

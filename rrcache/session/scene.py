@@ -13,7 +13,7 @@ import numpy as np
 from rrcache.errors import SessionError
 from rrcache.session.camera import orbit_position, trs_matrix
 from rrcache.session.keyframes import RotationTrack, Track
-from rrcache.session.model import Camera, Light
+from rrcache.session.model import Camera, Light, ShadowMap
 from rrcache.session.validation import json_path
 
 
@@ -97,7 +97,13 @@ def light_function(light: dict | None, camera: Callable[[int], Camera], file: st
         pos = channel(light["keyframes"], "position", [0.0, 0.0, 0.0]).at
     else:
         pos = lambda frame: camera(frame).eye  # noqa: E731
-    return lambda frame: Light(np.asarray(pos(frame), dtype=np.float64), color.copy())
+    spec = light.get("shadow_map")
+    shadow = None
+    if spec is not None:
+        target = spec.get("target")
+        shadow = ShadowMap(int(spec["size"]), tuple(float(v) for v in target) if target is not None else None,
+                           float(spec["extent"]) if "extent" in spec else None)
+    return lambda frame: Light(np.asarray(pos(frame), dtype=np.float64), color.copy(), shadow)
 
 
 def _scale3(value) -> np.ndarray:
