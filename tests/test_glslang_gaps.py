@@ -337,6 +337,55 @@ def test_uint_is_an_ordinary_name_before_it_became_a_type():
         accepted("#version 300 es\nprecision mediump float;\nint uint;\nvoid main() {}")
 
 
+# ----------------------------------------------------------------- found on the whole OpenGL set
+
+def test_arb_texture_query_lod_spelling():
+    """GL_ARB_texture_query_lod names its function textureQueryLOD (glslang's textureQueryLOD.frag);
+    GLSL 4.00 renamed it textureQueryLod. Both take derivatives like an implicit-LOD lookup."""
+    from rrcache.glsl.builtins import DERIVATIVE_FUNCTIONS
+    unit = accepted("""
+        #version 150
+        #extension GL_ARB_texture_query_lod : enable
+        uniform sampler2DShadow s;
+        uniform sampler2D t;
+        in vec2 uv;
+        out vec4 color;
+        void main() {
+            vec2 a = textureQueryLOD(s, uv);
+            vec2 b = textureQueryLod(t, uv);
+            color = vec4(a, b);
+        }
+    """)
+    assert [str(c.type) for c in calls(unit, "textureQueryLOD")] == ["vec2"]
+    assert "textureQueryLOD" in DERIVATIVE_FUNCTIONS
+    with pytest.raises(SemanticError, match="textureQueryLOD"):
+        accepted("#version 150\nuniform sampler2D t;\nout vec4 c;\n"
+                 "void main() { c = vec4(textureQueryLOD(t, 1.0), 0.0, 0.0); }")
+
+
+def test_gl_fragcoord_redeclared_again_with_the_same_qualifiers():
+    """glslang's gl_FragCoord.frag redeclares gl_FragCoord twice, identically, with a use between
+    (GLSL 4.60 §7.1.2: every redeclaration must have the same qualifiers)."""
+    unit = accepted("""
+        #version 150 core
+        layout(origin_upper_left, pixel_center_integer) in vec4 gl_FragCoord;
+        float x = gl_FragCoord.x;
+        layout(origin_upper_left, pixel_center_integer) in vec4 gl_FragCoord;
+        out vec4 c;
+        void main() { c = vec4(x, gl_FragCoord.y, 0.0, 1.0); }
+    """)
+    assert len([d for d in unit.decls if isinstance(d, A.VariableDecl)
+                and d.declarators and d.declarators[0].name == "gl_FragCoord"]) == 2
+    with pytest.raises(SemanticError, match="redefinition of 'gl_FragCoord'"):
+        accepted("#version 150\nlayout(origin_upper_left) in vec4 gl_FragCoord;\n"
+                 "layout(pixel_center_integer) in vec4 gl_FragCoord;\nout vec4 c;\n"
+                 "void main() { c = gl_FragCoord; }\n")
+    with pytest.raises(SemanticError, match="redefinition of 'gl_FragDepth'"):
+        accepted("#version 420\nlayout(depth_greater) out float gl_FragDepth;\n"
+                 "layout(depth_less) out float gl_FragDepth;\nout vec4 c;\n"
+                 "void main() { c = vec4(1.0); gl_FragDepth = 0.5; }\n")
+
+
 # ----------------------------------------------------------------- the measuring tool
 
 def _tool():
