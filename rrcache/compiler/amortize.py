@@ -57,6 +57,7 @@ import copy
 from dataclasses import dataclass
 from typing import Any, Optional
 
+from rrcache.deep import deep
 from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.legacy import to_core
@@ -455,6 +456,7 @@ def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinea
     return PassUnit(name, unit, runtime, spec, "amortize")
 
 
+@deep
 def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-pass", samples: int = 4,
                        blend: float = 0.6, filter: str = "bilinear", payload_dtype: str = "f4",
                        phase: str = "frame", history: str = "blend", vertex=None) -> Variant:

@@ -270,8 +270,12 @@ class CacheRuntime:
         return 4 + 16 + 2 * payload + 2 * 4 + 41
 
     def reset(self) -> None:
-        """Forget the cache: the next frame misses everywhere (as after a camera cut)."""
+        """Forget the cache: the next frame misses everywhere (as after a camera cut), and the
+        clock starts again at 0, so a run after a reset refreshes the same pixels on the same
+        frames whatever ran before it (a profile resumed after a kill measures what an
+        uninterrupted one does)."""
         self._valid = False
+        self.clock = 0
 
     def _release_targets(self) -> None:
         # moderngl re-binds the current framebuffer whenever it creates a new one: if the bound
