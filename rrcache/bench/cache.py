@@ -120,13 +120,14 @@ class CacheBench:
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
         progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
-        limit_algorithm: str = "three-pass", include_dirs=()) -> CacheBench:
+        limit_algorithm: str = "three-pass", vertex: Optional[str] = None, include_dirs=()) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
-    ``limit_algorithm``."""
+    ``limit_algorithm``. ``vertex``: the user's vertex shader (None: the session's, else
+    generated)."""
     say = progress or (lambda _msg: None)
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, include_dirs=include_dirs)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
@@ -134,8 +135,11 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
                        compare_period=compare_period)
 
     plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
+    # only the algorithms the node table allows for this node (one-pass cannot cache a value
+    # that needs screen-space derivatives)
     plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period)
-             for algorithm in ("three-pass", "two-pass", "one-pass")]
+             for algorithm in ("three-pass", "two-pass", "one-pass")
+             if algorithm in getattr(entry, "algorithms", ("three-pass", "two-pass", "one-pass"))]
     plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period) for block in blocks]
     if periods:
         plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH))

@@ -8,7 +8,7 @@ import json
 import click
 from rich.console import Console
 
-from rrcache.cli.options import include_dirs_option, resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, resolution_option as _resolution, vert_option
 
 
 @click.command("bench-cache")
@@ -23,8 +23,9 @@ from rrcache.cli.options import include_dirs_option, resolution_option as _resol
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
+@vert_option
 @include_dirs_option
-def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown,
+def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown, vert,
             include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import run
@@ -36,7 +37,7 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
     bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution, repeats=repeats,
                 include_dirs=include_dirs,
-                progress=lambda msg: err.print(f"[dim]{msg}[/dim]"))
+                progress=lambda msg: err.print(f"[dim]{msg}[/dim]"), vertex=vert)
     if as_json:
         click.echo(json.dumps(bench.to_json()))
     else:

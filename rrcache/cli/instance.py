@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
 
@@ -25,13 +25,14 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 @include_dirs_option
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
-def command(shader, node, period, algorithm, filter_, payload, session, defines, include_dirs, out_dir):
+@vert_option
+def command(shader, node, period, algorithm, filter_, payload, session, defines, include_dirs, out_dir, vert):
     """Write the shaders of the variant of SHADER that caches --node, and a manifest."""
     from rrcache.pipeline import load_for_session, variant_for
     from rrcache.session import load_session
 
     loaded = load_session(session) if session else None
-    work = load_for_session(shader, loaded, parse_defines(defines), include_dirs)
+    work = load_for_session(shader, loaded, parse_defines(defines), include_dirs, vertex=vert)
     entry = work.node(node)
     variant = variant_for(work, node, algorithm, filter_, payload)
     written = variant.write(out_dir, period=period)

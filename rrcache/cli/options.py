@@ -43,3 +43,11 @@ def resolution_option(ctx, param, value):
         return parse_resolution(value)
     except ValueError as err:
         raise click.BadParameter(str(err)) from None
+
+
+#: ``--vert FILE``: the user's vertex shader (glslViewer's .vert), on every command that renders or
+#: compiles; it wins over a session's ``"vertex"``.
+vert_option = click.option(
+    "--vert", "vert", type=click.Path(dir_okay=False), default=None, metavar="FILE",
+    help="The vertex shader paired with SHADER (a glslViewer .vert); default: the session's "
+         "\"vertex\", else a generated one.")

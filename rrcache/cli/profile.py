@@ -22,7 +22,7 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, 
                            TimeRemainingColumn)
 from rich.table import Table
 
-from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
 from rrcache.profiles.document import algorithm_line
@@ -85,8 +85,9 @@ def _fmt(value, spec=".3g", none="–"):
               help="If another rrcache process is profiling into the same --out, wait for it (default: exit 2).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @include_dirs_option
+@vert_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, wait, defines, include_dirs):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, wait, defines, include_dirs, vert):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -115,7 +116,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
             warnings.simplefilter("always")
             try:
                 prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh,
-                               include_dirs=include_dirs, wait=wait)
+                               include_dirs=include_dirs, wait=wait, vertex=vert)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

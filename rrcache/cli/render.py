@@ -23,7 +23,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, resolution_option
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, resolution_option, vert_option
 from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
@@ -58,8 +58,9 @@ from rrcache.session import load_session
               help="Cache precision: 32- or 16-bit float.")
 @click.option("--depth-epsilon", type=float, default=DEFAULT_DEPTH_EPSILON, show_default=True,
               help="Relative tolerance of the reprojected depth test.")
+@vert_option
 def command(shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, node, period, algorithm,
-            block, refresh, filter_, payload, depth_epsilon):
+            block, refresh, filter_, payload, depth_epsilon, vert):
     """Render SESSION through the fragment shader SHADER and report time and coverage per frame;
     with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
@@ -67,9 +68,9 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
     if node is not None:
         _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
-                            filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console)
+                            filter=filter_, payload=payload, depth_epsilon=depth_epsilon), err_console, vert)
         return
-    prepared = prepare_file(shader, loaded, parse_defines(defines), all_include_dirs(include_dirs, loaded))
+    prepared = prepare_file(shader, loaded, parse_defines(defines), all_include_dirs(include_dirs, loaded), vertex=vert)
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:
@@ -94,7 +95,7 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
         result = render(prepared, loaded, indices, resolution=resolution, progress=done, keep_images=False)
 
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     if as_json:
         click.echo(json.dumps({
             "frames": len(result.frames),
@@ -119,11 +120,12 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                   + (f"; images in {out}" if out is not None else ""), highlight=False)
 
 
-def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_count, resolution, as_json, opts, err_console):
+def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_count, resolution, as_json, opts,
+                   err_console, vert=None):
     from rrcache.harness.cached import compare
     from rrcache.pipeline import load_for_session, variant_for
 
-    work = load_for_session(shader, loaded, defines, include_dirs)
+    work = load_for_session(shader, loaded, defines, include_dirs, vertex=vert)
     entry = work.node(node)
     variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"])
     indices = frame_indices(loaded, frame_count)
@@ -148,7 +150,7 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
                          block=opts["block"], refresh=opts["refresh"], depth_epsilon=opts["depth_epsilon"],
                          on_frame=done)
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     summary = result.summary()
     if as_json:
         click.echo(json.dumps(dict(

@@ -65,6 +65,7 @@ class Variant:
     forms: dict[str, str] = field(default_factory=dict)
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
+    vertex_path: Optional[str] = None  # the user's vertex shader (None: generated)
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -93,6 +94,7 @@ class Variant:
                 "location": str(self.node_loc) if self.node_loc else None,
             },
             "shader": self.shader_path,
+            "vertex": self.vertex_path,  # the user's vertex shader the passes' .vert derive from (None: generated)
             "algorithm": self.algorithm,
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
@@ -142,7 +144,8 @@ class Variant:
                 programs[name] = build_program(
                     ctx, src.vertex, src.fragment, src.fragment_line_map,
                     fragment_name=f"{shader} ({name} pass)",
-                    vertex_name=f"<generated vertex shader of the {name} pass>")
+                    vertex_name=(f"{self.vertex_path} ({name} pass)" if self.vertex_path
+                                 else f"<generated vertex shader of the {name} pass>"))
             except GLError as err:
                 for prog in programs.values():
                     prog.release()

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import Iterator, Mapping, Sequence
 
 from rrcache.errors import PreprocessorError, SourceLoc, printable as _printable
+from rrcache.glsl.extensions import predefined as predefined_extensions
 
 __all__ = ["PPToken", "Preprocessed", "preprocess", "preprocess_file"]
 
@@ -46,7 +47,9 @@ class Preprocessed:
 
     ``version`` is the ``#version`` number (None when absent); ``profile`` the effective
     profile: ``es`` for ES versions, the written one or ``core`` for desktop 150 and later,
-    None below 150. ``files`` lists every file read, the main file first.
+    None below 150. ``files`` lists every file read, the main file first. ``assumed`` says,
+    for a shader without ``#version``, which language it was read as and why (see
+    :func:`_es_sketch_reason`).
     """
 
     tokens: list[PPToken]
@@ -57,6 +60,8 @@ class Preprocessed:
     extension_locs: list[SourceLoc] = field(default_factory=list)  # where each #extension stands
     pragmas: list[tuple[str, SourceLoc]] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    #: without ``#version``: the language the shader was read as, and why (None with one)
+    assumed: str | None = None
 
 
 # --------------------------------------------------------------------------------------------
@@ -402,6 +407,7 @@ class _Preprocessor:
         self.cond: list[_Cond] = []
         self.includes: list[tuple[str, str, frozenset]] = []
         self.version_done = False
+        self.main_source = ""  # the main file's text: without #version it decides ES or not
         self.produced = 0
         self.cur: _Source | None = None
         for name, value in (defines or {}).items():
@@ -427,6 +433,13 @@ class _Preprocessor:
         r = self.result
         self.version_done = True
         r.version, r.version_loc = version, loc
+        es_sketch = _es_sketch_reason(self.main_source) if version is None else None
+        if es_sketch:
+            # no #version, but written for GLSL ES 1.00 (see _es_sketch_reason)
+            profile = "es"
+            r.assumed = f"GLSL ES 1.00 (no #version; {es_sketch})"
+        elif version is None:
+            r.assumed = "desktop GLSL 1.10 (no #version, no precision statement, no GL_ES test)"
         if version in _ES_VERSIONS or profile == "es":
             r.profile = "es"
             self._builtin("GL_ES", "1")
@@ -438,6 +451,8 @@ class _Preprocessor:
                 self._builtin("GL_compatibility_profile", "1")
         else:
             r.profile = None
+        for ext in predefined_extensions(r.profile == "es"):
+            self._builtin(ext, "1")
 
     def _mark_content(self) -> None:
         if not self.version_done:
@@ -859,7 +874,7 @@ class _Preprocessor:
         elif t.text == "__FILE__":
             value = self.cur.number if self.cur is not None else 0
         else:
-            value = self.result.version or 110
+            value = self.result.version or (100 if self.result.profile == "es" else 110)
         return _Tok("number", str(value), t.loc, t.space, t.hide)
 
     @staticmethod
@@ -991,6 +1006,35 @@ def _read_text(path: str, loc: SourceLoc | None, pp: "_Preprocessor | None" = No
                    "save the shader as UTF-8") from None
 
 
+_COMMENT_RE = re.compile(r"//[^\n]*|/\*.*?(?:\*/|\Z)", re.S)
+_PRECISION_RE = re.compile(r"(?m)^[ \t]*precision[ \t]+(?:lowp|mediump|highp)[ \t]+\w+[ \t]*;")
+_GL_ES_TEST_RE = re.compile(r"(?m)^[ \t]*#[ \t]*(?:(?:ifdef|ifndef)[ \t]+GL_ES\b|(?:el)?if\b[^\n]*\bGL_ES\b)")
+
+
+def _es_sketch_reason(source: str) -> str | None:
+    """Why a main file without ``#version`` is GLSL ES 1.00, or None for desktop GLSL 1.10.
+
+    The ES sketch tools (glslViewer, GLSL Sandbox, The Book of Shaders' editor; all WebGL 1 or
+    GLES 2 underneath) run a versionless fragment shader as GLSL ES 1.00, and such sketches
+    say so: a ``precision`` statement (mandatory for floats in an ES 1.00 fragment shader), or a
+    test of ``GL_ES`` (``#ifdef GL_ES precision mediump float; #endif``). A versionless shader
+    with either, in its main file, active or not, is read as ES 1.00 (``GL_ES`` defined, so it
+    takes the branches its author ran); one with neither is desktop GLSL 1.10, as the GLSL
+    specification says. Comments are ignored.
+
+    >>> _es_sketch_reason("#ifdef GL_ES\\nprecision mediump float;\\n#endif\\nvoid main(){}")
+    'it has a precision statement and tests GL_ES, as ES sketches do'
+    >>> _es_sketch_reason("// precision highp float;\\nvoid main(){}") is None
+    True
+    """
+    text = _COMMENT_RE.sub(" ", source)
+    found = [what for what, pattern in (("has a precision statement", _PRECISION_RE),
+                                         ("tests GL_ES", _GL_ES_TEST_RE)) if pattern.search(text)]
+    if not found:
+        return None
+    return f"it {' and '.join(found)}, as ES sketches do"
+
+
 def preprocess(source: str, filename: str | os.PathLike = "<string>",
                defines: Mapping[str, object] | None = None,
                include_dirs: Sequence[str] = ()) -> Preprocessed:
@@ -1008,6 +1052,7 @@ def preprocess(source: str, filename: str | os.PathLike = "<string>",
     if not filename.startswith("<"):
         pp.roots.insert(0, os.path.dirname(os.path.realpath(filename)))
     pp.source_bytes = len(source.encode("utf-8", "surrogatepass"))
+    pp.main_source = source
     key = os.path.realpath(filename) if not filename.startswith("<") else filename
     # Tokens are many small acyclic objects: pausing the cyclic GC halves the run time.
     gc_was_enabled = gc.isenabled()
@@ -1026,9 +1071,9 @@ def preprocess_file(path: str | os.PathLike, defines: Mapping[str, object] | Non
                     include_dirs: Sequence[str] = ()) -> Preprocessed:
     """Read and preprocess the shader file ``path`` (see :func:`preprocess`).
 
-    >>> pp = preprocess_file("shaders/fog.frag", defines={"USE_FOG": None})  # doctest: +SKIP
-    >>> pp.files[0]  # doctest: +SKIP
-    'shaders/fog.frag'
+    >>> pp = preprocess_file("shaders/glslviewer_basic.glsl", defines={"MODEL_VERTEX_NORMAL": None})
+    >>> pp.files[0], "v_normal" in [t.text for t in pp.tokens]
+    ('shaders/glslviewer_basic.glsl', True)
     """
     path = os.fspath(path)
     return preprocess(_read_text(path, None), path, defines, include_dirs)

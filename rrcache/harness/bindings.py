@@ -2,7 +2,7 @@
 
 :func:`plan_bindings` checks the shader against the session once, before any frame is drawn:
 
-- a uniform or sampler the program uses that neither the harness (DESIGN.md §4 built-ins) nor
+- a uniform or sampler the program uses that neither the harness (docs/design.md §4 built-ins) nor
   the session supplies is an error naming the declaration (``shader.frag:line:col``) and the
   session file, saying what to add;
 - a session uniform or texture the shader does not declare is a *note*, never an error (sessions
@@ -24,7 +24,7 @@ BUILTINS = {
     "u_camera": "vec3", "u_light": "vec3", "u_lightColor": "vec3", "u_resolution": "vec2",
     "u_time": "float", "u_frame": "int", "u_modelMatrix": "mat4", "u_viewMatrix": "mat4",
     "u_projectionMatrix": "mat4", "u_modelViewProjectionMatrix": "mat4", "u_normalMatrix": "mat3",
-    "u_prevModelViewProjectionMatrix": "mat4",
+    "u_prevModelViewProjectionMatrix": "mat4", "u_reprojectionMatrix": "mat4",
 }
 
 _PATH = re.compile(r"([A-Za-z_]\w*)|\[(\d+)\]")

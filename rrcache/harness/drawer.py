@@ -3,13 +3,23 @@ renderer and the cached one (one program per pass).
 
 :class:`SceneDrawer` uploads meshes and textures once, checks each program it is given against
 the session (:func:`rrcache.harness.bindings.plan_bindings`), and per frame sets the built-in
-uniforms of DESIGN.md §4 (camera, light, time, matrices, the previous frame's
+uniforms of docs/design.md §4 (camera, light, time, matrices, the previous frame's
 model-view-projection for reprojection), the session's uniforms and samplers, and renders every
 object, culling back faces unless the object is ``double_sided``.
 
->>> drawer = SceneDrawer(ctx, session, prepared, (640, 480), scope)    # doctest: +SKIP
->>> drawer.add_program(program)                                         # doctest: +SKIP
->>> drawer.set_frame(10); drawer.draw(program)                          # doctest: +SKIP
+>>> from rrcache.gl import GLScope, build_program, get_context
+>>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.harness.vertex import vertex_source
+>>> from rrcache.session import load_session
+>>> ctx, scope = get_context(), GLScope()
+>>> session = load_session("sessions/marble.json")
+>>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+>>> program = scope.own(build_program(ctx, vertex_source({n: d.type for n, d in prepared.inputs.items()}),
+...                                   prepared.source))
+>>> drawer = SceneDrawer(ctx, session, prepared, (32, 24), scope)
+>>> _ = drawer.add_program(program)
+>>> drawer.set_frame(10); drawer.draw(program)
+>>> scope.release()
 """
 from __future__ import annotations
 
@@ -42,6 +52,23 @@ def normal_matrix(model: np.ndarray) -> np.ndarray:
         return m3
 
 
+def reprojection_matrix(mvp: np.ndarray, prev_mvp: np.ndarray) -> np.ndarray:
+    """This frame's clip position → the previous frame's, for one object:
+    ``prev_mvp @ inverse(mvp)`` in double precision (what a user's vertex shader multiplies
+    ``gl_Position`` by to find ``rr_prevClip``; see :mod:`rrcache.harness.user_vertex`).
+
+    >>> m = np.diag([2.0, 2.0, 2.0, 1.0])
+    >>> bool(np.allclose(reprojection_matrix(m, m), np.eye(4)))
+    True
+    """
+    mvp = np.asarray(mvp, dtype=np.float64)
+    try:
+        inv = np.linalg.inv(mvp)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(mvp)
+    return np.asarray(prev_mvp, dtype=np.float64) @ inv
+
+
 class SceneDrawer:
     """Draws the objects of ``session`` at ``size`` with programs registered by
     :meth:`add_program`. GL objects are owned by ``scope``."""
@@ -54,7 +81,7 @@ class SceneDrawer:
         self.size = size
         self.scope = scope
         self.cull_back_faces = cull_back_faces
-        self.notes: list[str] = []
+        self.notes: list[str] = list(getattr(session, "notes", None) or [])
         self._plans: dict[int, BindingPlan] = {}
         self._vaos: dict[int, list] = {}
         self._buffers: dict[tuple[int, str], moderngl.Buffer] = {}
@@ -128,8 +155,9 @@ class SceneDrawer:
         for obj in session.objects:
             model = obj.model_matrix(index)
             cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
-            self._per_object.append((model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev),
-                                     normal_matrix(model), cull))
+            mvp, prev_mvp = view_proj @ model, prev_view_proj @ obj.model_matrix(prev)
+            self._per_object.append((model, mvp, prev_mvp, normal_matrix(model), cull,
+                                     reprojection_matrix(mvp, prev_mvp)))
 
     def _set_builtin(self, plan: BindingPlan, name: str, value) -> None:
         uniform = plan.builtins.get(name)
@@ -142,7 +170,7 @@ class SceneDrawer:
             raise UnsupportedShaderError(
                 f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
                 decl.loc if decl is not None else None,
-                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
+                hint=f"declare `uniform {BUILTINS[name]} {name};` (docs/design.md §4)") from None
 
     def draw(self, program: moderngl.Program, _pass_name: str = "") -> None:
         """Draw every object of the current frame with ``program`` into the bound framebuffer
@@ -168,7 +196,7 @@ class SceneDrawer:
             unit, tex = self._textures[name]
             tex.use(location=unit)
         ctx.cull_face = "back"
-        for vao, (model, mvp, prev_mvp, nmat, cull) in zip(self._vaos[id(program)], self._per_object):
+        for vao, (model, mvp, prev_mvp, nmat, cull, reproject) in zip(self._vaos[id(program)], self._per_object):
             if cull:
                 ctx.enable(moderngl.CULL_FACE)
             else:
@@ -177,4 +205,5 @@ class SceneDrawer:
             set_builtin(plan, "u_modelViewProjectionMatrix", mvp)
             set_builtin(plan, "u_normalMatrix", nmat)
             set_builtin(plan, "u_prevModelViewProjectionMatrix", prev_mvp)
+            set_builtin(plan, "u_reprojectionMatrix", reproject)
             vao.render(moderngl.TRIANGLES)

@@ -3,8 +3,12 @@
 EXR keeps the float32 RGBA values bit-exact; PNG (and other 8-bit formats) clamp to [0, 1] and
 quantise, with straight (unassociated) alpha, since shaders write straight colour.
 
+>>> import os, tempfile
 >>> import numpy as np
->>> write_image("frame.exr", np.zeros((4, 4, 4), np.float32))   # doctest: +SKIP
+>>> path = os.path.join(tempfile.mkdtemp(), "frame.exr")
+>>> write_image(path, np.full((4, 4, 4), 0.25, np.float32))
+>>> os.path.getsize(path) > 0
+True
 """
 from __future__ import annotations
 

@@ -9,11 +9,11 @@ samples that passed the depth test (an occlusion query: shaded fragments, overdr
 the wall time of the draws (``time.perf_counter()`` around clear, draws and ``ctx.finish()``,
 after one untimed warm-up draw of the program, since llvmpipe compiles on the first draw).
 
->>> from rrcache.session import load_session                      # doctest: +SKIP
->>> session = load_session("scenes/marble/session.json")          # doctest: +SKIP
->>> result = render("scenes/marble/marble.frag", session, frames=3)  # doctest: +SKIP
->>> result.frames[0].image.shape, result.ms_per_frame > 0          # doctest: +SKIP
-((480, 640, 4), True)
+>>> from rrcache.session import load_session
+>>> session = load_session("sessions/marble.json")
+>>> result = render("shaders/glslviewer_basic.glsl", session, frames=3, resolution=(64, 48))
+>>> result.frames[0].image.shape, result.ms_per_frame > 0, result.frames[0].covered_pixels > 0
+((48, 64, 4), True, True)
 """
 from __future__ import annotations
 
@@ -33,8 +33,8 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
-from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
-from rrcache.harness.vertex import vertex_source
+from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare, prepare_file
+from rrcache.harness.vertex import vertex_for
 
 #: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
 #: and flipped (32), the depth read back (4) and the coverage mask (1); checked before allocating
@@ -91,8 +91,14 @@ class Renderer:
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
     images and masks are then of the window's size.
 
-    >>> with Renderer(prepared, session) as r:                # doctest: +SKIP
+    >>> from rrcache.harness.prepare import prepare_file
+    >>> from rrcache.session import load_session
+    >>> session = load_session("sessions/marble.json")
+    >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+    >>> with Renderer(prepared, session, (32, 24)) as r:
     ...     first = r.render_frame(0)
+    >>> first.image.shape
+    (24, 32, 4)
     """
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
@@ -120,9 +126,11 @@ class Renderer:
         check_target_size(ctx, self.size, TARGET_BYTES_PER_PIXEL, where)
         inputs = {name: d.type for name, d in prepared.inputs.items()}
         locs = {name: d.loc for name, d in prepared.inputs.items()}
-        self.vertex_source = vertex_source(inputs, locs)
+        user = getattr(prepared, "vertex", None)
+        self.vertex_source = vertex_for(inputs, locs, user)
         self.program = self._scope.own(build_program(
-            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path))
+            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path,
+            vertex_name=user.path if user is not None else "<generated vertex shader>"))
         self.drawer = SceneDrawer(ctx, self.session, prepared, self.size, self._scope, self.cull_back_faces)
         self.plan = self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
@@ -222,11 +230,12 @@ def frame_indices(session, frames=None) -> list[int]:
 
 def as_prepared(shader, session, defines=None) -> PreparedShader:
     """A :class:`PreparedShader` from a prepared shader, a front-end ``Shader`` or a shader path
-    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``)."""
+    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``), with the session's
+    ``"vertex"`` shader when it names one."""
     if isinstance(shader, PreparedShader):
         return shader
     if hasattr(shader, "unit"):
-        return prepare(shader, defines)
+        return prepare(shader, defines, load_user_vertex(None, session, shader.defines or defines))
     return prepare_file(shader, session, defines)
 
 
@@ -239,8 +248,10 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     streamed: ``progress`` sees each image, and the result keeps only the per-frame figures
     (``image`` and ``mask`` are None), so a session of a million frames runs in constant memory.
 
-    >>> result = render("marble.frag", load_session("session.json"), frames=2)   # doctest: +SKIP
-    >>> [f.index for f in result.frames]                                          # doctest: +SKIP
+    >>> from rrcache.session import load_session
+    >>> result = render("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"),
+    ...                 frames=2, resolution=(32, 24))
+    >>> [f.index for f in result.frames]
     [0, 1]
     """
     prepared = as_prepared(shader, session, defines)

@@ -1,7 +1,7 @@
 """The generated vertex shader and the mesh-attribute defines.
 
 The harness draws every mesh with a vertex shader written here (``#version 330 core``) that
-outputs the glslViewer varyings a fragment shader may read (DESIGN.md §4), in world space:
+outputs the glslViewer varyings a fragment shader may read (docs/design.md §4), in world space:
 
 =====================  ======  =========================================================
 ``v_position``         vec4    world position (``u_modelMatrix * position``)
@@ -102,6 +102,29 @@ def _convert(expr: str, size: int, pad: str, declared: int) -> str:
     return f"vec{declared}({expr}, {fill})"
 
 
+def vertex_for(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None,
+               user=None, prev_clip: bool = False) -> str:
+    """The vertex shader of a program whose fragment shader reads ``inputs``: the user's own
+    (a :class:`rrcache.harness.user_vertex.UserVertex`, checked against ``inputs``) when given,
+    else the generated one; ``prev_clip`` adds ``rr_prevClip`` and ``invariant gl_Position`` (the
+    cached variants' passes).
+
+    >>> "out vec2 v_texcoord;" in vertex_for({"v_texcoord": "vec2"})
+    True
+    """
+    if user is not None:
+        user.check_inputs(inputs, locs)
+        return user.source(prev_clip=prev_clip)
+    wanted = dict(inputs)
+    if prev_clip:
+        wanted["rr_prevClip"] = "vec4"
+    text = vertex_source(wanted, locs)
+    if not prev_clip:
+        return text
+    first, _, rest = text.partition("\n")
+    return f"{first}\ninvariant gl_Position;\n{rest}"
+
+
 def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None) -> str:
     """The vertex shader text writing the fragment inputs ``inputs`` (name → declared GLSL type).
 
@@ -119,7 +142,9 @@ def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optiona
             raise UnsupportedShaderError(
                 f"fragment input `{name}` is not a varying the harness supplies",
                 locs.get(name),
-                hint=f"use one of {', '.join(VARYINGS)} (DESIGN.md §4)",
+                hint=f"use one of {', '.join(v for v in VARYINGS if not v.startswith('rr_'))} "
+                     "(docs/design.md §4), or give the vertex shader that writes it (--vert FILE, or "
+                     "\"vertex\" in the session)",
             )
         if declared not in _FLOAT_TYPES:
             raise UnsupportedShaderError(

@@ -18,12 +18,14 @@ and nothing below imports it. Into the output folder it writes:
 from __future__ import annotations
 
 import sqlite3
+import os
 import time
 from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
+from rrcache.glsl.frontend import file_records
 from rrcache.profiler.train import ProgressFn, TrainingResult, train
 from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
@@ -41,13 +43,14 @@ def default_out_dir(shader_path, session_path) -> Path:
 
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
-            fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False) -> Profile:
+            fresh: bool = False, plots: bool = True, vertex=None, include_dirs=(), wait: bool = False) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
     moves it aside first. Another process profiling into the same folder holds its lock: this one
-    raises an error naming it, or with ``wait=True`` waits. ``progress`` receives :class:`~rrcache.profiler.train.ProgressEvent`
-    objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
+    raises an error naming it, or with ``wait=True`` waits. ``progress`` receives
+    :class:`~rrcache.profiler.train.ProgressEvent` objects; ``vertex`` is the user's vertex shader
+    file (None: the session's ``"vertex"``, else generated). A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
@@ -57,12 +60,12 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     from rrcache.session import load_session
 
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, defines, include_dirs)
+    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
     resolved = (settings or TrainingSettings()).resolved(session)
     out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
-    key = StoreKey(work.shader.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
+    key = StoreKey(work.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
     # one writer per folder: taken before the store is opened (or moved aside by --fresh)
     lock = StoreLock.acquire(out / LOCK_NAME, wait=wait)
     try:
@@ -119,7 +122,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     for nid in result.order:
         entry = by_id[nid]
         node = NodeProfile(nid, entry.type, entry.line, entry.column, entry.text, list(entry.call_chain),
-                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid))
+                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid),
+                           file=getattr(entry, "file", None))
         runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
         node.periods = [r.period for r in runs]
         node.errors = [r.mean_error for r in runs]
@@ -136,7 +140,10 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     plan = result.plan
     draft = Profile(
         shader=str(Path(shader_path).resolve()), session=str(Path(session_path).resolve()),
-        shader_hash=work.shader.hash, session_hash=session.hash, settings=settings,
+        shader_hash=work.hash, session_hash=session.hash, settings=settings,
+        shader_files=file_records(work.shader),
+        vertex=os.path.abspath(work.vertex.path) if work.vertex is not None else None,
+        vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
         nodes=nodes, defines=dict(work.defines), include_dirs=list(work.include_dirs), plan=plan.to_json() if plan is not None else None,

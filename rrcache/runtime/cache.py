@@ -5,10 +5,12 @@ inverse-depth textures, the depth buffer the passes share, the refresh pattern (
 seed: uniforms of the rule in :mod:`rrcache.runtime.refresh`; no texture), the clock
 and the occlusion queries that count shaded fragments. The application owns its geometry: each
 frame it hands the runtime a ``draw(program, pass_name)`` callback that sets its own uniforms on
-``program`` (including ``u_prevModelViewProjectionMatrix`` per object, for reprojection) and
-renders its vertex arrays with it.
+``program`` (including ``u_prevModelViewProjectionMatrix`` per object, for reprojection, or
+``u_reprojectionMatrix`` = previous MVP × inverse(this MVP) when the variant was compiled with the
+user's own vertex shader; the manifest lists the uniforms of each pass) and renders its vertex
+arrays with it.
 
-Passes (DESIGN.md §3; Sitthi-amorn 2008a §3):
+Passes (docs/design.md §3; Sitthi-amorn 2008a §3):
 
 three-pass (default; programs ``reproject``, ``payload``, ``shade``)
     1. ``reproject`` — depth test ``<`` with depth writes. At a hit it writes the reconstructed

@@ -10,7 +10,7 @@ depth edges, where it mixes foreground and background (Nehab 2007 §3.2). Compar
 to the expected value keeps the test meaningful for any near/far range (1e-4 to 1e6 included),
 unlike window depth, which saturates near 1.
 
-Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (DESIGN.md §3):
+Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (docs/design.md §3):
 
     expected = 1 / rr_prevClip.w;  uv = rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5
     hit = rr_valid && uv inside [0,1]² && |bilinear(prevInvDepth, uv) - expected| <= ε · expected

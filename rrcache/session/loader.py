@@ -25,6 +25,7 @@ from typing import Any
 from rrcache.budgets import budget
 from rrcache.errors import AssetError, SessionError, printable
 from rrcache.session import procedural, textures as tex
+from rrcache.session.model import DEFAULT_FILTER
 from rrcache.session.meshes import MeshLoadError, load_mesh_file
 from rrcache.session.model import MeshData, SceneObject, Session, TextureAsset
 from rrcache.session.scene import camera_function, light_function, model_function
@@ -239,14 +240,14 @@ def _textures(doc: dict, file: str, assets: _Assets) -> dict[str, TextureAsset]:
             header, path = assets.image(spec["path"], at)
             files = [path]
             if kind == "cube":
-                w, h = header[0], header[1]
-                if w != 6 * h and h != 6 * w:
-                    raise AssetError(f"a single-file cube map must be a 6:1 or 1:6 strip of square faces, got "
-                                     f"{w}×{h}: {printable(path)}", file, at)
-                header = (min(w, h), min(w, h), header[2])
+                try:
+                    face = tex.cube_face_size(header[0], header[1])
+                except tex.ImageLoadError as e:
+                    raise AssetError(f"{e}: {printable(path)}", file, at) from None
+                header = (face, face, header[2])
             loader = _image_loader(assets, path, at, file, kind == "cube")
         out[name] = TextureAsset(name=name, path=files[0], kind=kind, loader=loader, header=header,
-                                 filter=spec.get("filter", "linear"),
+                                 filter=spec.get("filter", DEFAULT_FILTER),
                                  wrap=spec.get("wrap", "clamp" if kind == "cube" else "repeat"),
                                  files=tuple(files))
     return out
@@ -319,10 +320,17 @@ def load_session(path: str | os.PathLike) -> Session:
             raise AssetError(f"include folder not found: {printable(folder)}", file, where,
                              "include folders are relative to the session file's folder")
         include_dirs.append(folder)
+    vertex = None
+    if "vertex" in doc:
+        vertex = assets.resolve(doc["vertex"], "vertex", "vertex shader")
+        if not os.path.isfile(vertex):
+            raise AssetError(f"cannot find the vertex shader {vertex}", file, "vertex",
+                             "the path is relative to the session file's folder")
     return Session(
         path=file, resolution=(int(doc["resolution"][0]), int(doc["resolution"][1])),
         frames=int(doc["frames"]), fps=float(doc.get("fps", 30)), objects=objects, textures=textures,
         hash=assets.digest(doc), name=doc.get("name", ""), description=doc.get("description", ""),
         background=tuple(float(c) for c in doc.get("background", (0.0, 0.0, 0.0, 0.0))), document=doc,
         include_dirs=tuple(include_dirs),
-        _camera=camera, _light=light, _uniforms=uniforms)
+        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex,
+        notes=[f"{path}: {note}" for path, mesh in assets.meshes.items() for note in mesh.notes])

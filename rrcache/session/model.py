@@ -40,6 +40,8 @@ class MeshData:
     texcoords: np.ndarray | None = None
     colors: np.ndarray | None = None
     tangents: np.ndarray | None = None
+    #: one line per complaint of the mesh file's loader (e.g. a missing texture it names)
+    notes: tuple = ()
 
     @property
     def vertex_count(self) -> int:
@@ -109,6 +111,11 @@ class SceneObject:
         return self._model(check_frame(frame))
 
 
+#: the filter of a session texture that names none (see :class:`TextureAsset`)
+DEFAULT_FILTER = "mipmap"
+
+
+@dataclass(eq=False)
 class TextureAsset:
     """An image bound to a sampler uniform.
 
@@ -117,7 +124,10 @@ class TextureAsset:
     kept bit-exact. Row 0 is the image's *top* row: for a 2D texture the harness must flip rows
     (``data[::-1]``) before upload so that texcoord v = 0 samples the image's bottom row as GL
     expects; cube-map faces are uploaded as stored (GL's cube-map convention has row 0 at the top).
-    ``filter`` is ``linear|nearest|mipmap``, ``wrap`` ``repeat|clamp|mirror``. ``path`` is the
+    ``filter`` is ``linear|nearest|mipmap``, ``wrap`` ``repeat|clamp|mirror``; a texture given
+    without a filter gets :data:`DEFAULT_FILTER` (``mipmap``: mipmaps generated and trilinear
+    filtering, as an application sets up a texture its shader samples with an implicit level of
+    detail; without mipmaps a minified ``texture()`` lookup aliases). ``path`` is the
     resolved file (the +X face for a cube map given as six files); ``files`` lists every file read.
 
     The session loader reads only the image headers (size checked against the pixel budget) and
@@ -126,7 +136,7 @@ class TextureAsset:
     """
 
     def __init__(self, name: str, path: str, kind: str, data: "np.ndarray | None" = None,
-                 filter: str = "linear", wrap: str = "repeat", files: tuple[str, ...] = (),
+                 filter: str = DEFAULT_FILTER, wrap: str = "repeat", files: tuple[str, ...] = (),
                  loader: "Callable[[], np.ndarray] | None" = None,
                  header: "tuple[int, int, int] | None" = None):
         if data is None and loader is None:
@@ -197,6 +207,10 @@ class Session:
     document: dict = field(default_factory=dict, repr=False)
     #: the session's "include_dirs", resolved against its folder (after the command line's -I)
     include_dirs: tuple[str, ...] = ()
+    #: the user's vertex shader file (``"vertex"``, resolved), or None for a generated one
+    vertex: str | None = None
+    #: what loading the session's assets had to say that is not an error (one line each)
+    notes: list = field(default_factory=list)
     _camera: Callable[[int], Camera] | None = field(default=None, repr=False)
     _light: Callable[[int], Light] | None = field(default=None, repr=False)
     _uniforms: Callable[[int], dict[str, Any]] | None = field(default=None, repr=False)

@@ -8,7 +8,8 @@ the process's stderr: they are silenced, and the error comes through OpenImageIO
 exactly (float data textures are used as arrays of records). Row 0 of the result is the
 image's top row (see :class:`rrcache.session.model.TextureAsset` for how to upload it).
 A cube map is six files (+X −X +Y −Y +Z −Z) of equal square size, or one image holding the six
-faces side by side (a 6:1 horizontal strip) or stacked (a 1:6 vertical strip) in that order.
+faces side by side (a 6:1 horizontal strip) or stacked (a 1:6 vertical strip) in that order, or
+one of the cross layouts glslViewer (and cmft, CubeMapGen) read (see :func:`split_cube_cross`).
 
 >>> read_image("tests/data/sessions/textures/checker.png").shape
 (4, 4, 3)
@@ -87,8 +88,27 @@ def read_image(path: str) -> np.ndarray:
     return np.ascontiguousarray(data)
 
 
+def cube_face_size(width: int, height: int) -> int:
+    """The face size of a single-file cube map of ``width``×``height`` pixels (a strip or a
+    cross, as :func:`split_cube_strip` reads it), from the header alone; ImageLoadError otherwise.
+
+    >>> cube_face_size(8, 6)
+    2
+    """
+    w, h = int(width), int(height)
+    if w == 6 * h or h == 6 * w:
+        return min(w, h)
+    if w * 3 == h * 4 and w % 4 == 0:
+        return w // 4
+    if w * 4 == h * 3 and w % 3 == 0:
+        return w // 3
+    raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip or a 4:3 or 3:4 cross of "
+                         f"square faces, got {w}×{h}")
+
+
 def split_cube_strip(image: np.ndarray) -> np.ndarray:
-    """A 6:1 horizontal or 1:6 vertical strip → 6×S×S×C faces.
+    """A 6:1 horizontal or 1:6 vertical strip (or a cross, :func:`split_cube_cross`) → 6×S×S×C
+    faces.
 
     >>> split_cube_strip(np.zeros((2, 12, 3), np.float32)).shape
     (6, 2, 2, 3)
@@ -98,7 +118,47 @@ def split_cube_strip(image: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(np.stack([image[:, k * h:(k + 1) * h] for k in range(6)]))
     if h == 6 * w:
         return np.ascontiguousarray(np.stack([image[k * w:(k + 1) * w] for k in range(6)]))
-    raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip of square faces, got {w}×{h}")
+    if (w * 3 == h * 4 and w % 4 == 0) or (w * 4 == h * 3 and w % 3 == 0):
+        return split_cube_cross(image)
+    raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip or a 4:3 or 3:4 cross of "
+                         f"square faces, got {w}×{h}")
+
+
+def split_cube_cross(image: np.ndarray) -> np.ndarray:
+    """A horizontal (4:3) or vertical (3:4) cross → 6×S×S×C faces (+X −X +Y −Y +Z −Z).
+
+    The unfolded cube seen from inside, +Z in the middle (rows from the top)::
+
+        horizontal cross        vertical cross
+            .  +Y  .   .            .  +Y  .
+           −X  +Z  +X  −Z          −X  +Z  +X
+            .  −Y  .   .            .  −Y  .
+                                    .  −Z  .    (upside down: rotated 180°)
+
+    Each face comes out as it would in a strip; the vertical cross' −Z is turned back (glslViewer
+    flips it horizontally and vertically too).
+
+    >>> split_cube_cross(np.zeros((6, 8, 3), np.float32)).shape
+    (6, 2, 2, 3)
+    """
+    h, w = image.shape[:2]
+    if w * 3 == h * 4 and w % 4 == 0:
+        s = w // 4
+        cells = {0: (1, 2), 1: (1, 0), 2: (0, 1), 3: (2, 1), 4: (1, 1), 5: (1, 3)}  # face: (row, col)
+        rotate = ()
+    elif w * 4 == h * 3 and w % 3 == 0:
+        s = w // 3
+        cells = {0: (1, 2), 1: (1, 0), 2: (0, 1), 3: (2, 1), 4: (1, 1), 5: (3, 1)}
+        rotate = (5,)
+    else:
+        raise ImageLoadError(f"a cube-map cross is 4:3 (horizontal) or 3:4 (vertical) with square faces, "
+                             f"got {w}×{h}")
+    faces = []
+    for k in range(6):
+        r, c = cells[k]
+        face = image[r * s:(r + 1) * s, c * s:(c + 1) * s]
+        faces.append(face[::-1, ::-1] if k in rotate else face)
+    return np.ascontiguousarray(np.stack(faces))
 
 
 def stack_cube_faces(faces: list[np.ndarray]) -> np.ndarray:
