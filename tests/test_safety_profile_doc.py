@@ -79,7 +79,9 @@ def test_bad_profile_json_is_refused_with_the_key_path(profiled, tmp_path, stabi
         text = json.dumps(doc).replace("Infinity", "1e999")
     (folder / "profile.json").write_text(text)
     expected = expected.replace("[T]", f"[{t}]")
-    case = stability_case(f"profile.json: {name}", AREA, f"{expected.split(':')[0]} = {value!r} in a real profile")
+    given = (f"nodes[{t}].alpha = NaN (the JSON token)" if value == "NaN"
+             else f"{expected.split(':')[0]} = {value!r}")
+    case = stability_case(f"profile.json: {name}", AREA, f"{given} in a real profile")
     with pytest.raises(RRCacheError) as info:
         load_profile(folder)
     msg = str(info.value)
