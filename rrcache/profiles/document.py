@@ -287,7 +287,9 @@ class Profile:
             raise RRCacheError(f"profile version {version!r}; this rrcache reads {PROFILE_VERSION}", file,
                                hint="run 'rrcache profile' again with this rrcache")
         body = {k: v for k, v in data.items() if k != "rrcache_profile"}
-        return _read_dataclass(cls, body, "", file)
+        prof = _read_dataclass(cls, body, "", file)
+        _check_models(prof, file)
+        return prof
 
     def __repr__(self) -> str:
         ms = f"original {self.original_ms:.2f} ms" if isinstance(self.original_ms, float) else "no timing"
@@ -374,6 +376,43 @@ def _read(value, tp, path: str, file: str, meta):
     raise TypeError(f"no reader for {tp!r}")  # a shape declared with a type this module cannot check
 
 
+#: the numbers of the fitted models' dictionaries (``error_fit``, ``perf_fit``, ``hit_fit``) the
+#: selection computes with: each must be a finite number in its range
+_MODEL_NUMBERS = {
+    "error_fit": {"alpha": (0, None), "lam": (0, None)},
+    "perf_fit": {"t_hit": (0, None), "t_miss": (0, None), "t_overhead": (0, None)},
+    "hit_fit": {"mu": (0, 1)},
+}
+#: what a trained node must carry (null only for a node that was not trained)
+_TRAINED_NUMBERS = ("alpha", "lam", "t_hit", "t_miss")
+
+
+def _check_models(prof: "Profile", file: str) -> None:
+    """The checks the field types cannot say: a trained node has its α, λ, t_hit and t_miss, and
+    the fitted models' numbers (what :meth:`Profile.fits` rebuilds the models from) are finite and
+    in range: a NaN, infinite, negative or null one is refused with its key path."""
+    def check(data, kind, at):
+        for key, (low, high) in _MODEL_NUMBERS[kind].items():
+            if key not in data:
+                continue
+            value = data[key]
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or not _in_range(value, {"minimum": low, "maximum": high}):
+                raise _fail(file, f"{at}.{key}", "must be a finite number" + _bounds({"minimum": low, "maximum": high}))
+
+    for i, node in enumerate(prof.nodes):
+        if node.trained:
+            for name in _TRAINED_NUMBERS:
+                if getattr(node, name) is None:
+                    raise _fail(file, f"nodes[{i}].{name}", "must be a finite number >= 0 for a trained node")
+            for kind in ("error_fit", "perf_fit"):
+                if not getattr(node, kind):
+                    raise _fail(file, f"nodes[{i}].{kind}", "is missing for a trained node")
+                check(getattr(node, kind), kind, f"nodes[{i}].{kind}")
+    if prof.hit_fit:
+        check(prof.hit_fit, "hit_fit", "hit_fit")
+
+
 def _in_range(value, meta) -> bool:
     low, high = meta.get("minimum"), meta.get("maximum")
     return (low is None or value >= low) and (high is None or value <= high)
@@ -450,6 +489,9 @@ def load_profile(path) -> Profile:
         data = json.loads(file.read_text(encoding="utf-8"), parse_constant=_no_constant)
     except (OSError, UnicodeDecodeError, ValueError) as err:
         raise RRCacheError(f"cannot read the profile ({err})", str(file), hint="run 'rrcache profile' again") from None
+    except RecursionError:  # JSON nested thousands deep: no profile looks like that
+        raise RRCacheError("cannot read the profile (its JSON is nested too deeply)", str(file),
+                           hint="run 'rrcache profile' again") from None
     prof = Profile.from_json(data, str(file))
     prof.path = file.parent
     return prof

@@ -335,7 +335,8 @@ class ProfileStore:
         try:
             conn = sqlite3.connect(str(path), isolation_level=None)
         except sqlite3.Error as err:
-            raise _refuse(path, f"cannot create the profile store: {err}", "check that the folder is writable") from None
+            raise _refuse(path, f"cannot create the profile store: {err}",
+                          "free disk space or make the folder writable, then run the same command again") from None
         store = cls(path, conn)
         store._create(key)
         return store
@@ -381,7 +382,8 @@ class ProfileStore:
         except sqlite3.Error as err:
             if conn.in_transaction:
                 conn.execute("ROLLBACK")
-            raise _refuse(self.path, f"cannot create the profile store: {err}", "check that the folder is writable") from None
+            raise _refuse(self.path, f"cannot create the profile store: {err}",
+                          "free disk space or make the folder writable, then run the same command again") from None
 
     def _check(self, key: StoreKey) -> None:
         path = self.path

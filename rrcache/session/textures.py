@@ -88,6 +88,24 @@ def read_image(path: str) -> np.ndarray:
     return np.ascontiguousarray(data)
 
 
+def cube_face_size(width: int, height: int) -> int:
+    """The face size of a single-file cube map of ``width``×``height`` pixels (a strip or a
+    cross, as :func:`split_cube_strip` reads it), from the header alone; ImageLoadError otherwise.
+
+    >>> cube_face_size(8, 6)
+    2
+    """
+    w, h = int(width), int(height)
+    if w == 6 * h or h == 6 * w:
+        return min(w, h)
+    if w * 3 == h * 4 and w % 4 == 0:
+        return w // 4
+    if w * 4 == h * 3 and w % 3 == 0:
+        return w // 3
+    raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip or a 4:3 or 3:4 cross of "
+                         f"square faces, got {w}×{h}")
+
+
 def split_cube_strip(image: np.ndarray) -> np.ndarray:
     """A 6:1 horizontal or 1:6 vertical strip (or a cross, :func:`split_cube_cross`) → 6×S×S×C
     faces.
