@@ -25,8 +25,8 @@ import statistics
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Optional
 
-from rrcache.harness.cached import CachedRenderer, compare
-from rrcache.harness.renderer import Renderer
+from rrcache.harness.cached import compare
+from rrcache.harness.limit import all_hit_limit, probe_frames
 from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
 
@@ -160,17 +160,8 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
             getattr(bench, group).append(row)
 
     say("limit: every pixel hits")
-    probe = list(indices)[:: max(1, len(indices) // 5)][:5]
     variant = variant_for(work, node_id, compare_period, limit_algorithm)
-    cached_ms, original_ms = [], []
-    with Renderer(work.prepared, session, resolution) as original, \
-            CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:
-        for index in probe:
-            # alternating with the original frame by frame, as every other row is measured
-            times: list[float] = []
-            cached_ms.append(cached.render_static(
-                index, repeats=5, between=lambda: times.append(original.render_frame(index).ms)))
-            original_ms.append(statistics.median(times[2:]))
-    bench.limit_ms = statistics.median(cached_ms)
-    bench.limit_original_ms = statistics.median(original_ms)
+    limit = all_hit_limit(variant, session, work.prepared, probe_frames(indices), resolution, period=compare_period)
+    bench.limit_ms = limit.limit_ms
+    bench.limit_original_ms = limit.original_median_ms
     return bench

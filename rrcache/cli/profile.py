@@ -4,7 +4,10 @@
     rrcache profile marble.frag marble.json --out marble.rrprofile --budget 900 -D OCTAVES=5
     rrcache profile noise.frag orbit.json --resolution 32x24 --periods 2,4,8 --timing-frames 6
 
-A progress bar with an ETA runs on stderr while training (when stderr is a terminal). Rerunning
+The ceiling (:mod:`rrcache.profile.ceiling`) is measured first, in seconds: when no cached variant
+can reach ``--min-gain`` (default 1.1×) the command stops there and says so, with the measured
+ceiling, why, and what would change it. Progress goes to stderr (:mod:`rrcache.cli.progress`: a bar
+on a terminal, a line per finished step elsewhere; ``--quiet`` for none). Rerunning
 the same command resumes: every stored run is skipped (the summary says how many). Ctrl-C stops
 after the run in flight is dropped: what is stored stays, it is listed, and the exit code is 130.
 The closing summary gives the nodes trained, μ, the overhead, the original's frame time and the
@@ -17,11 +20,11 @@ import warnings
 
 import click
 from rich.console import Console
-from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
-                           TimeRemainingColumn)
 from rich.table import Table
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.errors import RRCacheError
 from rrcache.profile.profile import STORE_NAME, algorithm_line, default_out_dir, profile
 from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
@@ -72,15 +75,25 @@ def _fmt(value, spec=".3g", none="–"):
               help="Render each selection over the first N frames (default: all).")
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
+@click.option("--min-gain", type=click.FloatRange(min=0, max=100, max_open=True), default=None,
+              help=f"The least speed-up worth having (default: {TrainingSettings.min_gain:g}): the ceiling is "
+                   "measured first and the profile stops with the answer 'the original' when nothing can "
+                   "reach it; nodes whose best case is below it are not trained. 0: never stop.")
+@click.option("--timing-format", type=click.Choice(tuple(COLOR_FORMATS)), default=None,
+              help="Colour target of every timed run, original and variants alike (default: "
+                   f"{TrainingSettings.timing_format}, as applications draw); error runs use rgba32f.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@quiet_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, defines):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, defines,
+            quiet):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
                   validate=not no_validate, validation_frames=validation_frames)
-    for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving)):
+    for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
+                        ("min_gain", min_gain), ("timing_format", timing_format)):
         if value is not None:
             kwargs[name] = value
     if periods is not None:
@@ -90,19 +103,11 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
     settings = TrainingSettings(**kwargs)
     out = out_dir if out_dir is not None else default_out_dir(shader, session)
 
-    bar = Progress(TextColumn("{task.description:<32}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                   TextColumn("ETA"), TimeRemainingColumn(), console=err_console, transient=True,
-                   disable=not err_console.is_terminal)
-    task = bar.add_task("starting", total=None)
-
-    def progress(event):
-        bar.update(task, completed=event.done, total=event.total, description=f"{event.stage} {event.detail}"[:32])
-
     try:
-        with bar, warnings.catch_warnings(record=True) as caught:
+        with Reporter(err_console, quiet=quiet) as reporter, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh)
+                prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
@@ -132,7 +137,22 @@ def _interrupted(out, err_console) -> None:
         err_console.print(f"nothing readable is stored ({err})", highlight=False, markup=False)
 
 
+def _verdict(prof, console: Console) -> None:
+    v, ceiling = prof.verdict, prof.ceiling
+    console.print(f"profile: {prof.path}", highlight=False)
+    console.print(f"answer: {v['answer']}", highlight=False)
+    if ceiling is not None:
+        console.print(f"ceiling: {ceiling.summary()}", highlight=False)
+    console.print(f"why: {v['reason']}", highlight=False)
+    console.print("what would change it:", highlight=False)
+    for change in v["changes"]:
+        console.print(f"  - {change}", highlight=False)
+
+
 def _summary(prof, console: Console) -> None:
+    if prof.verdict is not None:
+        _verdict(prof, console)
+        return
     c = prof.counts
     trained = len(prof.trained_nodes)
     console.print(f"profile: {prof.path}", highlight=False)
@@ -147,6 +167,9 @@ def _summary(prof, console: Console) -> None:
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
+    ceiling = prof.ceiling
+    if ceiling is not None:
+        console.print(f"ceiling: {ceiling.summary()}", highlight=False)
     table = Table(title="selections")
     for name in ("level", "max error", "node", "Δn", "speed-up pred.", "speed-up meas.", "error pred.",
                  "error meas.", "PSNR"):

@@ -66,8 +66,10 @@ class CachedRenderer:
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
                  period: int = 8, block: int = 4, refresh: str = "random", depth_epsilon: float = 1e-3,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
-                 ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None):
+                 ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
+                 color_format: str = "rgba32f"):
         self.ctx = ctx or get_context()
+        self.color_format = color_format
         self.variant = variant
         self.session = session
         self.size = tuple(int(v) for v in (resolution or session.resolution))
@@ -91,7 +93,7 @@ class CachedRenderer:
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
-                clear_color=session_background(session))
+                clear_color=session_background(session), color_format=color_format)
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:
@@ -249,6 +251,7 @@ class Comparison:
     resolution: tuple[int, int] = (0, 0)
     skip_first: int = 1  # frames left out of the summary: the first one has no cache
     payload_dtype: str = "f4"  # the cache precision used (f4 when an f2 request did not fit)
+    color_format: str = "rgba32f"  # the colour target both drew into
 
     def _steady(self) -> list[FrameComparison]:
         steady = self.frames[self.skip_first:]
@@ -312,15 +315,19 @@ def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
             resolution: Optional[tuple[int, int]] = None, block: int = 4, refresh: str = "random",
             depth_epsilon: float = 1e-3, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
-            window: Optional[tuple[int, int, int, int]] = None) -> Comparison:
+            window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f") -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
     is called per frame (for progress bars and writing images). ``window``: both render only
-    that rectangle of the frame (errors and times are then the window's)."""
+    that rectangle of the frame (errors and times are then the window's). ``color_format``: the
+    colour target both draw into (:mod:`rrcache.gl.formats`; ``rgba8`` as an application draws,
+    the error then being what it displays)."""
     result = Comparison()
-    with Renderer(prepared, session, resolution, window=window) as original, \
+    result.color_format = color_format
+    with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
             CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
-                           depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window) as cached:
+                           depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window,
+                           color_format=color_format) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:

@@ -2,7 +2,7 @@
 
 :class:`Renderer` compiles the shader with the generated vertex shader, checks that the session
 supplies every uniform and sampler the program uses, uploads meshes and textures once, and then
-renders frames into an RGBA32F colour target plus a depth texture: depth test on, back faces
+renders frames into a colour target (RGBA32F by default; ``color_format``) plus a depth texture: depth test on, back faces
 drawn, cleared to the session background. Per frame it returns a :class:`FrameResult`: the image
 (H×W×4 float32, row 0 = top), the covered pixels (where geometry was drawn: depth written), the
 samples that passed the depth test (an occlusion query: shaded fragments, overdraw included) and
@@ -27,6 +27,7 @@ import numpy as np
 
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
+from rrcache.gl.formats import ERROR_FORMAT, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
@@ -84,7 +85,9 @@ class Renderer:
     """Renders frames of ``session`` through ``prepared`` at ``resolution`` (default: the session's).
 
     Back faces are culled for every object the session does not mark ``double_sided`` (pass
-    ``cull_back_faces`` to override). Holds GL objects until :meth:`release` (or the end of a
+    ``cull_back_faces`` to override). ``color_format`` (:mod:`rrcache.gl.formats`) is the colour
+    target's format: ``rgba32f`` (the default, exact) for error runs, ``rgba8`` to time frames as
+    an application draws them; images are float32 either way. Holds GL objects until :meth:`release` (or the end of a
     ``with`` block). ``notes`` lists what
     the session supplies that the shader does not use. ``window`` = (x, y, w, h) (pixels, origin
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
@@ -96,9 +99,11 @@ class Renderer:
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
                  cull_back_faces: Optional[bool] = None, ctx: Optional[moderngl.Context] = None,
-                 window: Optional[tuple[int, int, int, int]] = None):
+                 window: Optional[tuple[int, int, int, int]] = None, color_format: str = ERROR_FORMAT):
         self.ctx = ctx or get_context()
         self.prepared = prepared
+        self.color_format = color_format
+        self._color_dtype = color_dtype(color_format)
         self.session = session
         self.size = tuple(int(v) for v in (resolution or session.resolution))
         self._asked_size = resolution is not None
@@ -126,7 +131,7 @@ class Renderer:
         self.plan = self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
         w, h = self.size
-        self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
+        self._color = self._scope.own(ctx.texture((w, h), 4, dtype=self._color_dtype))
         self._depth = self._scope.own(ctx.depth_texture((w, h)))
         self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
         self.fbo.scissor = self.window
@@ -165,7 +170,7 @@ class Renderer:
             self._warm = True
         ms, samples = self._draw(index)
         w, h = self.size
-        image = crop_rows(np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4), self.window).copy()
+        image = crop_rows(texture_floats(self._color.read(), self._color_dtype, (h, w, 4)), self.window).copy()
         depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
         mask = depth < 1.0
         return FrameResult(index, image, int(mask.sum()), ms, mask, samples)

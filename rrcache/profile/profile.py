@@ -149,6 +149,19 @@ class Profile:
         self._table = None
 
     @property
+    def ceiling(self):
+        """The measured :class:`~rrcache.profile.ceiling.Ceiling` (None in older profiles)."""
+        from rrcache.profile.ceiling import Ceiling
+
+        return Ceiling.from_json(self.data.get("ceiling"))
+
+    @property
+    def verdict(self) -> Optional[dict]:
+        """When the ceiling stopped the profile before training: ``choice`` ("original"),
+        ``ceiling``, ``answer``, ``reason``, ``changes``; else None."""
+        return self.data.get("verdict")
+
+    @property
     def algorithm(self) -> str:
         """The cache algorithm the profile was trained and validated with (``auto`` settings:
         the one its plan measured faster)."""
@@ -183,6 +196,9 @@ class Profile:
             from rrcache.model import ModelTable
 
             errors, perfs, hit = self.fits()
+            if self.verdict is not None:
+                raise RRCacheError(f"no node was trained: {self.verdict['answer']}", self._where,
+                                   hint="; ".join(self.verdict["changes"]))
             if hit is None or not errors:
                 raise RRCacheError("this profile has no trained node", self._where,
                                    hint="run 'rrcache profile' with a larger --budget")
@@ -205,6 +221,10 @@ class Profile:
         if not math.isfinite(level) or level < 0:
             raise RRCacheError(f"{max_error!r} is not an error threshold", "--max-error",
                                hint="give a mean RGB L2 error >= 0, e.g. 0.01 (profile.json lists the e1..e4 levels)")
+        if self.verdict is not None:  # the ceiling answered before training: the original
+            from rrcache.model import Selection
+
+            return Selection(None, None, 0.0, float(self.original_ms), 1.0)
         return model_select(self.table, level)
 
     def write_variant(self, choice, out_dir) -> list[str]:
@@ -213,11 +233,12 @@ class Profile:
         shader is loaded again and must still have the profiled hash."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        if choice.node is None:
+        if choice is None or choice.node is None:
+            note = (self.verdict["answer"] if self.verdict is not None
+                    else "no cached variant is predicted to beat the original at this error")
             path = out / "manifest.json"
             path.write_text(json.dumps({"rrcache_selection": 1, "node": None, "shader": self.shader,
-                                        "note": "no cached variant is predicted to beat the original at this error"},
-                                       indent=2) + "\n")
+                                        "note": note}, indent=2) + "\n")
             return [str(path)]
         from rrcache.pipeline import load_for_session, variant_for
         from rrcache.session import load_session
@@ -393,6 +414,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         "pixels": result.pixels,
         "training_wall_s": result.spent_s,
         "counts": result.counts,
+        "ceiling": result.ceiling.to_json() if result.ceiling is not None else None,
+        "verdict": _verdict(result.ceiling) if result.stopped else None,
         "selections": [],
     }
     prof = Profile(_finite(data))
@@ -407,6 +430,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
                                            r.predicted_error, r.predicted_ms, r.predicted_speedup, r.measured_error,
                                            r.measured_psnr, r.measured_ms, r.measured_original_ms,
                                            r.measured_speedup, r.hit_rate, r.frames) for r in rows]
+        # the counts were taken before validation: take them again
+        prof.counts = prof.data["counts"] = dict(result.counts, validations=store.counts()["validations"])
     elif result.trained:
         from rrcache.model import select as model_select, thresholds
 
@@ -417,6 +442,14 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
                                                    float(c.predicted_error), float(c.predicted_ms),
                                                    float(c.predicted_speedup)))
     return prof
+
+
+def _verdict(ceiling) -> dict:
+    """What profile.json says when the ceiling stopped the profile before training."""
+    return {"choice": "original", "ceiling": ceiling.speedup, "min_gain": ceiling.min_gain,
+            "answer": f"keep the original shader: no cached variant can reach {ceiling.min_gain:.2f}× here "
+                      f"(ceiling {ceiling.speedup:.2f}×)",
+            "reason": ceiling.reason(), "changes": ceiling.changes()}
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
@@ -437,6 +470,9 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     prof.path = out
     prof._where = str(out / JSON_NAME)
     prof.data["selections"] = [_finite(dataclasses.asdict(s)) for s in prof.selections]
+    if prof.verdict is not None:  # stopped before training: nothing to plot or report
+        prof.write_variant(None, out / "optimized" / "original")
+        plots = False
     if plots:
         from rrcache.profile.plots import write_plots
 

@@ -54,6 +54,7 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
+from rrcache.profile.ceiling import Ceiling, measure_ceiling
 from rrcache.profile.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                    shader_inputs, signature)
 from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
@@ -92,10 +93,10 @@ class _Meter:
         if self.progress is not None:
             self.progress(ProgressEvent(stage, self.done, self.total, detail))
 
-    def shrink(self, by: int) -> None:
+    def shrink(self, by: int, stage: str = "train", detail: str = "budget spent") -> None:
         self.total = max(self.done, self.total - by)
         if self.progress is not None:
-            self.progress(ProgressEvent("train", self.done, self.total, "budget spent"))
+            self.progress(ProgressEvent(stage, self.done, self.total, detail))
 
     def grow(self, by: int) -> None:
         self.total += by
@@ -126,6 +127,10 @@ class TrainingResult:
     budget_stopped: bool = False
     notes: dict = field(default_factory=dict)
     plan: Optional[Plan] = None
+    #: the measured ceiling (:mod:`rrcache.profile.ceiling`), and whether it stopped the profile
+    #: before training (nothing can reach ``settings.min_gain``)
+    ceiling: Optional[Ceiling] = None
+    stopped: bool = False
 
 
 def training_order(work: ShaderWork, session, settings: TrainingSettings) -> TrainingOrder:
@@ -222,7 +227,8 @@ def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node
     for algorithm in AUTO_CANDIDATES:
         variant = variant_for(work, node_id, period, algorithm)
         with CachedRenderer(variant, session, work.prepared, full, period=period, block=settings.block,
-                            refresh=settings.refresh, depth_epsilon=settings.depth_epsilon, window=window) as cached:
+                            refresh=settings.refresh, depth_epsilon=settings.depth_epsilon, window=window,
+                            color_format=settings.timing_format) as cached:
             frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
         fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
     return min(fractions, key=fractions.get), fractions
@@ -272,8 +278,10 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
 
     original: Optional[Renderer] = None
     timed_original: Optional[Renderer] = None
+    ceiling: Optional[Ceiling] = None
+    fmt = settings.timing_format
     try:
-        original = Renderer(work.prepared, session, full)
+        original = Renderer(work.prepared, session, full, color_format=fmt)
         if need_ref_timing:
             rows = []
             for index in timing:
@@ -290,8 +298,35 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             plan = Plan.from_json(stored_plan)
         if plan.timing_window is not None:
             original.release()
-            original = Renderer(work.prepared, session, full, window=plan.timing_window)
+            original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt)
         timed_original = original
+        if order.nodes and len(timing) > 0:
+            ceiling = _ceiling(work, session, settings, store, plan, order.nodes[0], timing, meter)
+            if settings.min_gain > 0 and not ceiling.reaches:
+                # nothing can pay: answer now, before any training
+                if plan.algorithm is None:
+                    plan.algorithm = ceiling.algorithm if settings.algorithm == "auto" else settings.algorithm
+                    store.set_plan(plan.to_json())
+                meter.shrink(meter.total - meter.done, "ceiling", f"{ceiling.speedup:.2f}× < {settings.min_gain:.2f}×: stop")
+                notes.update({n.id: f"not trained: the ceiling ({ceiling.speedup:.2f}×) is below --min-gain "
+                                    f"{settings.min_gain:.2f}×" for n in order.nodes})
+                result = TrainingResult(order=ids + [i for i in _skipped_ids(work, order)], trained=[],
+                                        untrained=ids + _skipped_ids(work, order), notes=notes, plan=plan,
+                                        ceiling=ceiling, stopped=True)
+                fit_models(store, settings, result)
+                result.counts = store.counts()
+                result.wall_s = clock() - start
+                result.spent_s = store.spent_s()
+                return result
+            pruned = _prune(work, order, ceiling, settings)
+            for nid, why in pruned.items():
+                notes[nid] = why
+                meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing),
+                             "ceiling", f"{len(pruned)} nodes cannot pay")
+                todo_error[nid], todo_timing[nid] = [], []
+            order.nodes = [n for n in order.nodes if n.id not in pruned]
+            order.skipped.update(pruned)
+            ids = [n.id for n in order.nodes]
         if plan.algorithm is None:
             if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
                 meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
@@ -334,7 +369,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, full, period=settings.timing_periods[0],
                                     block=settings.block, refresh=settings.refresh,
-                                    depth_epsilon=settings.depth_epsilon, window=plan.timing_window) as cached:
+                                    depth_epsilon=settings.depth_epsilon, window=plan.timing_window,
+                                    color_format=fmt) as cached:
                     compile_s = clock() - built
                     for period in todo_timing[nid]:
                         t0 = clock()
@@ -352,10 +388,10 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     if trained and need_overhead:
         _measure_overhead(work, session, settings, store, trained[0], timing, meter, plan.algorithm)
 
-    skipped_ids = [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
+    skipped_ids = _skipped_ids(work, order)
     result = TrainingResult(order=ids + skipped_ids, trained=trained,
                             untrained=[i for i in ids + skipped_ids if i not in trained],
-                            budget_stopped=budget_stopped, notes=notes, plan=plan)
+                            budget_stopped=budget_stopped, notes=notes, plan=plan, ceiling=ceiling)
     fit_models(store, settings, result)
     result.counts = store.counts()
     result.wall_s = clock() - start
@@ -363,11 +399,48 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     return result
 
 
+def _skipped_ids(work: ShaderWork, order: TrainingOrder) -> list[str]:
+    return [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
+
+
+def _ceiling(work, session, settings: TrainingSettings, store: ProfileStore, plan: Plan, node, timing, meter) -> Ceiling:
+    """The plan's ceiling, measured once (kept in the store's plan; ``min_gain`` is the settings')."""
+    if plan.ceiling is not None:
+        ceiling = Ceiling.from_json(plan.ceiling)
+        ceiling.min_gain = settings.min_gain
+        return ceiling
+    ref = store.reference_timing()
+    pixels = float(np.mean([c for _, _, c in ref])) if ref else 0.0
+    algorithms = AUTO_CANDIDATES if settings.algorithm == "auto" else (settings.algorithm,)
+    meter.grow(2 * len(algorithms))
+    ceiling = measure_ceiling(work, session, settings, node, algorithms, timing, pixels, plan.timing_window,
+                              step=lambda detail: meter.step("ceiling", detail))
+    plan.ceiling = ceiling.to_json()
+    store.set_plan(plan.to_json())
+    return ceiling
+
+
+def _prune(work: ShaderWork, order: TrainingOrder, ceiling: Ceiling, settings: TrainingSettings) -> dict[str, str]:
+    """{node id: reason} of the nodes to train whose best case (:meth:`Ceiling.node_speedup` from
+    their share of the costliest node's static cost) is below ``settings.min_gain``."""
+    if settings.min_gain <= 0 or not order.nodes:
+        return {}
+    top = max(n.cost for n in work.table.nodes) or 1
+    out = {}
+    for n in order.nodes[1:]:  # the measured node itself is bounded by the ceiling, which reaches
+        best = ceiling.node_speedup(n.cost / top)
+        if best < settings.min_gain:
+            out[n.id] = (f"its best case ({best:.2f}× with every pixel hitting, from its {n.cost / top:.0%} "
+                         f"of the static cost and the measured ceiling) is below --min-gain {settings.min_gain:.2f}×")
+    return out
+
+
 def _measure_overhead(work, session, settings, store, node_id, timing, meter, algorithm: str) -> None:
     variant = variant_for(work, node_id, settings.timing_periods[-1], algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
-                        block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon) as cached:
+                        block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon,
+                        color_format=settings.timing_format) as cached:
         for index in timing:
             cached.reset()
             cached.render_frame(index - 1)

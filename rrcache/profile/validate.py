@@ -66,7 +66,8 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
 
                 result = compare(variant, session, work.prepared, frames, period=int(choice.period),
                                  block=settings.block, refresh=settings.refresh,
-                                 depth_epsilon=settings.depth_epsilon, on_frame=step, window=window)
+                                 depth_epsilon=settings.depth_epsilon, on_frame=step, window=window,
+                                 color_format=settings.timing_format)
                 measured[key] = (result.mean_error, min(result.psnr, PSNR_CAP), result.ms_per_frame,
                                  result.original_ms_per_frame, result.speedup, result.hit_rate, len(result.frames))
             row = ValidationRow(label, level, choice.node, int(choice.period), float(choice.predicted_error),

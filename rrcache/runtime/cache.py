@@ -52,6 +52,7 @@ import moderngl
 import numpy as np
 
 from rrcache.gl.context import bind_default_framebuffer
+from rrcache.gl.formats import bytes_per_texel, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
@@ -91,7 +92,8 @@ class CacheRuntime:
     ``programs`` maps the pass names of ``algorithm`` (see :data:`ALGORITHMS`) to linked
     programs. ``size`` is (width, height). ``period`` (Δn), ``block`` (k), ``refresh`` and
     ``depth_epsilon`` can be changed between frames (they are uniforms or small textures).
-    ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
+    ``color_format`` (``rgba8``, ``rgba16f``, ``rgba32f``; :mod:`rrcache.gl.formats`) is the
+    format of the colour target the variant draws into. ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
     the application's culling state alone (the draw callback may set it per object).
 
     Example, inside a render loop (``draw`` renders the scene with the given program)::
@@ -118,6 +120,7 @@ class CacheRuntime:
         depth_epsilon: float = 1e-3,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
         cull_back_faces: Optional[bool] = None,
+        color_format: str = "rgba32f",
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -131,6 +134,8 @@ class CacheRuntime:
         if block not in BLOCK_SIZES:
             raise ValueError(f"block must be one of {BLOCK_SIZES}, not {block}")
         self.ctx = ctx
+        self.color_format = color_format
+        self._color_dtype = color_dtype(color_format)
         self.programs = programs
         self.algorithm = algorithm
         self.payload_dtype = payload_dtype
@@ -195,7 +200,7 @@ class CacheRuntime:
         ctx = self.ctx
         self.size = (w, h)
         self.depth = ctx.depth_texture((w, h))
-        self.color = ctx.texture((w, h), 4, dtype="f4")
+        self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
         self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
         self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
         for tex in self._payload + self._invdepth:
@@ -245,7 +250,7 @@ class CacheRuntime:
         """Memory per pixel of the cache's targets (depth, colour, two payloads, two inverse
         depths) plus the colour and depth read back (41): what :meth:`resize` checks first."""
         payload = self.payload_components * (4 if self.payload_dtype == "f4" else 2)
-        return 4 + 16 + 2 * payload + 2 * 4 + 41
+        return 4 + bytes_per_texel(self.color_format) + 2 * payload + 2 * 4 + 41
 
     def reset(self) -> None:
         """Forget the cache: the next frame misses everywhere (as after a camera cut)."""
@@ -356,8 +361,7 @@ class CacheRuntime:
 
     def _read(self, tex: moderngl.Texture, components: int) -> np.ndarray:
         w, h = self.size
-        data = np.frombuffer(tex.read(), dtype=np.float32 if tex.dtype == "f4" else np.float16)
-        return crop_rows(data.reshape(h, w, components), self.window).astype(np.float32)
+        return crop_rows(texture_floats(tex.read(), tex.dtype, (h, w, components)), self.window).astype(np.float32)
 
     def read_color(self) -> np.ndarray:
         """The last frame's colour, float32 (height, width, 4), row 0 = top of the image (only
