@@ -63,6 +63,8 @@ from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
 
+#: a ceiling below ``min_gain`` but within this factor of it is measured a second time
+CEILING_RECHECK = 1.3
 #: the resolution of the overhead measurement
 OVERHEAD_SIZE = (8, 8)
 PSNR_CAP = 100.0
@@ -415,6 +417,14 @@ def _ceiling(work, session, settings: TrainingSettings, store: ProfileStore, pla
     meter.grow(2 * len(algorithms))
     ceiling = measure_ceiling(work, session, settings, node, algorithms, timing, pixels, plan.timing_window,
                               step=lambda detail: meter.step("ceiling", detail))
+    if settings.min_gain > 0 and ceiling.speedup < settings.min_gain <= ceiling.speedup * CEILING_RECHECK:
+        # near the line a loaded machine decides: measure again and keep the higher ceiling, so
+        # that noise does not stop a profile that could pay
+        meter.grow(2 * len(algorithms))
+        again = measure_ceiling(work, session, settings, node, algorithms, timing, pixels, plan.timing_window,
+                                step=lambda detail: meter.step("ceiling", f"again: {detail}"))
+        again.wall_s += ceiling.wall_s
+        ceiling = max(ceiling, again, key=lambda c: c.speedup)
     plan.ceiling = ceiling.to_json()
     store.set_plan(plan.to_json())
     return ceiling
