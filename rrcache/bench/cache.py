@@ -25,6 +25,7 @@ import statistics
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Optional
 
+from rrcache.gl.formats import DEFAULT_TIMING_FORMAT
 from rrcache.harness.cached import compare
 from rrcache.harness.limit import all_hit_limit, probe_frames
 from rrcache.pipeline import load_for_session, variant_for
@@ -73,6 +74,8 @@ class CacheBench:
     #: the node at the compared period with refresh turned off: only disocclusions miss (the
     #: gap between this row and the limit is what disocclusions cost, the rest is the refresh)
     no_refresh: Optional[BenchRow] = None
+    #: the colour target every render drew into
+    color_format: str = DEFAULT_TIMING_FORMAT
 
     @property
     def limit_fraction(self) -> float:
@@ -92,7 +95,7 @@ class CacheBench:
     def markdown(self) -> str:
         """The tables as Markdown (for the README)."""
         lines = [f"`{self.shader}` × `{self.session}`, caching `{self.node}` (`{self.node_text}`), "
-                 f"{self.resolution[0]}×{self.resolution[1]}, {self.frames} frames", ""]
+                 f"{self.resolution[0]}×{self.resolution[1]}, {self.frames} frames, {self.color_format} colour target", ""]
         header = "| | algorithm | Δn | k | speed-up (repeats) | hit rate | mean error | PSNR dB | ms | original ms |"
         rule = "|---|---|---|---|---|---|---|---|---|---|"
         for title, rows in (("refresh period", self.periods), ("algorithm", self.algorithms),
@@ -119,19 +122,20 @@ class CacheBench:
 
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
-        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
-        limit_algorithm: str = "three-pass") -> CacheBench:
+        progress: Optional[Callable[[str, int, int], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
+        limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
-    ``limit_algorithm``."""
-    say = progress or (lambda _msg: None)
+    ``limit_algorithm``; every render draws into a ``color_format`` colour target (the errors
+    are then those of that format). ``progress(message, done, total)`` before each step."""
+    step = {"done": 0}
     session = load_session(session_path)
     work = load_for_session(shader_path, session)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
     bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices),
-                       compare_period=compare_period)
+                       compare_period=compare_period, color_format=color_format)
 
     plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
     plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period)
@@ -143,12 +147,19 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     for _group, _label, algorithm, period, _block, _run in plan:
         if algorithm not in variants:
             variants[algorithm] = variant_for(work, node_id, period, algorithm)
+    total = len(plan) * repeats + 1
+
+    def say(message):
+        if progress is not None:
+            progress(message, step["done"], total)
+        step["done"] += 1
+
     runs: list[list] = [[] for _ in plan]
     for repeat in range(repeats):
         for i, (_group, label, algorithm, period, block, run_period) in enumerate(plan):
             say(f"[{repeat + 1}/{repeats}] {label}: {algorithm}, Δn={period}, k={block}")
             runs[i].append(compare(variants[algorithm], session, work.prepared, indices, period=run_period,
-                                   resolution=resolution, block=block))
+                                   resolution=resolution, block=block, color_format=color_format))
     for (group, label, algorithm, period, block, _run), repeated in zip(plan, runs):
         speedups = sorted(c.speedup for c in repeated)
         c = sorted(repeated, key=lambda c: c.speedup)[len(repeated) // 2]  # the median run
@@ -161,7 +172,98 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
 
     say("limit: every pixel hits")
     variant = variant_for(work, node_id, compare_period, limit_algorithm)
-    limit = all_hit_limit(variant, session, work.prepared, probe_frames(indices), resolution, period=compare_period)
+    limit = all_hit_limit(variant, session, work.prepared, probe_frames(indices), resolution, period=compare_period,
+                          color_format=color_format)
     bench.limit_ms = limit.limit_ms
     bench.limit_original_ms = limit.original_median_ms
+    if progress is not None:
+        progress("limit: done", total, total)
     return bench
+
+
+@dataclass
+class BreakdownRow:
+    """One configuration's all-hit frame, stage by stage (:func:`rrcache.harness.limit.all_hit_breakdown`)."""
+
+    algorithm: str
+    color_format: str
+    cached: dict
+    original: dict
+
+    @property
+    def speedup(self) -> float:
+        return self.original["plain_ms"] / self.cached["plain_ms"] if self.cached["plain_ms"] else float("nan")
+
+
+@dataclass
+class Breakdown:
+    """The all-hit cost per stage of each (algorithm, colour format), measured side by side with
+    the original, ``repeats`` times (each row the median repeat by speed-up; ``ranges`` the
+    repeats' speed-ups)."""
+
+    shader: str
+    session: str
+    node: str
+    resolution: tuple[int, int]
+    frames: list[int]
+    rows: list[BreakdownRow] = field(default_factory=list)
+    ranges: list = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    def markdown(self) -> str:
+        lines = [f"All-hit frame of `{self.shader}` caching `{self.node}`, {self.resolution[0]}×{self.resolution[1]}, "
+                 f"frames {self.frames}; each stage waited for (ctx.finish) before the next; fixed = the same stage "
+                 f"at 8×8 (geometry, state changes); per pixel = (ms − fixed) / covered pixels.", ""]
+        lines += ["| algorithm | colour | stage | ms | fixed ms | ns per covered pixel |", "|---|---|---|---|---|---|"]
+        for row in self.rows:
+            for who, data in (("cached", row.cached), ("original", row.original)):
+                for stage, ms in data["full_ms"].items():
+                    lines.append(f"| {row.algorithm} | {row.color_format} | {who}: {stage} | {ms:.2f} | "
+                                 f"{data['fixed_ms'].get(stage, float('nan')):.2f} | {data['per_pixel_ns'][stage]:.1f} |")
+        lines += ["", "| algorithm | colour | all-hit ms (no waits) | original ms | limit speed-up (repeats) | covered pixels |",
+                  "|---|---|---|---|---|---|"]
+        for row, (lo, hi) in zip(self.rows, self.ranges):
+            lines.append(f"| {row.algorithm} | {row.color_format} | {row.cached['plain_ms']:.2f} | "
+                         f"{row.original['plain_ms']:.2f} | {row.speedup:.2f}× ({lo:.2f}–{hi:.2f}) | "
+                         f"{row.cached['pixels']:.0f} |")
+        return "\n".join(lines)
+
+
+def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("three-pass", "two-pass"),
+              formats=("rgba32f", "rgba8"), frames: int = 60, resolution: Optional[tuple[int, int]] = None,
+              period: int = 16, repeats: int = 3,
+              progress: Optional[Callable[[str, int, int], None]] = None) -> Breakdown:
+    """Measure the all-hit frame stage by stage for every algorithm and colour format (see
+    :class:`Breakdown`); the configurations take turns within each repeat."""
+    from rrcache.harness.limit import all_hit_breakdown
+
+    session = load_session(session_path)
+    work = load_for_session(shader_path, session)
+    work.node(node_id)
+    indices = probe_frames(range(min(frames, session.frames)), 3)
+    size = tuple(resolution or session.resolution)
+    out = Breakdown(shader_path, session_path, node_id, size, list(indices))
+    configs = [(a, f) for a in algorithms for f in formats]
+    variants = {a: variant_for(work, node_id, period, a) for a in algorithms}
+    measured = {c: [] for c in configs}
+    done, total = 0, len(configs) * repeats
+    for repeat in range(repeats):
+        for algorithm, fmt in configs:
+            if progress is not None:
+                progress(f"[{repeat + 1}/{repeats}] breakdown {algorithm} {fmt}", done, total)
+            cached, original = all_hit_breakdown(variants[algorithm], session, work.prepared, indices, resolution,
+                                                 period=period, color_format=fmt)
+            cj, oj = cached.to_json(), original.to_json()
+            # the original's frame without waits: clear + draw (its stages are one of each)
+            oj["plain_ms"] = original.frame_ms
+            measured[(algorithm, fmt)].append(BreakdownRow(algorithm, fmt, cj, oj))
+            done += 1
+    for config in configs:
+        rows = sorted(measured[config], key=lambda r: r.speedup)
+        out.rows.append(rows[len(rows) // 2])
+        out.ranges.append((rows[0].speedup, rows[-1].speedup))
+    if progress is not None:
+        progress("breakdown: done", total, total)
+    return out

@@ -175,7 +175,8 @@ class CachedRenderer:
         payload = self.runtime.read_payload() if self.keep_payload else None
         return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
 
-    def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None) -> float:
+    def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None,
+                      stages: Optional[dict] = None) -> float:
         """The cached pipeline's best case: frame ``index`` shown again and again with nothing
         moving and no refresh, so every covered pixel hits after the first showing. Returns the
         median ms of the ``repeats`` hitting frames (the speed-up limit's denominator). The cache
@@ -184,7 +185,11 @@ class CachedRenderer:
         Each frame is read back as :meth:`render_frame` does, and ``between()`` (if given) runs
         before each frame: :func:`compare` renders the original between two cached frames, and
         a limit measured back to back, with the CPU caches warm from the frame before, came out
-        ~25% faster than the same all-hit frame measured that way (Marble, 640×480)."""
+        ~25% faster than the same all-hit frame measured that way (Marble, 640×480).
+
+        ``stages`` (a dict; diagnostics) gets, per timed frame, the ms of each stage of the frame
+        (``clear``, each pass, ``queries``: the runtime waits for the GPU after each) and of the
+        read-back (``read-back``); the frame time is then that of the staged frame."""
         index = check_frame_index(self.session, index)
         if self._check_half:  # decide the payload precision first, on an untimed frame
             self.render_frame(index)
@@ -197,14 +202,27 @@ class CachedRenderer:
             for i in range(repeats + 2):
                 if between is not None:
                     between()
+                marks: list = []
+
+                def mark(stage):
+                    self.ctx.finish()
+                    marks.append((stage, time.perf_counter()))
+
                 self.ctx.finish()
                 start = time.perf_counter()
-                stats = self.runtime.frame(self.drawer.draw)
+                stats = self.runtime.frame(self.drawer.draw, mark=mark if stages is not None else None)
                 self.ctx.finish()
-                if i >= 2:
-                    times.append((time.perf_counter() - start) * 1000.0)
+                end = time.perf_counter()
                 self.runtime.read_color()
                 self.runtime.read_depth()
+                if i >= 2:
+                    times.append((end - start) * 1000.0)
+                    if stages is not None:
+                        last = start
+                        for stage, at in marks:
+                            stages.setdefault(stage, []).append((at - last) * 1000.0)
+                            last = at
+                        stages.setdefault("read-back", []).append((time.perf_counter() - end) * 1000.0)
             self.last_static_stats = stats
         finally:
             self.runtime.period = saved

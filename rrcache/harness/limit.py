@@ -96,3 +96,72 @@ def all_hit_limit(variant, session, prepared, frames: Sequence[int], resolution:
             if on_frame is not None:
                 on_frame(int(index))
     return out
+
+
+#: the resolution at which a stage's fixed cost (geometry: vertex processing, set-up, binning,
+#: state changes) is measured: almost no pixel is shaded there
+FIXED_SIZE = (8, 8)
+
+
+@dataclass
+class StageBreakdown:
+    """Where an all-hit frame's time goes, per stage (the GPU waited for after each): ``full``
+    stage → median ms at the measured size, ``fixed`` the same at :data:`FIXED_SIZE` (what does
+    not grow with the pixels: geometry, state changes), ``pixels`` the covered pixels at the
+    measured size; ``frame_ms`` the staged frame's median (clear to queries), ``plain_ms`` the
+    same frame without the waits between stages."""
+
+    full: dict = field(default_factory=dict)
+    fixed: dict = field(default_factory=dict)
+    pixels: float = 0.0
+    frame_ms: float = float("nan")
+    plain_ms: float = float("nan")
+
+    def per_pixel_ns(self, stage: str) -> float:
+        """The part of ``stage`` that grows with the covered pixels, per pixel (ns)."""
+        if not self.pixels:
+            return float("nan")
+        return max(self.full.get(stage, 0.0) - self.fixed.get(stage, 0.0), 0.0) / self.pixels * 1e6
+
+    def to_json(self) -> dict:
+        return {"full_ms": self.full, "fixed_ms": self.fixed, "pixels": self.pixels, "frame_ms": self.frame_ms,
+                "plain_ms": self.plain_ms, "per_pixel_ns": {k: self.per_pixel_ns(k) for k in self.full}}
+
+
+def _medians(stages: dict) -> dict:
+    return {k: statistics.median(v) for k, v in stages.items()}
+
+
+def all_hit_breakdown(variant, session, prepared, frames: Sequence[int], resolution=None, repeats: int = 5,
+                      period: int = 16, block: int = 4, color_format: str = "rgba32f",
+                      on_frame: Optional[Callable[[int], None]] = None) -> tuple[StageBreakdown, StageBreakdown]:
+    """(cached, original): the per-stage cost of ``variant``'s all-hit frame and of the
+    original's frame, alternating frame by frame as :func:`all_hit_limit` measures, at
+    ``resolution`` and at :data:`FIXED_SIZE`. Stages of the cached frame: ``clear``, each pass
+    (``reproject``/``payload``/``shade`` or ``hit``/``miss``), ``queries`` (the occlusion
+    query results) and ``read-back`` (colour and depth, what the harness reads after a timed
+    frame); of the original: ``clear``, ``draw``, ``queries``, ``read-back``."""
+    cached_out, original_out = StageBreakdown(), StageBreakdown()
+    for size, key in ((resolution, "full"), (FIXED_SIZE, "fixed")):
+        cached_stages: dict = {}
+        original_stages: dict = {}
+        frame_ms, plain_ms, covered = [], [], []
+        with Renderer(prepared, session, size, color_format=color_format) as original, \
+                CachedRenderer(variant, session, prepared, size, period=period, block=block,
+                               color_format=color_format) as cached:
+            for index in frames:
+                def between():
+                    got = original.render_frame(index, stages=original_stages)
+                    covered.append(got.covered_pixels)
+
+                frame_ms.append(cached.render_static(index, repeats=repeats, between=between, stages=cached_stages))
+                plain_ms.append(cached.render_static(index, repeats=repeats))
+                if on_frame is not None:
+                    on_frame(int(index))
+        setattr(cached_out, key, _medians(cached_stages))
+        setattr(original_out, key, _medians(original_stages))
+        if key == "full":
+            cached_out.pixels = original_out.pixels = statistics.mean(covered) if covered else 0.0
+            cached_out.frame_ms, cached_out.plain_ms = statistics.median(frame_ms), statistics.median(plain_ms)
+            original_out.frame_ms = sum(original_out.full.get(k, 0.0) for k in ("clear", "draw"))
+    return cached_out, original_out

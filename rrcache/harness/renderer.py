@@ -142,7 +142,7 @@ class Renderer:
     def _check_frame(self, index: int) -> int:
         return check_frame_index(self.session, index)
 
-    def _draw(self, index: int) -> tuple[float, int]:
+    def _draw(self, index: int, stages: Optional[dict] = None) -> tuple[float, int]:
         ctx = self.ctx
         self.drawer.set_frame(index)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -153,25 +153,38 @@ class Renderer:
         ctx.finish()
         start = time.perf_counter()
         self.fbo.clear(*background, depth=1.0)
+        if stages is not None:
+            ctx.finish()
+            cleared = time.perf_counter()
         with self._query:
             self.drawer.draw(self.program)
         ctx.finish()
-        ms = (time.perf_counter() - start) * 1000.0
-        return ms, int(self._query.samples)
+        end = time.perf_counter()
+        samples = int(self._query.samples)
+        if stages is not None:
+            stages.setdefault("clear", []).append((cleared - start) * 1000.0)
+            stages.setdefault("draw", []).append((end - cleared) * 1000.0)
+            stages.setdefault("queries", []).append((time.perf_counter() - end) * 1000.0)
+        return (end - start) * 1000.0, samples
 
-    def render_frame(self, index: int) -> FrameResult:
+    def render_frame(self, index: int, stages: Optional[dict] = None) -> FrameResult:
         """Render frame ``index`` (an int in ``0..session.frames-1``) and read it back.
 
         The first call draws once untimed (llvmpipe compiles the shader on its first draw).
+        ``stages`` (a dict; diagnostics) gets the ms of the clear, the draw, the query result
+        and the read-back of this frame, the GPU waited for after each.
         """
         index = self._check_frame(index)
         if not self._warm:
             self._draw(index)
             self._warm = True
-        ms, samples = self._draw(index)
+        ms, samples = self._draw(index, stages)
+        read = time.perf_counter()
         w, h = self.size
         image = crop_rows(texture_floats(self._color.read(), self._color_dtype, (h, w, 4)), self.window).copy()
         depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
+        if stages is not None:
+            stages.setdefault("read-back", []).append((time.perf_counter() - read) * 1000.0)
         mask = depth < 1.0
         return FrameResult(index, image, int(mask.sum()), ms, mask, samples)
 

@@ -299,13 +299,17 @@ class CacheRuntime:
         with query:
             draw(program, pass_name)
 
-    def frame(self, draw: DrawCallback, count: bool = True, after_first_pass: Optional[Callable[[], None]] = None) -> FrameStats:
+    def frame(self, draw: DrawCallback, count: bool = True, after_first_pass: Optional[Callable[[], None]] = None,
+              mark: Optional[Callable[[str], None]] = None) -> FrameStats:
         """Render one frame with the cache and advance the clock.
 
         ``after_first_pass`` (diagnostics only; it breaks timing) runs after the reprojection
-        pass, e.g. to read the hit map.
+        pass, e.g. to read the hit map. ``mark(stage)`` (diagnostics: the per-pass breakdown of
+        ``rrcache bench-cache``) is called after the clears (``"clear"``), after each pass (its
+        name) and after the query results are read (``"queries"``); it may wait for the GPU.
         """
         ctx = self.ctx
+        mark = mark or (lambda _stage: None)
         ctx.enable(moderngl.DEPTH_TEST)
         if self.cull_back_faces is True:
             ctx.enable(moderngl.CULL_FACE)
@@ -325,31 +329,40 @@ class CacheRuntime:
         # the refresh rule's uniforms, once per frame for every pass
         self._refresh_values = refresh_uniforms(self.size, self._block, self._refresh_mode, self.seed,
                                                 self._period, self.clock)
+        mark("clear")
         covered = misses = None
         if self.algorithm == "three-pass":
             self._run("reproject", draw)
+            mark("reproject")
             if after_first_pass:
                 after_first_pass()
                 cache_fbo.use()
             self._run("payload", draw, first)
+            mark("payload")
             self._out_fbo.depth_mask = False
             self._out_fbo.use()
             ctx.depth_func = "=="
             self._run("shade", draw, second)
+            mark("shade")
             self._out_fbo.depth_mask = True
             if count:
                 misses, covered = int(first.samples), int(second.samples)
         elif self.algorithm == "two-pass":
             self._run("hit", draw, first)
+            mark("hit")
             if after_first_pass:
                 after_first_pass()
                 cache_fbo.use()
             self._run("miss", draw, second)
+            mark("miss")
             if count:
                 misses = int(second.samples)
                 covered = int(first.samples) + misses
         else:
             self._run("single", draw)
+            mark("single")
+        if count:
+            mark("queries")
         ctx.depth_func = "<"
         stats = FrameStats(self.clock, covered, misses)
         self._index = 1 - self._index
