@@ -32,6 +32,12 @@ from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
 from rrcache.runtime import CacheRuntime
 
+def _unreliable() -> float:
+    from rrcache.harness.timing import UNRELIABLE_NOISE
+
+    return UNRELIABLE_NOISE
+
+
 #: the largest finite 16-bit float: payload values beyond it would be stored as ±inf
 HALF_MAX = 65504.0
 
@@ -314,6 +320,23 @@ class Comparison:
     def speedup(self) -> float:
         return self.original_ms_per_frame / self.ms_per_frame if self.ms_per_frame > 0 else float("nan")
 
+    @property
+    def speedup_interval(self) -> tuple[float, float]:
+        """A 95% bootstrap interval of :attr:`speedup` over the steady frame pairs
+        (:func:`rrcache.harness.timing.ratio_interval`)."""
+        from rrcache.harness.timing import ratio_interval
+
+        steady = self._steady()
+        return ratio_interval([f.original_ms for f in steady], [f.ms for f in steady])
+
+    @property
+    def noise(self) -> float:
+        """The relative noise of the original's frame times in this run
+        (:func:`rrcache.harness.timing.frame_noise`)."""
+        from rrcache.harness.timing import frame_noise
+
+        return frame_noise([f.original_ms for f in self._steady()])
+
     def summary(self) -> dict:
         """The figures ``rrcache render --node ... --json`` prints."""
         return {
@@ -326,6 +349,12 @@ class Comparison:
             "original_nonfinite_pixels": sum(f.original_nonfinite for f in self._steady()),
             "error_left_out_pixels": sum(f.left_out for f in self._steady()),
             "payload_dtype": self.payload_dtype,
+            "color_format": self.color_format,
+            # how far the speed-up can be trusted: a 95% interval over frame pairs, the noise of
+            # the original's frame times, and whether it was too noisy to rely on
+            "speedup_ci95": list(self.speedup_interval),
+            "noise": self.noise,
+            "reliable": self.noise <= _unreliable(),
         }
 
 

@@ -246,11 +246,12 @@ def as_prepared(shader, session, defines=None) -> PreparedShader:
 
 
 def render(shader, session, frames=None, resolution=None, defines=None,
-           progress: Optional[Callable[[FrameResult], None]] = None) -> RenderResult:
+           progress: Optional[Callable[[FrameResult], None]] = None, color_format: str = ERROR_FORMAT) -> RenderResult:
     """Render ``frames`` of ``session`` (None: all, an int: the first n, or a list of indices).
 
     ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
-    called with each :class:`FrameResult` as it is done.
+    called with each :class:`FrameResult` as it is done; ``color_format`` the colour target
+    (:mod:`rrcache.gl.formats`).
 
     >>> result = render("marble.frag", load_session("session.json"), frames=2)   # doctest: +SKIP
     >>> [f.index for f in result.frames]                                          # doctest: +SKIP
@@ -259,7 +260,7 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     prepared = as_prepared(shader, session, defines)
     indices = frame_indices(session, frames)
     results = []
-    with Renderer(prepared, session, resolution) as renderer:
+    with Renderer(prepared, session, resolution, color_format=color_format) as renderer:
         for result in renderer.frames(indices):
             results.append(result)
             if progress is not None:
