@@ -212,7 +212,7 @@ def test_bench_cache_measures_every_configuration(files, capsys):
         assert row["ms_per_frame"] > 0 and row["original_ms_per_frame"] > 0
     assert doc["no_refresh"]["hit_rate"] >= doc["periods"][0]["hit_rate"]
     assert doc["limit_speedup"] > 0 and doc["limit_ms"] > 0
-    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1
+    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1 and "limit: every pixel hits" in captured.err
     assert doc["color_format"] == "rgba8"
 
 

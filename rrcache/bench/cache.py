@@ -149,17 +149,17 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
             variants[algorithm] = variant_for(work, node_id, period, algorithm)
     total = len(plan) * repeats + 1
 
-    def say(message):
+    def say(message):  # after each step: the reporter counts finished work
+        step["done"] += 1
         if progress is not None:
             progress(message, step["done"], total)
-        step["done"] += 1
 
     runs: list[list] = [[] for _ in plan]
     for repeat in range(repeats):
         for i, (_group, label, algorithm, period, block, run_period) in enumerate(plan):
-            say(f"[{repeat + 1}/{repeats}] {label}: {algorithm}, Δn={period}, k={block}")
             runs[i].append(compare(variants[algorithm], session, work.prepared, indices, period=run_period,
                                    resolution=resolution, block=block, color_format=color_format))
+            say(f"[{repeat + 1}/{repeats}] {label}: {algorithm}, Δn={period}, k={block}")
     for (group, label, algorithm, period, block, _run), repeated in zip(plan, runs):
         speedups = sorted(c.speedup for c in repeated)
         c = sorted(repeated, key=lambda c: c.speedup)[len(repeated) // 2]  # the median run
@@ -170,14 +170,12 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         else:
             getattr(bench, group).append(row)
 
-    say("limit: every pixel hits")
     variant = variant_for(work, node_id, compare_period, limit_algorithm)
     limit = all_hit_limit(variant, session, work.prepared, probe_frames(indices), resolution, period=compare_period,
                           color_format=color_format)
     bench.limit_ms = limit.limit_ms
     bench.limit_original_ms = limit.original_median_ms
-    if progress is not None:
-        progress("limit: done", total, total)
+    say("limit: every pixel hits")
     return bench
 
 
@@ -189,6 +187,7 @@ class BreakdownRow:
     color_format: str
     cached: dict
     original: dict
+    payload: str = "f4"
 
     @property
     def speedup(self) -> float:
@@ -216,16 +215,17 @@ class Breakdown:
         lines = [f"All-hit frame of `{self.shader}` caching `{self.node}`, {self.resolution[0]}×{self.resolution[1]}, "
                  f"frames {self.frames}; each stage waited for (ctx.finish) before the next; fixed = the same stage "
                  f"at 8×8 (geometry, state changes); per pixel = (ms − fixed) / covered pixels.", ""]
-        lines += ["| algorithm | colour | stage | ms | fixed ms | ns per covered pixel |", "|---|---|---|---|---|---|"]
+        lines += ["| algorithm | colour | payload | stage | ms | fixed ms | ns per covered pixel |",
+                  "|---|---|---|---|---|---|---|"]
         for row in self.rows:
             for who, data in (("cached", row.cached), ("original", row.original)):
                 for stage, ms in data["full_ms"].items():
-                    lines.append(f"| {row.algorithm} | {row.color_format} | {who}: {stage} | {ms:.2f} | "
+                    lines.append(f"| {row.algorithm} | {row.color_format} | {row.payload} | {who}: {stage} | {ms:.2f} | "
                                  f"{data['fixed_ms'].get(stage, float('nan')):.2f} | {data['per_pixel_ns'][stage]:.1f} |")
-        lines += ["", "| algorithm | colour | all-hit ms (no waits) | original ms | limit speed-up (repeats) | covered pixels |",
-                  "|---|---|---|---|---|---|"]
+        lines += ["", "| algorithm | colour | payload | all-hit ms (no waits) | original ms | limit speed-up (repeats) "
+                  "| covered pixels |", "|---|---|---|---|---|---|---|"]
         for row, (lo, hi) in zip(self.rows, self.ranges):
-            lines.append(f"| {row.algorithm} | {row.color_format} | {row.cached['plain_ms']:.2f} | "
+            lines.append(f"| {row.algorithm} | {row.color_format} | {row.payload} | {row.cached['plain_ms']:.2f} | "
                          f"{row.original['plain_ms']:.2f} | {row.speedup:.2f}× ({lo:.2f}–{hi:.2f}) | "
                          f"{row.cached['pixels']:.0f} |")
         return "\n".join(lines)
@@ -233,10 +233,11 @@ class Breakdown:
 
 def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("three-pass", "two-pass"),
               formats=("rgba32f", "rgba8"), frames: int = 60, resolution: Optional[tuple[int, int]] = None,
-              period: int = 16, repeats: int = 3,
+              period: int = 16, repeats: int = 3, payloads=("f4",),
               progress: Optional[Callable[[str, int, int], None]] = None) -> Breakdown:
-    """Measure the all-hit frame stage by stage for every algorithm and colour format (see
-    :class:`Breakdown`); the configurations take turns within each repeat."""
+    """Measure the all-hit frame stage by stage for every algorithm, colour format and payload
+    precision (see :class:`Breakdown`); the configurations take turns within each repeat. (A
+    16-bit payload is used as asked: its range is not checked here.)"""
     from rrcache.harness.limit import all_hit_breakdown
 
     session = load_session(session_path)
@@ -245,25 +246,23 @@ def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("th
     indices = probe_frames(range(min(frames, session.frames)), 3)
     size = tuple(resolution or session.resolution)
     out = Breakdown(shader_path, session_path, node_id, size, list(indices))
-    configs = [(a, f) for a in algorithms for f in formats]
-    variants = {a: variant_for(work, node_id, period, a) for a in algorithms}
+    configs = [(a, f, p) for a in algorithms for p in payloads for f in formats]
+    variants = {(a, p): variant_for(work, node_id, period, a, payload_dtype=p) for a in algorithms for p in payloads}
     measured = {c: [] for c in configs}
     done, total = 0, len(configs) * repeats
     for repeat in range(repeats):
-        for algorithm, fmt in configs:
-            if progress is not None:
-                progress(f"[{repeat + 1}/{repeats}] breakdown {algorithm} {fmt}", done, total)
-            cached, original = all_hit_breakdown(variants[algorithm], session, work.prepared, indices, resolution,
-                                                 period=period, color_format=fmt)
+        for algorithm, fmt, payload in configs:
+            cached, original = all_hit_breakdown(variants[(algorithm, payload)], session, work.prepared, indices,
+                                                 resolution, period=period, color_format=fmt)
             cj, oj = cached.to_json(), original.to_json()
             # the original's frame without waits: clear + draw (its stages are one of each)
             oj["plain_ms"] = original.frame_ms
-            measured[(algorithm, fmt)].append(BreakdownRow(algorithm, fmt, cj, oj))
+            measured[(algorithm, fmt, payload)].append(BreakdownRow(algorithm, fmt, cj, oj, payload))
             done += 1
+            if progress is not None:
+                progress(f"[{repeat + 1}/{repeats}] breakdown {algorithm} {fmt} payload {payload}", done, total)
     for config in configs:
         rows = sorted(measured[config], key=lambda r: r.speedup)
         out.rows.append(rows[len(rows) // 2])
         out.ranges.append((rows[0].speedup, rows[-1].speedup))
-    if progress is not None:
-        progress("breakdown: done", total, total)
     return out

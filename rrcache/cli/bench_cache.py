@@ -34,11 +34,15 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 @click.option("--breakdown", is_flag=True, help="Only the all-hit frame, stage by stage, per algorithm and format.")
 @click.option("--formats", default="rgba32f,rgba8", show_default=True,
               help="Colour formats of --breakdown, side by side.")
+@click.option("--payloads", default="f4", show_default=True,
+              help="Payload precisions of --breakdown (f4, f2), side by side.")
+@click.option("--algorithms", default="three-pass,two-pass", show_default=True,
+              help="Algorithms of --breakdown, side by side.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
 @quiet_option
 def command(shader, session, node, periods, compare_period, frames, repeats, resolution, timing_format, breakdown,
-            formats, as_json, markdown, quiet):
+            formats, payloads, algorithms, as_json, markdown, quiet):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import breakdown as run_breakdown, run
 
@@ -52,9 +56,16 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
     if bad or not format_list:
         raise click.BadParameter(f"{formats!r}: give colour formats from {', '.join(COLOR_FORMATS)}",
                                  param_hint="--formats")
+    payload_list = [p.strip() for p in payloads.split(",") if p.strip()]
+    if not payload_list or any(p not in ("f4", "f2") for p in payload_list):
+        raise click.BadParameter(f"{payloads!r}: give f4 and/or f2", param_hint="--payloads")
+    algorithm_list = [a.strip() for a in algorithms.split(",") if a.strip()]
+    if not algorithm_list or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
+        raise click.BadParameter(f"{algorithms!r}: give three-pass, two-pass and/or one-pass", param_hint="--algorithms")
     with Reporter(err, quiet=quiet) as reporter:
         if breakdown:
-            bench = run_breakdown(shader, session, node, formats=tuple(format_list), frames=frames,
+            bench = run_breakdown(shader, session, node, algorithms=tuple(algorithm_list), formats=tuple(format_list),
+                                  payloads=tuple(payload_list), frames=frames,
                                   resolution=resolution, period=compare_period, repeats=repeats,
                                   progress=reporter.update)
         else:

@@ -170,6 +170,11 @@ def _summary(prof, console: Console) -> None:
     ceiling = prof.ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
+    noise = prof.data.get("timing_noise")
+    if noise is not None and not prof.data.get("timing_reliable", True):
+        console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "
+                      "other work on the machine made the timings unreliable; profile again on a quieter machine",
+                      highlight=False)
     table = Table(title="selections")
     for name in ("level", "max error", "node", "Δn", "speed-up pred.", "speed-up meas.", "error pred.",
                  "error meas.", "PSNR"):

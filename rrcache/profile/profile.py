@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.harness.timing import UNRELIABLE_NOISE
 from rrcache.jsonable import finite_json as _finite
 from rrcache.profile.settings import TrainingSettings
 from rrcache.profile.store import ProfileStore, StoreKey
@@ -415,6 +416,10 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         "training_wall_s": result.spent_s,
         "counts": result.counts,
         "ceiling": result.ceiling.to_json() if result.ceiling is not None else None,
+        # the relative noise of the original's repeated timing-run times, and whether the
+        # machine's load made the timings unreliable (above 10%)
+        "timing_noise": result.noise,
+        "timing_reliable": result.noise <= UNRELIABLE_NOISE,
         "verdict": _verdict(result.ceiling) if result.stopped else None,
         "selections": [],
     }

@@ -133,6 +133,8 @@ class TrainingResult:
     #: before training (nothing can reach ``settings.min_gain``)
     ceiling: Optional[Ceiling] = None
     stopped: bool = False
+    #: the relative noise of the original's repeated timings (:func:`_original_noise`)
+    noise: float = 0.0
 
 
 def training_order(work: ShaderWork, session, settings: TrainingSettings) -> TrainingOrder:
@@ -470,6 +472,25 @@ def _typical_originals(store: ProfileStore, nodes, settings: TrainingSettings) -
     return {frame: float(statistics.median(v)) for frame, v in samples.items()}
 
 
+def _original_noise(store: ProfileStore, nodes, settings: TrainingSettings) -> float:
+    """The noise of the training's timings: every timing run renders the original on the same
+    timing frames, so per frame the spread of its times (1.4826 × MAD / median) is the machine's
+    noise; the median over the frames (0 when nothing was timed twice)."""
+    samples: dict[int, list[float]] = {}
+    for nid in nodes:
+        for period, frames in store.timing_frames(nid).items():
+            if period in settings.timing_periods:
+                for f in frames:
+                    samples.setdefault(f.frame, []).append(f.original_ms)
+    spreads = []
+    for values in samples.values():
+        if len(values) > 2:
+            med = float(np.median(values))
+            if med > 0:
+                spreads.append(1.4826 * float(np.median(np.abs(np.asarray(values) - med))) / med)
+    return float(np.median(spreads)) if spreads else 0.0
+
+
 def fit_models(store: ProfileStore, settings: TrainingSettings, result: TrainingResult) -> None:
     """Fit α, λ (per trained node), μ (every trained node's hit rates in the timing runs) and
     t_hit, t_miss (per trained node, with the measured overhead) from ``store``, into ``result``.
@@ -489,6 +510,7 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
     if ref_timing:
         result.pixels = float(np.mean([c for _, _, c in ref_timing]))
     typical = _typical_originals(store, result.trained, settings)
+    result.noise = _original_noise(store, result.trained, settings)
     # timed in a window, the original's timing-run times are the window's, not a frame's
     windowed = result.plan is not None and result.plan.timing_window is not None
     periods, rates = [], []
