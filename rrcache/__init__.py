@@ -44,11 +44,11 @@ _LAZY = {
     "mean_l2": "rrcache.harness",
     "psnr": "rrcache.harness",
     "CacheRuntime": "rrcache.runtime",
-    "profile": "rrcache.profile",
-    "load_profile": "rrcache.profile",
-    "select": "rrcache.profile",
-    "TrainingSettings": "rrcache.profile",
-    "held_out": "rrcache.profile.accuracy",
+    "profile": "rrcache.profiler",
+    "load_profile": "rrcache.profiles",
+    "select": "rrcache.profiles",
+    "TrainingSettings": "rrcache.profiles",
+    "held_out": "rrcache.profiler.accuracy",
     "get_context": "rrcache.gl",
 }
 

@@ -23,6 +23,7 @@ import pytest
 from rrcache.bench import paper
 from rrcache.bench.scenes import PAPER_SCENES, Scene, default_root, resolve_scenes, scaled_session
 from rrcache.errors import RRCacheError
+from rrcache.selection import CachedNode, Selection
 from rrcache.session import load_session
 
 SHADER = """#version 330
@@ -63,7 +64,9 @@ SESSION = {
 }
 
 SCENE_KEYS = {"name", "cacheable_nodes", "precompute_s", "original_ms", "limit_speedup", "selections"}
-SELECTION_KEYS = {"label", "max_error", "node", "period", "speedup", "mean_error", "psnr"}
+#: a bench selection is the profile's Selection record (rrcache.selection), measured again
+SELECTION_KEYS = {"label", "max_error", "parts", "algorithm", "predicted_speedup", "measured_speedup",
+                  "measured_error", "measured_psnr", "speedups"}
 
 
 def write_scene(folder, name="noise"):
@@ -132,8 +135,9 @@ def test_json_shape(quick_run):
     assert [s["label"] for s in scene["selections"]] == ["e1", "e2", "e3", "e4"]
     for sel in scene["selections"]:
         assert SELECTION_KEYS <= set(sel)
-        assert sel["speedup"] > 0 and sel["mean_error"] >= 0 and 0 < sel["psnr"] <= 100
-        assert (sel["node"] is None) == (sel["period"] is None)
+        assert sel["measured_speedup"] > 0 and sel["measured_error"] >= 0 and 0 < sel["measured_psnr"] <= 100
+        assert all(part["kind"] == "cache" and part["period"] >= 1 for part in sel["parts"])
+        assert len(sel["speedups"]) == (1 if sel["parts"] else 0)  # QUICK: one side-by-side run
     if scene["medium"] is not None:  # something is cached at some level
         assert scene["limit_speedup"] > 0
         assert [a["method"] for a in scene["algorithms"]] == ["three-pass", "two-pass", "one-pass"]
@@ -168,7 +172,8 @@ def test_second_run_resumes_the_profile(quick_run):
     first = doc["scenes"][0]
     assert scene.training_s == pytest.approx(first["training_s"], rel=1e-6)  # nothing new was trained
     assert scene.precompute_s >= first["precompute_s"]  # the resumed invocation adds its own time
-    assert [s.node_id for s in scene.selections] == [s.get("node_id") for s in doc["scenes"][0]["selections"]]
+    assert [s.key for s in scene.selections] == [
+        tuple((p["kind"], p["node"], p["period"]) for p in s["parts"]) for s in doc["scenes"][0]["selections"]]
 
 
 def test_interrupted_run_keeps_finished_scenes(tmp_path):
@@ -202,7 +207,9 @@ def test_bad_scene_is_one_line_exit_2(tmp_path):
 
 # ---------------------------------------------------------------- the medium selection
 def _row(label, node):
-    return paper.SelectionRow(label, 0.01, node, node and f"text of {node}", 8 if node else None, 1.5, 0.01, 40.0)
+    parts = (CachedNode(node, 8, f"text of {node}"),) if node else ()
+    return Selection(parts, 0.01, 1.0, 1.5, label=label, max_error=0.01).with_measurement(0.01, 40.0, 1.0, 1.5, 1.5,
+                                                                                           0.9, 10)
 
 
 def test_medium_is_e3_or_the_nearest_cached():

@@ -22,7 +22,7 @@ import pytest
 
 from test_profile import CLI_SETTINGS, write_scene
 
-from rrcache.profile import read_store
+from rrcache.profiles import read_store
 
 # the same entry point as `python -m rrcache`, with the two commands registered if the package
 # does not list them yet
@@ -93,11 +93,11 @@ def test_profile_end_to_end(full):
     for name in ("profile.json", "profile.sqlite", "tradeoff.png", "tradeoff.svg", "hitrate.png"):
         assert (out / name).exists(), name
     data = json.loads((out / "profile.json").read_text())
-    assert data["rrcache_profile"] == 1 and data["trained"] == len(data["nodes"])
+    assert data["rrcache_profile"] == 2 and all(n["trained"] for n in data["nodes"])
     assert [s["label"] for s in data["selections"]] == ["e1", "e2", "e3", "e4"]
     for sel in data["selections"]:
         assert (out / "optimized" / sel["label"] / "manifest.json").exists()
-        if sel["node"] is not None:  # a cached selection was rendered beside the original
+        if sel["parts"]:  # a cached selection was rendered beside the original
             assert sel["frames"] == 12 and sel["measured_error"] is not None
             assert list((out / "optimized" / sel["label"]).glob("*.frag"))
     assert f"nodes trained: {len(data['nodes'])} of {len(data['nodes'])}" in proc.stdout
@@ -140,6 +140,20 @@ def test_errors_are_one_located_line(full, tmp_path, args, message):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("rrcache: error:") and message in lines[0], proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("command", [["select", "--max-error", "0.1"], ["report"], ["accuracy"]])
+def test_a_bad_profile_document_exits_2_naming_the_key(full, tmp_path, command):
+    """Every command that reads profile.json refuses a document outside its declared shape with
+    one line naming the file and the key path, exit code 2."""
+    folder, _ = full
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    data["nodes"][1]["alpha"] = -1
+    (tmp_path / "profile.json").write_text(json.dumps(data))
+    proc = rrcache(command[0], tmp_path, *command[1:], check=False)
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "profile.json: nodes[1].alpha: must be a finite number >= 0" in lines[0], proc.stderr
 
 
 def test_resume_after_sigkill(full, tmp_path, stability_case):

@@ -18,7 +18,8 @@ from test_profile import SETTINGS, write_scene
 
 from rrcache.model import ErrorFit, HitRateFit, ModelTable, PerfFit
 from rrcache.model.psnr import PSNR_CAP, fit_psnr, psnr_grid, psnr_text, select_min_psnr
-from rrcache.profile import TrainingSettings, profile
+from rrcache.profiler import profile
+from rrcache.profiles import TrainingSettings
 
 
 @pytest.fixture(scope="module")

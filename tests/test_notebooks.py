@@ -64,7 +64,7 @@ def test_explore_runs_and_shows_its_figures(executed):
 
 def test_interactive_reselects_and_writes_files(executed):
     folder, _, nb = executed
-    from rrcache.profile import load_profile
+    from rrcache.profiles import load_profile
 
     widgets = _outputs(nb, "application/vnd.jupyter.widget-view+json")
     assert len(widgets) == 1
@@ -85,7 +85,7 @@ def test_widget_events_from_another_thread_run_on_the_gl_thread(executed):
     import asyncio
     import threading
 
-    from rrcache.profile import load_profile
+    from rrcache.profiles import load_profile
     from rrcache.report.explore import Explorer
 
     folder, _, _ = executed

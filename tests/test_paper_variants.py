@@ -50,7 +50,7 @@ def scene(request, gl_ctx):
 
 
 def _check(session, work, references, node, algorithm):
-    variant = variant_for(work, node.id, 1, algorithm)
+    variant = variant_for(work, node.id, algorithm)
     with CachedRenderer(variant, session, work.prepared, SIZE, period=1) as cached:
         for frame, want in zip(FRAMES, references):
             got = cached.render_frame(frame).image

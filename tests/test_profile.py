@@ -17,13 +17,16 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
 
 from rrcache.errors import RRCacheError
-from rrcache.profile import TrainingSettings, load_profile, profile, read_store, select
-from rrcache.profile.profile import algorithm_line
+from rrcache.profiler import profile
+from rrcache.profiles import TrainingSettings, load_profile, read_store, select
+from rrcache.profiles.document import algorithm_line
+from rrcache.selection import CachedNode, Selection
 
 SHADER = """#version 330
 in vec4 v_position;
@@ -113,7 +116,7 @@ def test_nodes_worth_training_are_trained_costliest_first(trained):
 def test_profile_json_schema(trained):
     prof, _, folder = trained
     data = json.loads((folder / "out" / "profile.json").read_text())
-    assert data["rrcache_profile"] == 1
+    assert data["rrcache_profile"] == 2
     assert data["settings"]["periods"] == [2, 4, 8] and data["settings"]["resolution"] == [32, 24]
     for key in ("mu", "mu_quality", "overhead_ms", "original_ms", "pixels", "training_wall_s", "selections",
                 "shader_hash", "session_hash", "untrained"):
@@ -123,6 +126,13 @@ def test_profile_json_schema(trained):
     assert [s["label"] for s in data["selections"]] == ["e1", "e2", "e3", "e4"]
     for sel in data["selections"]:
         assert (folder / "out" / sel["files"] / "manifest.json").exists()
+        assert all(part["kind"] == "cache" for part in sel["parts"]) and sel["algorithm"] == prof.algorithm
+        manifest = json.loads((folder / "out" / sel["files"] / "manifest.json").read_text())
+        if sel["parts"]:  # the manifest records what the selection runs with
+            assert manifest["period"] == sel["parts"][0]["period"] and manifest["algorithm"] == sel["algorithm"]
+            assert manifest["runtime"] == prof.settings.cache_options()
+    # what is read back is what the run returned (written once, from the same record)
+    assert load_profile(folder / "out") == prof
     # nothing non-finite leaks into the JSON
     assert "NaN" not in (folder / "out" / "profile.json").read_text()
 
@@ -135,13 +145,14 @@ def test_auto_algorithm_keeps_the_faster_variant(trained):
     assert data["settings"]["algorithm"] == "auto"
     times = data["plan"]["algorithm_times"]
     assert set(times) == {"three-pass", "two-pass"} and all(0 < t < 100 for t in times.values())
-    assert prof.algorithm == data["plan"]["algorithm"] == min(times, key=times.get)
+    assert prof.algorithm == data["algorithm"] == data["plan"]["algorithm"] == min(times, key=times.get)
     # this tiny scene's selections are all the original (its variants cost more than it), so
     # write a trained node's variant the way selections are written
-    from types import SimpleNamespace
     node = prof.trained_nodes[0].id
-    prof.write_variant(SimpleNamespace(node=node, period=8), folder / "chosen")
-    assert json.loads((folder / "chosen" / "manifest.json").read_text())["algorithm"] == prof.algorithm
+    prof.write_variant(Selection((CachedNode(node, 13),)), folder / "chosen")
+    manifest = json.loads((folder / "chosen" / "manifest.json").read_text())
+    assert manifest["algorithm"] == prof.algorithm and manifest["period"] == 13  # what it runs with
+    assert manifest["runtime"] == {"block": 4, "refresh": "random", "depth_epsilon": 1e-3}
     assert prof.algorithm in algorithm_line(prof) and "auto:" in algorithm_line(prof)
 
 
@@ -181,12 +192,12 @@ def test_budget_stops_new_nodes_and_resume_finishes(tmp_path):
     first = profile(shader, session, tmp_path / "out", settings)
     trained = [n.id for n in first.nodes if n.trained]
     assert trained == [first.nodes[0].id]  # the costliest node is always started
-    assert first.data["budget_stopped"] and len(first.data["untrained"]) == len(first.nodes) - 1
+    assert first.budget_stopped and len(first.untrained) == len(first.nodes) - 1
     assert first.counts["error_runs_computed"] == 3 and first.counts["error_runs_skipped"] == 0
     assert first.nodes[1].note.startswith("not reached within the training budget")
     second = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False))
     worth = [n for n in second.nodes if n.note is None]
-    assert all(n.trained for n in worth) and len(worth) == len(second.data["nodes"]) - len(second.data["untrained"])
+    assert all(n.trained for n in worth) and len(worth) == len(second.nodes) - len(second.untrained)
     assert second.counts["error_runs_skipped"] == 3 and second.counts["timing_runs_skipped"] == 2
     assert second.counts["error_runs_computed"] == 3 * (len(worth) - 1)
     assert second.nodes[0].alpha == pytest.approx(first.nodes[0].alpha, rel=1e-9)
@@ -201,19 +212,19 @@ def test_error_runs_in_a_window_at_full_resolution(tmp_path):
     shader, session = write_scene(tmp_path)
     settings = dict(SETTINGS, resolution=None)
     first = profile(shader, session, tmp_path / "out", TrainingSettings(**settings, validate=False, budget_s=1e-6))
-    window = first.data["plan"]["error_window"]
+    window = first.plan["error_window"]
     assert window is not None and window[2:] == [32, 24], window
-    assert first.data["plan"]["timing_window"] is None  # a cheap shader is timed on whole frames
+    assert first.plan["timing_window"] is None  # a cheap shader is timed on whole frames
     store = read_store(tmp_path / "out" / "profile.sqlite")
     try:
-        assert store.plan() == first.data["plan"]
+        assert store.plan() == first.plan
         runs = store.error_runs(first.nodes[0].id)
         # every covered pixel counted lies in the window
         assert runs and all(r.covered <= 32 * 24 * (r.frames - 1) for r in runs)
     finally:
         store.close()
     again = profile(shader, session, tmp_path / "out", TrainingSettings(**settings, validate=False, budget_s=1e-6))
-    assert again.data["plan"] == first.data["plan"] and again.counts["error_runs_computed"] == 0
+    assert again.plan == first.plan and again.counts["error_runs_computed"] == 0
 
 
 def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
@@ -221,8 +232,8 @@ def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
     by fits that make caching pay, so the choice does not depend on this machine's speed)."""
     import rrcache.model as model
     from rrcache.pipeline import load_for_session
-    from rrcache.profile.store import ProfileStore, StoreKey
-    from rrcache.profile.validate import validate
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.profiler.validate import validate
     from rrcache.session import load_session
 
     prof, _, folder = trained
@@ -234,9 +245,14 @@ def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
     table = model.ModelTable.from_fits([node.id], [errors[0]], [cheap], hit, prof.pixels, 1000.0)
     settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
     key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    levels = model.thresholds(table, 4)
+    choices = [model.select(table, float(t)).replace(label=label, max_error=float(t), algorithm="three-pass")
+               for label, t in zip(("e1", "e2", "e3", "e4"), levels)]
     with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
-        rows = validate(work, session, settings, store, table)
+        rows = validate(work, session, settings, store, choices)
         assert [r.label for r in rows] == ["e1", "e2", "e3", "e4"]
+        # the same records, measured: what was chosen is unchanged
+        assert [r.key for r in rows] == [c.key for c in choices]
         cached = [r for r in rows if r.node is not None]
         assert cached, rows
         for row in cached:
@@ -247,9 +263,9 @@ def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
                 assert row.measured_error > 0 and 0 < row.hit_rate < 1
                 assert math.isfinite(row.measured_psnr)
         assert any(row.period > 1 for row in cached), rows
-        assert len(store.validations()) == 4
+        assert store.validations() == rows
         events = []
-        again = validate(work, session, settings, store, table, progress=events.append)
+        again = validate(work, session, settings, store, choices, progress=events.append)
         assert not events  # every (node, period) was measured already
         assert [r.measured_error for r in again] == [r.measured_error for r in rows]
 
@@ -266,8 +282,47 @@ def test_load_profile_refuses_other_files(tmp_path):
     with pytest.raises(RRCacheError, match="not an rrcache profile"):
         load_profile(bad)
     bad.write_text(json.dumps({"rrcache_profile": 1, "shader": "x"}))
-    with pytest.raises(RRCacheError, match="not a complete profile"):
+    with pytest.raises(RRCacheError, match="profile version 1; this rrcache reads 2"):
         load_profile(bad)
+    bad.write_text(json.dumps({"rrcache_profile": 2, "shader": "x"}))
+    with pytest.raises(RRCacheError, match=r"profile.json: session: is missing"):
+        load_profile(bad)
+
+
+@pytest.mark.parametrize("edit, where, message", [
+    (lambda d: d["nodes"][3].update(alpha=-0.5), "nodes[3].alpha", "must be a finite number >= 0"),
+    (lambda d: d["nodes"][1].update(periods=[2, "4"]), "nodes[1].periods[1]", "must be a whole number >= 1"),
+    (lambda d: d.update(mu=1.5), "mu", "must be a finite number in [0, 1]"),
+    (lambda d: d["nodes"][0].update(trained="yes"), "nodes[0].trained", "must be true or false"),
+    (lambda d: d.update(colour=1), "colour", "unknown key"),
+    (lambda d: d["selections"][2].update(parts=[{"kind": "cache", "node": "n1", "period": 0}]),
+     "selections[2].parts[0].period", "must be a whole number >= 1"),
+    (lambda d: d["selections"][0].update(parts=[{"kind": "teleport"}]), "selections[0].parts[0].kind",
+     "unknown kind 'teleport'"),
+    (lambda d: d["selections"][1].update(hit_rate=2.0), "selections[1].hit_rate", "must be a finite number in"),
+    (lambda d: d["settings"].update(block=3), "settings", "block"),
+])
+def test_load_profile_names_the_bad_key(trained, tmp_path, edit, where, message):
+    """A document the declared shape does not allow is refused with its key path (an
+    RRCacheError; the CLI exits 2 with it, see test_cli_profile)."""
+    _, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    edit(data)
+    bad = tmp_path / "profile.json"
+    bad.write_text(json.dumps(data))
+    with pytest.raises(RRCacheError, match=re.escape(f"profile.json: {where}") + ".*" + re.escape(message)) as info:
+        load_profile(bad)
+    assert str(bad) in str(info.value)
+
+
+def test_load_profile_refuses_non_finite_numbers(trained, tmp_path):
+    _, _, folder = trained
+    text = (folder / "out" / "profile.json").read_text()
+    data = json.loads(text)
+    data["overhead_ms"] = float("inf")
+    (tmp_path / "profile.json").write_text(json.dumps(data))  # Python writes the bare word Infinity
+    with pytest.raises(RRCacheError, match="Infinity is not a JSON number"):
+        load_profile(tmp_path)
 
 
 def test_store_matches_profile_json(trained):

@@ -1,5 +1,5 @@
-"""Held-out accuracy of a profile's models (rrcache.profile.accuracy, ``rrcache accuracy``) and
-the training order (rrcache.profile.order), on the tiny scene of test_profile:
+"""Held-out accuracy of a profile's models (rrcache.profiler.accuracy, ``rrcache accuracy``) and
+the training order (rrcache.profiler.order), on the tiny scene of test_profile:
 
 - the nodes that matter are the predicted Pareto front's (plus the selections'); each is measured
   at periods training did not use, as training measures; predictions come from the profile's
@@ -20,9 +20,10 @@ from test_profile import SETTINGS, write_scene
 
 from rrcache.errors import RRCacheError
 from rrcache.pipeline import load_for_session
-from rrcache.profile import TrainingSettings, profile
-from rrcache.profile.accuracy import held_out, nodes_that_matter
-from rrcache.profile.train import training_order
+from rrcache.profiler import profile
+from rrcache.profiles import TrainingSettings
+from rrcache.profiler.accuracy import held_out, nodes_that_matter
+from rrcache.profiler.train import training_order
 from rrcache.session import load_session
 
 

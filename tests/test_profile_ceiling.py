@@ -19,8 +19,9 @@ import pytest
 
 from test_profile import SESSION
 
-from rrcache.profile import TrainingSettings, load_profile, profile, read_store
-from rrcache.profile.ceiling import Ceiling, relative_noise
+from rrcache.profiler import profile
+from rrcache.profiles import TrainingSettings, load_profile, read_store
+from rrcache.profiler.ceiling import Ceiling, relative_noise
 
 CHEAP = """#version 330
 in vec4 v_position;

@@ -15,8 +15,9 @@ from types import SimpleNamespace
 import pytest
 
 from rrcache.errors import RRCacheError
-from rrcache.profile.settings import TrainingSettings, parse_periods
-from rrcache.profile.store import SCHEMA_VERSION, ErrorFrame, ErrorRun, ProfileStore, StoreKey, read_store
+from rrcache.profiles.settings import TrainingSettings, parse_periods
+from rrcache.profiles.store import SCHEMA_VERSION, ErrorFrame, ErrorRun, ProfileStore, StoreKey, read_store
+from rrcache.selection import CachedNode, Selection
 
 SETTINGS = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), frames=12, validation_frames=12)
 
@@ -201,3 +202,48 @@ def test_short_session_warns_and_too_many_frames_fail():
     with pytest.raises(RRCacheError, match="the session has 12") as info:
         TrainingSettings(frames=20).resolved(session)
     assert info.value.where == "s.json"
+
+
+def _selection(label, parts, **measured):
+    sel = Selection(parts, 0.02, 3.0, 1.5, label=label, max_error=0.03, algorithm="two-pass")
+    return sel.with_measurement(measured.get("error", 0.018), 41.0, 3.1, 4.5, 1.45, 0.8, 12)
+
+
+def test_validations_keep_the_selection_record(tmp_path):
+    """A measured Selection goes into the store and comes back equal: its parts (whatever their
+    kind), the algorithm, the predicted and measured figures."""
+    rows = [_selection("e1", (CachedNode("n7", 16),)), _selection("e2", (), error=0.0)]
+    with ProfileStore.open(tmp_path / "profile.sqlite", _key()) as store:
+        for row in rows:
+            store.add_validation(row)
+        assert store.validations() == rows
+        assert store.validations()[0].key == (("cache", "n7", 16),)
+        with pytest.raises(ValueError, match="measured"):
+            store.add_validation(Selection((CachedNode("n7", 16),), 0.02, 3.0, 1.5, label="e3"))
+
+
+def test_a_schema_1_store_is_upgraded_in_place(tmp_path):
+    """Schema 1 kept a validation's node and period in two columns; opening such a store
+    rewrites them as parts and keeps every measurement."""
+    path = tmp_path / "profile.sqlite"
+    with ProfileStore.open(path, _key()) as store:
+        store.add_error_run(_run(), _frames())
+    conn = sqlite3.connect(str(path), isolation_level=None)
+    conn.execute("DROP TABLE validation")
+    conn.execute("CREATE TABLE validation (label TEXT PRIMARY KEY, max_error REAL NOT NULL, node TEXT, "
+                 "period INTEGER, predicted_error REAL NOT NULL, predicted_ms REAL NOT NULL, predicted_speedup "
+                 "REAL NOT NULL, measured_error REAL NOT NULL, measured_psnr REAL NOT NULL, measured_ms REAL NOT "
+                 "NULL, measured_original_ms REAL NOT NULL, measured_speedup REAL NOT NULL, hit_rate REAL NOT "
+                 "NULL, frames INTEGER NOT NULL)")
+    conn.execute("INSERT INTO validation VALUES ('e1', 0.03, 'n7', 16, 0.02, 3.0, 1.5, 0.018, 41.0, 3.1, 4.5, "
+                 "1.45, 0.8, 12)")
+    conn.execute("INSERT INTO validation VALUES ('e2', 0.05, NULL, NULL, 0, 4.5, 1, 0, 100, 4.5, 4.5, 1, 0, 0)")
+    conn.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
+    conn.close()
+    with ProfileStore.open(path, _key()) as store:
+        assert store.meta()["schema_version"] == str(SCHEMA_VERSION)
+        first, second = store.validations()
+        assert first.key == (("cache", "n7", 16),) and first.measured_error == 0.018 and first.frames == 12
+        assert first.algorithm is None  # schema 1 did not record it
+        assert second.parts == () and second.measured_speedup == 1.0
+        assert [r.period for r in store.error_runs("n1")] == [2]  # the measurements stay

@@ -26,7 +26,8 @@ import pytest
 from PIL import Image
 
 from rrcache.errors import RRCacheError
-from rrcache.report import REPORT_NAME, demo_profile, write_report
+from rrcache.profiler import demo_profile
+from rrcache.report import REPORT_NAME, write_report
 from rrcache.report.data import selection_timing
 from rrcache.report.images import HIT_COLOR, MISS_COLOR, FrameShots, image_size
 
@@ -143,7 +144,8 @@ def test_tiny_profile_and_the_plots_flag(tmp_path):
     node and the four selections; ``plots=False`` writes neither plots nor report."""
     from test_profile import SETTINGS, write_scene
 
-    from rrcache.profile import TrainingSettings, profile
+    from rrcache.profiler import profile
+    from rrcache.profiles import TrainingSettings
 
     shader, session = write_scene(tmp_path)
     prof = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False))

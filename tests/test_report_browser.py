@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rrcache.report import REPORT_NAME, demo_profile
+from rrcache.profiler import demo_profile
+from rrcache.report import REPORT_NAME
 from rrcache.report.browser import Chromium, find_chromium
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"

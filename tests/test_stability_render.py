@@ -21,7 +21,7 @@ from rrcache.harness.cached import HALF_MAX, CachedRenderer, compare
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import Renderer, render
 from rrcache.harness.vertex import mesh_defines, session_attributes
-from rrcache.profile.settings import TrainingSettings
+from rrcache.profiles.settings import TrainingSettings
 from rrcache.runtime import CacheRuntime
 from rrcache.session import load_session
 

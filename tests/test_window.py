@@ -45,7 +45,7 @@ def test_window_image_is_the_crop_of_the_frame(scene):
 def test_cached_variant_in_a_window(scene):
     work, session = scene
     node = max(work.table.nodes, key=lambda n: n.cost).id
-    variant = variant_for(work, node, 1)
+    variant = variant_for(work, node)
     exact = compare(variant, session, work.prepared, range(4), period=1, window=WINDOW)
     assert exact.resolution == (64, 48) and exact.mean_error <= 1e-6
     with CachedRenderer(variant, session, work.prepared, period=4, window=WINDOW) as cached, \

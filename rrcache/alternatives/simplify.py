@@ -144,7 +144,7 @@ def node_means(work, session, node_ids: Sequence[str], frames: Sequence[int], re
 
     means = {}
     for node_id in node_ids:
-        variant = variant_for(work, node_id, 1, "one-pass")
+        variant = variant_for(work, node_id, "one-pass")
         total = np.zeros(4)
         count = 0
         with CachedRenderer(variant, session, work.prepared, resolution, period=1, keep_payload=True) as r:

@@ -146,7 +146,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     variants = {}
     for _group, _label, algorithm, period, _block, _run in plan:
         if algorithm not in variants:
-            variants[algorithm] = variant_for(work, node_id, period, algorithm)
+            variants[algorithm] = variant_for(work, node_id, algorithm)
     total = len(plan) * repeats + 1
 
     def say(message):  # after each step: the reporter counts finished work
@@ -170,7 +170,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         else:
             getattr(bench, group).append(row)
 
-    variant = variant_for(work, node_id, compare_period, limit_algorithm)
+    variant = variant_for(work, node_id, limit_algorithm)
     limit = all_hit_limit(variant, session, work.prepared, probe_frames(indices), resolution, period=compare_period,
                           color_format=color_format)
     bench.limit_ms = limit.limit_ms
@@ -247,7 +247,7 @@ def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("th
     size = tuple(resolution or session.resolution)
     out = Breakdown(shader_path, session_path, node_id, size, list(indices))
     configs = [(a, f, p) for a in algorithms for p in payloads for f in formats]
-    variants = {(a, p): variant_for(work, node_id, period, a, payload_dtype=p) for a in algorithms for p in payloads}
+    variants = {(a, p): variant_for(work, node_id, a, payload_dtype=p) for a in algorithms for p in payloads}
     measured = {c: [] for c in configs}
     done, total = 0, len(configs) * repeats
     for repeat in range(repeats):

@@ -48,6 +48,7 @@ import numpy as np
 from rrcache.bench.scenes import Scene, scaled_session
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json as _finite
+from rrcache.selection import Selection
 
 ProgressFn = Callable[[str, Optional[int], Optional[int]], None]
 PSNR_CAP = 100.0
@@ -61,7 +62,7 @@ class BenchSettings:
     - ``resolution``/``frames``: the session is scaled down to fit this size (aspect ratio kept)
       and cut to this frame count (None: as it is); ``scene_overrides`` per scene name (quick:
       chess smaller).
-    - ``training``: keyword arguments of :class:`rrcache.profile.TrainingSettings`.
+    - ``training``: keyword arguments of :class:`rrcache.profiles.TrainingSettings`.
     - ``repeats``: side-by-side runs per selection (speed-up: the median).
     - ``candidates``: the costliest nodes considered by the simplification; ``probe_frames``
       sample frames for its node means and errors, at ``probe_resolution`` (None: a quarter).
@@ -113,24 +114,6 @@ QUICK = BenchSettings(
 
 
 @dataclass
-class SelectionRow:
-    label: str
-    max_error: float
-    node_id: Optional[str]
-    node: Optional[str]
-    period: Optional[int]
-    speedup: float
-    mean_error: float
-    psnr: float
-    hit_rate: Optional[float] = None
-    ms: Optional[float] = None
-    original_ms: Optional[float] = None
-    predicted_speedup: Optional[float] = None
-    predicted_error: Optional[float] = None
-    speedups: list = field(default_factory=list)
-
-
-@dataclass
 class MethodRow:
     """One row of a side-by-side table: the cache algorithms, or the equal-time methods."""
 
@@ -175,7 +158,9 @@ class SceneResult:
     figure: Optional[str] = None
 
     def to_json(self) -> dict:
-        return _finite(asdict(self))
+        out = asdict(self)
+        out["selections"] = [s.to_json() for s in self.selections]
+        return _finite(out)
 
 
 def _cap(psnr: float) -> float:
@@ -205,38 +190,40 @@ def _effective_session(scene: Scene, settings: BenchSettings, out: Path) -> str:
     return str(scaled_session(scene.session, out / "sessions" / f"{scene.name}.json", size, frames))
 
 
-def _choose_medium(selections: list) -> Optional[SelectionRow]:
+def _choose_medium(selections: list) -> Optional[Selection]:
     by_label = {s.label: s for s in selections}
     for label in (MEDIUM, "e4", "e2", "e1"):
         row = by_label.get(label)
-        if row is not None and row.node_id is not None:
+        if row is not None and row.parts:
             return row
     return None
 
 
-def _measure_selections(prof, work, session, frames, settings: BenchSettings, progress) -> list[SelectionRow]:
+def _measure_selections(prof, work, session, frames, settings: BenchSettings, progress) -> list[Selection]:
+    """The profile's selections, each measured again beside the original (``repeats`` times;
+    the speed-up is the median): the same records, their measured figures replaced. The
+    original shader is not rendered (error 0, speed-up 1)."""
     from rrcache.harness.cached import compare
-    from rrcache.pipeline import variant_for
+    from rrcache.pipeline import variant_for_selection
 
-    ps = prof.settings
+    options = prof.settings.cache_options()
     rows = []
     for sel in prof.selections:
         _say(progress, f"selection {sel.label}", None, None)
-        row = SelectionRow(sel.label, sel.max_error, sel.node, sel.text, sel.period, 1.0, 0.0, PSNR_CAP,
-                           predicted_speedup=sel.predicted_speedup, predicted_error=sel.predicted_error)
-        if sel.node is not None:
-            variant = variant_for(work, sel.node, int(sel.period), prof.algorithm)
-            runs = []
-            for _ in range(settings.repeats):
-                runs.append(compare(variant, session, work.prepared, frames, period=int(sel.period), block=ps.block,
-                                    refresh=ps.refresh, depth_epsilon=ps.depth_epsilon))
-            first = runs[0]
-            row.speedups = [r.speedup for r in runs]
-            row.speedup = float(statistics.median(row.speedups))
-            row.mean_error, row.psnr, row.hit_rate = first.mean_error, _cap(first.psnr), first.hit_rate
-            row.ms = float(statistics.median(r.ms_per_frame for r in runs))
-            row.original_ms = float(statistics.median(r.original_ms_per_frame for r in runs))
-        rows.append(row)
+        if not sel.parts:
+            rows.append(sel.replace(measured_error=0.0, measured_psnr=PSNR_CAP, measured_speedup=1.0,
+                                    measured_ms=None, measured_original_ms=None, hit_rate=None, frames=0,
+                                    speedups=()))
+            continue
+        variant, period = variant_for_selection(work, sel)
+        runs = [compare(variant, session, work.prepared, frames, period=period, **options)
+                for _ in range(settings.repeats)]
+        first = runs[0]
+        speedups = [r.speedup for r in runs]
+        rows.append(sel.with_measurement(
+            first.mean_error, _cap(first.psnr), float(statistics.median(r.ms_per_frame for r in runs)),
+            float(statistics.median(r.original_ms_per_frame for r in runs)), float(statistics.median(speedups)),
+            first.hit_rate, len(first.frames), speedups))
     return rows
 
 
@@ -244,11 +231,12 @@ def _within(speedup: float, target: float, tolerance: float) -> bool:
     return bool(math.isfinite(speedup) and abs(speedup / target - 1.0) <= tolerance)
 
 
-def _equal_time(work, session, frames, medium: SelectionRow,
+def _equal_time(work, session, frames, medium: Selection,
                 settings: BenchSettings, result: SceneResult, progress) -> list[MethodRow]:
-    target = medium.speedup
-    rows = [MethodRow("reprojection cache (ours)", f"{medium.label}: {medium.node_id} at Δn={medium.period}",
-                      medium.speedup, medium.mean_error, medium.psnr, medium.ms, medium.original_ms, True)]
+    target = medium.measured_speedup
+    rows = [MethodRow("reprojection cache (ours)", f"{medium.label}: {medium.node} at Δn={medium.period}",
+                      medium.measured_speedup, medium.measured_error, medium.measured_psnr, medium.measured_ms,
+                      medium.measured_original_ms, True)]
     search = list(frames)[:max(1, settings.search_frames)]
 
     try:
@@ -340,7 +328,8 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     from rrcache.alternatives.simplify import simplified_shader
     from rrcache.bench import cache as cache_bench
     from rrcache.pipeline import load_for_session
-    from rrcache.profile import TrainingSettings, profile
+    from rrcache.profiler import profile
+    from rrcache.profiles import TrainingSettings
     from rrcache.session import load_session
 
     started = time.time()
@@ -367,10 +356,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     result.profile = str(folder)
     # the profiler's precomputation time: every invocation on its store added up (older
     # profiles only have the training time)
-    result.precompute_s = prof.data.get("precompute_s", prof.training_wall_s)
+    result.precompute_s = prof.precompute_s if prof.precompute_s is not None else prof.training_wall_s
     result.training_s = prof.training_wall_s
     result.precompute_resumed = bool(counts.get("error_runs_skipped", 0) or counts.get("timing_runs_skipped", 0))
-    result.profile_run_s = prof.data.get("run_wall_s")
+    result.profile_run_s = prof.run_wall_s
     result.trained_nodes = len(prof.trained_nodes)
     if not prof.selections:
         result.notes.append("no node was trained (budget too small): nothing selected")
@@ -378,19 +367,19 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         return result
 
     result.selections = _measure_selections(prof, work, session, frames, settings, progress)
-    originals = [s.original_ms for s in result.selections if s.original_ms is not None]
+    originals = [s.measured_original_ms for s in result.selections if s.measured_original_ms is not None]
     medium = _choose_medium(result.selections)
     if medium is None:
         result.notes.append("every selection is the original shader: no algorithm, limit or equal-time comparison")
         result.original_ms = _original_ms(work, session, frames)
         result.wall_s = time.time() - started
         return result
-    result.medium, result.target_speedup = medium.label, medium.speedup
+    result.medium, result.target_speedup = medium.label, medium.measured_speedup
     if medium.label != MEDIUM:
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
-    _say(progress, f"algorithms and limit on {medium.node_id}")
-    bench = cache_bench.run(scene.shader, session_path, medium.node_id, periods=(), compare_period=int(medium.period),
+    _say(progress, f"algorithms and limit on {medium.node}")
+    bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
                             progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
@@ -400,11 +389,11 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     result.limit_speedup = bench.limit_speedup
     result.limit_algorithm = prof.algorithm
 
-    if medium.speedup > 1.0 + settings.tolerance:
+    if medium.measured_speedup > 1.0 + settings.tolerance:
         result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
         originals += [r.original_ms for r in result.equal_time[1:]]
     else:
-        result.notes.append(f"the {medium.label} selection measured {medium.speedup:.2f}×, no faster than the "
+        result.notes.append(f"the {medium.label} selection measured {medium.measured_speedup:.2f}×, no faster than the "
                             "original: no equal-time comparison")
     result.original_ms = float(statistics.median(originals)) if originals else _original_ms(work, session, frames)
     result.wall_s = time.time() - started

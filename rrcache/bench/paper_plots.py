@@ -31,7 +31,8 @@ def write_scene_plot(scene, out) -> str:
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=110)
     try:
         ax.scatter([1.0], [0.0], color="black", zorder=3, label="original")
-        sel = [(r.label, _x(r.speedup), r.mean_error) for r in scene.selections if _x(r.speedup) is not None]
+        sel = [(r.label, _x(r.measured_speedup), r.measured_error) for r in scene.selections
+               if _x(r.measured_speedup) is not None]
         if sel:
             ax.plot([s[1] for s in sel], [s[2] for s in sel], "o-", color="tab:blue", zorder=3,
                     label="our selections")

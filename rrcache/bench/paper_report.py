@@ -49,8 +49,9 @@ def scene_markdown(s) -> str:
         lines += ["| level | max error | node | Δn | speed-up | mean error | PSNR dB | hit rate | predicted speed-up |",
                   "|---|---|---|---|---|---|---|---|---|"]
         for r in s.selections:
-            lines.append(f"| {r.label} | {_f(r.max_error, '.4f')} | {_code(r.node)} | {_f(r.period, 'd')} | "
-                         f"{_f(r.speedup, '.2f')}× | {_f(r.mean_error, '.4f')} | {_f(r.psnr, '.1f')} | "
+            lines.append(f"| {r.label} | {_f(r.max_error, '.4f')} | {_code(r.text if r.parts else None)} | "
+                         f"{_f(r.period, 'd')} | {_f(r.measured_speedup, '.2f')}× | {_f(r.measured_error, '.4f')} | "
+                         f"{_f(r.measured_psnr, '.1f')} | "
                          f"{_f(r.hit_rate, '.3f')} | {_f(r.predicted_speedup, '.2f')}× |")
         lines.append("")
     if s.algorithms:
@@ -86,8 +87,8 @@ def markdown(result) -> str:
         med = next((r for r in s.selections if r.label == s.medium), None)
         lines.append(f"| {s.name} | {s.static_cost} | {s.cacheable_nodes} | {_f(s.precompute_s, '.1f')}"
                      f"{' (resumed)' if s.precompute_resumed else ''} | {_f(s.original_ms, '.2f')} | "
-                     f"{s.medium or '–'} | {_f(med.speedup if med else None, '.2f')}× | "
-                     f"{_f(med.psnr if med else None, '.1f')} | {_f(s.limit_speedup, '.2f')}× |")
+                     f"{s.medium or '–'} | {_f(med.measured_speedup if med else None, '.2f')}× | "
+                     f"{_f(med.measured_psnr if med else None, '.1f')} | {_f(s.limit_speedup, '.2f')}× |")
     lines.append("")
     for s in result.scenes:
         lines.append(scene_markdown(s))

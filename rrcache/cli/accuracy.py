@@ -18,9 +18,9 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from rrcache.jsonable import finite_json
-from rrcache.profile.accuracy import DEFAULT_PERIODS, held_out
-from rrcache.profile.profile import load_profile
-from rrcache.profile.settings import parse_periods
+from rrcache.profiler.accuracy import DEFAULT_PERIODS, held_out
+from rrcache.profiles.document import load_profile
+from rrcache.profiles.settings import parse_periods
 
 
 @click.command("accuracy")

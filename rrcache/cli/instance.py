@@ -10,13 +10,13 @@ from __future__ import annotations
 import click
 
 from rrcache.cli.options import parse_defines
-from rrcache.runtime import ALGORITHMS, FILTERS
+from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
 
 @click.command("instance")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--node", required=True, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)
@@ -32,8 +32,8 @@ def command(shader, node, period, algorithm, filter_, payload, session, defines,
     loaded = load_session(session) if session else None
     work = load_for_session(shader, loaded, parse_defines(defines))
     entry = work.node(node)
-    variant = variant_for(work, node, period, algorithm, filter_, payload)
-    written = variant.write(out_dir)
+    variant = variant_for(work, node, algorithm, filter_, payload)
+    written = variant.write(out_dir, period=period)
     click.echo(f"{node} ({entry.type}, {shader}:{entry.line}:{entry.column}) cached with {algorithm} at Δn={period}:")
     for path in written:
         click.echo(f"  {path}")

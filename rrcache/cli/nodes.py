@@ -16,9 +16,8 @@ import json
 
 import click
 
-from rrcache.analysis.cacheable import cacheable_nodes
 from rrcache.cli.options import parse_defines
-from rrcache.glsl.frontend import load_shader
+from rrcache.pipeline import load_for_session
 
 _TEXT_WIDTH = 70
 
@@ -77,14 +76,12 @@ def format_table(table, show_all: bool) -> str:
                    "and `rrcache profile` do (node ids depend on the defines).")
 def command(shader, as_json, show_all, define, max_unroll, session):
     """List the nodes of SHADER that a reprojection cache can hold."""
-    defines = parse_defines(define)
+    loaded = None
     if session is not None:
-        from rrcache.harness.vertex import mesh_defines, session_attributes
         from rrcache.session import load_session
 
-        defines = {**mesh_defines(session_attributes(load_session(session))), **defines}
-    loaded = load_shader(shader, defines)
-    table = cacheable_nodes(loaded, max_iterations=max_unroll)
+        loaded = load_session(session)
+    table = load_for_session(shader, loaded, parse_defines(define), max_unroll=max_unroll).table
     if as_json:
         doc = table.to_json(shader)
         if not show_all:

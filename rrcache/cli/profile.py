@@ -4,7 +4,7 @@
     rrcache profile marble.frag marble.json --out marble.rrprofile --budget 900 -D OCTAVES=5
     rrcache profile noise.frag orbit.json --resolution 32x24 --periods 2,4,8 --timing-frames 6
 
-The ceiling (:mod:`rrcache.profile.ceiling`) is measured first, in seconds: when no cached variant
+The ceiling (:mod:`rrcache.profiler.ceiling`) is measured first, in seconds: when no cached variant
 can reach ``--min-gain`` (default 1.1×) the command stops there and says so, with the measured
 ceiling, why, and what would change it. Progress goes to stderr (:mod:`rrcache.cli.progress`: a bar
 on a terminal, a line per finished step elsewhere; ``--quiet`` for none). Rerunning
@@ -15,6 +15,7 @@ four selections (node, Δn, predicted/measured speed-up and error, PSNR).
 """
 from __future__ import annotations
 
+import math
 import sys
 import warnings
 
@@ -24,10 +25,14 @@ from rich.table import Table
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.harness.timing import UNRELIABLE_NOISE
+from rrcache.model.psnr import VISIBLE_DB, psnr_text
 from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.errors import RRCacheError
-from rrcache.profile.profile import STORE_NAME, algorithm_line, default_out_dir, profile
-from rrcache.profile.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
+from rrcache.profiler.run import default_out_dir, profile
+from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.store import STORE_NAME
+from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_KINDS, TrainingSettings, parse_periods
 
 
 def _periods(ctx, param, value):
@@ -82,16 +87,19 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--timing-format", type=click.Choice(tuple(COLOR_FORMATS)), default=None,
               help="Colour target of every timed run, original and variants alike (default: "
                    f"{TrainingSettings.timing_format}, as applications draw); error runs use rgba32f.")
+@click.option("--levels", type=click.Choice(LEVEL_KINDS), default="psnr", show_default=True,
+              help="The four selection levels e1..e4: psnr = predicted PSNR against the original >= 45, 40, 35, "
+                   "30 dB; relative = the paper's error thresholds (fractions of the largest error seen).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @quiet_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, defines,
-            quiet):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            defines, quiet):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
-                  validate=not no_validate, validation_frames=validation_frames)
+                  validate=not no_validate, validation_frames=validation_frames, levels=levels)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format)):
         if value is not None:
@@ -123,7 +131,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
 def _interrupted(out, err_console) -> None:
     from pathlib import Path
 
-    from rrcache.profile.store import read_store
+    from rrcache.profiles.store import read_store
 
     err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
     path = Path(out) / STORE_NAME
@@ -138,7 +146,7 @@ def _interrupted(out, err_console) -> None:
 
 
 def _verdict(prof, console: Console) -> None:
-    v, ceiling = prof.verdict, prof.ceiling
+    v, ceiling = prof.verdict, prof.measured_ceiling
     console.print(f"profile: {prof.path}", highlight=False)
     console.print(f"answer: {v['answer']}", highlight=False)
     if ceiling is not None:
@@ -167,24 +175,79 @@ def _summary(prof, console: Console) -> None:
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
-    ceiling = prof.ceiling
+    ceiling = prof.measured_ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-    noise = prof.data.get("timing_noise")
-    if noise is not None and not prof.data.get("timing_reliable", True):
+    noise = prof.timing_noise
+    if noise is not None and not prof.timing_reliable:
         console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "
                       "other work on the machine made the timings unreliable; profile again on a quieter machine",
                       highlight=False)
+    console.print(_table(prof))
+    for s in prof.selections:
+        if s.fallback:
+            console.print(f"{s.label}: {s.fallback}", highlight=False)
+    if any(s.visible_artifacts for s in prof.selections):
+        marked = ", ".join(s.label for s in prof.selections if s.visible_artifacts)
+        console.print(f"{marked}: below {VISIBLE_DB:.0f} dB PSNR: visible artifacts (a choice, not a default)",
+                      highlight=False)
+    noisy = [s.label for s in prof.selections if s.measured_noise is not None and s.measured_noise > UNRELIABLE_NOISE]
+    if noisy:
+        console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
+                      f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
+
+
+def _level(s) -> str:
+    if s.min_psnr is not None:
+        return f"≥ {s.min_psnr:g} dB"
+    return f"error ≤ {_fmt(s.max_error)}"
+
+
+def _speedup(s) -> str:
+    if s.measured_speedup is None:
+        return "–"
+    if len(s.speedups) > 1:
+        lo, hi = s.speedup_range
+        return f"{s.measured_speedup:.2f} ({lo:.2f}–{hi:.2f})"
+    return f"{s.measured_speedup:.2f}"
+
+
+def _predicted_speedup(s) -> str:
+    if not s.parts or len(s.predicted_speedup_range) != 2:
+        return _fmt(s.predicted_speedup, ".2f")
+    lo, hi = s.predicted_speedup_range
+    return f"{s.predicted_speedup:.2f} ({lo:.2f}–{hi:.2f})"
+
+
+def _predicted_psnr(s) -> str:
+    if s.exact or not s.parts:
+        return psnr_text(math.inf)
+    if s.predicted_psnr is None:
+        return "–"
+    return f"{psnr_text(s.predicted_psnr)} ± {s.predicted_psnr_uncertainty or 0:.1f}"
+
+
+def _measured_psnr(s) -> str:
+    if s.measured_error is None:
+        return "–"
+    if s.exact or not s.parts:
+        return psnr_text(math.inf)
+    text = psnr_text(s.measured_psnr)
+    return text + (" (visible)" if s.visible_artifacts else "")
+
+
+def _table(prof) -> Table:
     table = Table(title="selections")
-    for name in ("level", "max error", "node", "Δn", "speed-up pred.", "speed-up meas.", "error pred.",
-                 "error meas.", "PSNR"):
+    for name in ("level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
+                 "error pred.", "error meas."):
         if name == "node":
-            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=40)
+            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=36)
         else:
             table.add_column(name, justify="right")
     for s in prof.selections:
         node = "(original)" if s.node is None else f"{s.node}: {s.text}"
-        table.add_row(s.label, _fmt(s.max_error), node, _fmt(s.period, "d"), _fmt(s.predicted_speedup, ".2f"),
-                      _fmt(s.measured_speedup, ".2f"), _fmt(s.predicted_error), _fmt(s.measured_error),
-                      _fmt(s.measured_psnr, ".1f"))
-    console.print(table)
+        if s.fallback:
+            node = "↩ " + node
+        table.add_row(f"{s.label} {_level(s)}", node, _fmt(s.period, "d"), _predicted_speedup(s), _speedup(s),
+                      _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
+    return table

@@ -125,7 +125,7 @@ class Reporter:
             self.console.print(f"[{self._elapsed():9.1f} s] {text}", highlight=False, markup=False, soft_wrap=True)
 
     def event(self, event) -> None:
-        """A :class:`~rrcache.profile.train.ProgressEvent` (stage, done, total, detail)."""
+        """A :class:`~rrcache.profiler.train.ProgressEvent` (stage, done, total, detail)."""
         self.update(f"{event.stage} {event.detail}".strip(), event.done, event.total)
 
 

@@ -37,7 +37,8 @@ from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, render
-from rrcache.runtime import ALGORITHMS, FILTERS, REFRESH_MODES
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH,
+                             FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 
 
@@ -53,16 +54,16 @@ from rrcache.session import load_session
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=8, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
-@click.option("--block", type=click.Choice(["1", "2", "4", "8"]), default="4", show_default=True,
+@click.option("--block", type=click.Choice([str(b) for b in BLOCK_SIZES]), default=str(DEFAULT_BLOCK), show_default=True,
               help="Refresh block size k (pixels).")
-@click.option("--refresh", type=click.Choice(REFRESH_MODES), default="random", show_default=True)
+@click.option("--refresh", type=click.Choice(REFRESH_MODES), default=DEFAULT_REFRESH, show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
               help="Payload reconstruction filter.")
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
               help="Cache precision: 32- or 16-bit float.")
-@click.option("--depth-epsilon", type=float, default=1e-3, show_default=True,
+@click.option("--depth-epsilon", type=float, default=DEFAULT_DEPTH_EPSILON, show_default=True,
               help="Relative tolerance of the reprojected depth test.")
 @click.option("--color-format", type=click.Choice(("auto",) + tuple(COLOR_FORMATS)), default="auto",
               show_default=True,
@@ -146,7 +147,7 @@ def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resoluti
 
     work = load_for_session(shader, loaded, defines)
     entry = work.node(node)
-    variant = variant_for(work, node, opts["period"], opts["algorithm"], opts["filter"], opts["payload"])
+    variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"])
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:

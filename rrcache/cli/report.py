@@ -14,7 +14,7 @@ from pathlib import Path
 
 import click
 
-from rrcache.profile.profile import load_profile
+from rrcache.profiles.document import load_profile
 from rrcache.report import REPORT_NAME, write_report
 
 

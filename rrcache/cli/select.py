@@ -15,7 +15,7 @@ import math
 
 import click
 
-from rrcache.profile.profile import load_profile
+from rrcache.profiles.document import load_profile
 
 
 @click.command("select")

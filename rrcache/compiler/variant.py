@@ -8,12 +8,16 @@ to the original shader), what the application must bind, and how the runtime mus
 
     variant = instance(analysed, node_id)            # rrcache.compiler.instance
     programs = variant.build_programs(ctx)
-    rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h),
+    rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h), period=16,
                       payload_dtype=variant.payload_dtype)
+    variant.write("out/", period=16)                 # the manifest records the period it ran with
+
+The refresh period and the cache's other run-time parameters are not part of a variant (the same
+passes run at any period): they are the runtime's, with their defaults in
+:mod:`rrcache.runtime.cache` (``DEFAULT_PERIOD`` …).
 """
 from __future__ import annotations
 
-import inspect
 import json
 import os
 from dataclasses import dataclass, field
@@ -23,12 +27,7 @@ import moderngl
 
 from rrcache.errors import GLError, SourceLoc
 from rrcache.gl.program import build_program
-from rrcache.runtime.cache import ALGORITHMS, CacheRuntime
-
-
-def default_period() -> int:
-    """The runtime's default refresh period Δn."""
-    return int(inspect.signature(CacheRuntime.__init__).parameters["period"].default)
+from rrcache.runtime.cache import ALGORITHMS, DEFAULT_PERIOD
 
 
 @dataclass
@@ -65,15 +64,18 @@ class Variant:
     forms: dict[str, str] = field(default_factory=dict)
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
-    period: Optional[int] = None  # the refresh period Δn chosen for this variant (None: runtime default)
 
     @property
     def pass_names(self) -> tuple[str, ...]:
         """The passes in the order the runtime runs them."""
         return ALGORITHMS[self.algorithm]
 
-    def manifest(self) -> dict:
-        """A JSON-able description of the variant.
+    def manifest(self, period: Optional[int] = None, runtime: Optional[dict] = None) -> dict:
+        """A JSON-able description of the variant; ``period`` is the refresh period Δn it runs
+        with (the runtime's default when None): the passes do not depend on it, the runtime
+        takes it, and the manifest records it. ``runtime`` (the cache's other keyword arguments
+        it ran with: ``block``, ``refresh``, ``depth_epsilon``) is recorded as ``"runtime"`` when
+        given.
 
         >>> v = Variant("one-pass", 3, "float", "sin(x)", 1, "bilinear", "f4",
         ...             {"single": PassSource("vs", "fs")})
@@ -93,8 +95,8 @@ class Variant:
             "algorithm": self.algorithm,
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
-            "default_period": default_period(),
-            "period": self.period if self.period is not None else default_period(),
+            "default_period": DEFAULT_PERIOD,
+            "period": int(period) if period is not None else DEFAULT_PERIOD,
             "passes": {
                 name: {
                     "vertex": f"{name}.vert", "fragment": f"{name}.frag",
@@ -106,11 +108,14 @@ class Variant:
             },
             "uniforms": sorted({u for names in self.uniforms.values() for u in names}),
             "textures": sorted({s for names in self.samplers.values() for s in names}),
+            **({"runtime": dict(runtime)} if runtime else {}),
         }
 
-    def write(self, out_dir: "str | os.PathLike[str]") -> list[str]:
-        """Write ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json`` into ``out_dir``
-        (created when missing); returns the paths written."""
+    def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,
+              runtime: Optional[dict] = None) -> list[str]:
+        """Write ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json`` (recording ``period``
+        and ``runtime``, see :meth:`manifest`) into ``out_dir`` (created when missing); returns
+        the paths written."""
         out_dir = os.fspath(out_dir)
         os.makedirs(out_dir, exist_ok=True)
         written = []
@@ -122,7 +127,7 @@ class Variant:
                 written.append(path)
         path = os.path.join(out_dir, "manifest.json")
         with open(path, "w", encoding="utf-8") as f:
-            json.dump(self.manifest(), f, indent=2)
+            json.dump(self.manifest(period, runtime), f, indent=2)
             f.write("\n")
         written.append(path)
         return written

@@ -30,7 +30,7 @@ from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
-from rrcache.runtime import CacheRuntime
+from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
 
 def _unreliable() -> float:
     from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -70,7 +70,8 @@ class CachedRenderer:
     """
 
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
-                 period: int = 8, block: int = 4, refresh: str = "random", depth_epsilon: float = 1e-3,
+                 period: int = DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+                 depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
                  color_format: str = "rgba32f"):
@@ -140,7 +141,9 @@ class CachedRenderer:
         self.runtime.reset()
         self._last = None
 
-    def _frame(self, index: int, hit_box: Optional[dict]):
+    def _frame(self, hit_box: Optional[dict]):
+        """Run the passes of the frame set on the drawer; with ``hit_box`` the exact hit map is
+        read after the first pass into ``hit_box["map"]``."""
         def read_hits():
             hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
         return self.runtime.frame(self.drawer.draw, after_first_pass=read_hits if hit_box is not None else None)
@@ -154,7 +157,7 @@ class CachedRenderer:
             self.runtime.reset()
         self.drawer.set_frame(index)
         if not self._warm:
-            self._frame(index, None)
+            self._frame(None)
             if self._check_half:
                 self._settle_payload()
             self.runtime.reset()
@@ -162,7 +165,7 @@ class CachedRenderer:
         hit_box = {} if self.hit_maps else None
         ctx.finish()
         start = time.perf_counter()
-        stats = self._frame(index, hit_box)
+        stats = self._frame(hit_box)
         ctx.finish()
         ms = (time.perf_counter() - start) * 1000.0
         self._last = index
@@ -358,9 +361,9 @@ class Comparison:
         }
 
 
-def compare(variant, session, prepared: PreparedShader, frames, period: int = 8,
-            resolution: Optional[tuple[int, int]] = None, block: int = 4, refresh: str = "random",
-            depth_epsilon: float = 1e-3, hit_maps: bool = False,
+def compare(variant, session, prepared: PreparedShader, frames, period: int = DEFAULT_PERIOD,
+            resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
+            depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
             window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f") -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating

@@ -5,7 +5,7 @@ A cache never renders faster than its all-hit frame (the frame shown again with 
 and no refresh: every pixel reprojects and only the shading after the cached value runs), so
 ``original_ms / limit_ms`` bounds the speed-up any refresh period can reach. Both the cache
 benchmark (:mod:`rrcache.bench.cache`) and the profiler's ceiling
-(:mod:`rrcache.profile.ceiling`) measure it here.
+(:mod:`rrcache.profiler.ceiling`) measure it here.
 
 Per probe frame the cached variant renders the frame ``repeats + 2`` times with every pixel
 hitting (:meth:`~rrcache.harness.cached.CachedRenderer.render_static`, the first two untimed) and

@@ -4,8 +4,8 @@
 core`` fragment text the driver compiles, the printer's line map (so driver errors name the
 original ``file:line``), the declared uniforms/samplers and fragment inputs with the place of their
 declaration, the source path and a content hash. :func:`prepare` makes one from a front-end
-``Shader``; :func:`prepare_file` loads a shader file with the ``MODEL_VERTEX_*`` defines of a
-session's meshes first.
+``Shader``; :func:`load_for_meshes` loads a shader file with the ``MODEL_VERTEX_*`` defines of a
+session's meshes (the one place that does) and :func:`prepare_file` prepares what it loaded.
 
 >>> p = PreparedShader(source="#version 330 core\\nout vec4 c;\\nvoid main(){c=vec4(1);}",
 ...                    path="white.frag", hash="h1")
@@ -122,26 +122,37 @@ def prepare(shader, defines: Optional[Mapping[str, str]] = None) -> PreparedShad
     )
 
 
-def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping[str, str]] = None,
-                 include_dirs=()) -> PreparedShader:
-    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes and
-    prepare it.
+def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[str, str]] = None,
+                    include_dirs=()):
+    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes:
+    the one place a shader is loaded for a session. Returns ``(shader, defines)``: the front-end
+    ``Shader`` and every define it was loaded with.
 
-    ``session_or_attributes`` is a session (the union of its meshes' attributes counts) or an
-    iterable of attribute names (``normal texcoord color tangent``). ``extra_defines`` (e.g. from
-    ``-D`` on the command line) are added and win over the mesh defines.
+    ``session_or_attributes`` is a session (the union of its meshes' attributes counts), an
+    iterable of attribute names (``normal texcoord color tangent``) or None (no mesh defines).
+    ``defines`` (e.g. from ``-D`` on the command line) are added and win over the mesh defines.
 
-    >>> prepared = prepare_file("marble.frag", {"normal", "texcoord"})   # doctest: +SKIP
-    >>> prepared.defines                                                 # doctest: +SKIP
+    >>> shader, defines = load_for_meshes("marble.frag", {"normal", "texcoord"})   # doctest: +SKIP
+    >>> defines                                                                   # doctest: +SKIP
     {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
     """
     from rrcache.glsl.frontend import load_shader
 
-    if hasattr(session_or_attributes, "objects"):
-        attrs = session_attributes(session_or_attributes)
+    if session_or_attributes is None:
+        all_defines = {}
+    elif hasattr(session_or_attributes, "objects"):
+        all_defines = mesh_defines(session_attributes(session_or_attributes))
     else:
-        attrs = frozenset(session_or_attributes)
-    defines = mesh_defines(attrs)
-    defines.update(extra_defines or {})
-    shader = load_shader(path, defines=defines, include_dirs=include_dirs)
-    return prepare(shader, defines)
+        all_defines = mesh_defines(frozenset(session_or_attributes))
+    all_defines.update(defines or {})
+    return load_shader(path, defines=all_defines, include_dirs=include_dirs), all_defines
+
+
+def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping[str, str]] = None,
+                 include_dirs=()) -> PreparedShader:
+    """:func:`load_for_meshes`, then :func:`prepare`.
+
+    >>> prepare_file("marble.frag", {"normal", "texcoord"}).defines     # doctest: +SKIP
+    {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
+    """
+    return prepare(*load_for_meshes(path, session_or_attributes, extra_defines, include_dirs))

@@ -6,7 +6,9 @@ predicted error grid E[N, P] (eq. 2) and frame-time grid T[N, P] (eq. 5) over Δ
 :func:`select` is then a masked argmin over those grids — a few tens of microseconds for 200
 nodes × 50 periods (:func:`selection_benchmark`), so a threshold slider can re-select at once.
 The original shader competes as the option (error 0, ``original_ms``): a node is chosen only
-when it is predicted strictly faster than the original.
+when it is predicted strictly faster than the original. A choice is the record
+:class:`rrcache.selection.Selection` (one ``CachedNode(node, period)`` part, or none for the
+original), the same record the store, ``profile.json``, the report and the bench carry.
 
 >>> table = synthetic_table(20, seed=1)
 >>> choice = select(table, max_error=0.05)
@@ -20,13 +22,13 @@ from __future__ import annotations
 import math
 import statistics
 import time
-from dataclasses import dataclass
 from typing import NamedTuple, Optional
 
 import numpy as np
 
 from rrcache.errors import RRCacheError
 from rrcache.model.error import _quiet
+from rrcache.selection import CachedNode, Selection
 
 #: the paper's clip on the refresh period
 MAX_PERIOD = 50
@@ -34,19 +36,6 @@ MAX_PERIOD = 50
 LOW_QUANTILE = 0.05
 #: ε1 is at most ε_k divided by this
 MIN_SPREAD = 10.0
-
-
-@dataclass(frozen=True)
-class Selection:
-    """The chosen option: ``node`` (id; None = keep the original shader), ``period`` (Δn; None
-    for the original), ``predicted_error``, ``predicted_ms`` and ``predicted_speedup``
-    (``original_ms / predicted_ms``)."""
-
-    node: Optional[str]
-    period: Optional[int]
-    predicted_error: float
-    predicted_ms: float
-    predicted_speedup: float
 
 
 class FrontPoint(NamedTuple):
@@ -187,12 +176,12 @@ class ModelTable:
         """The :class:`Selection` of flat grid index ``index`` (node-major, then period)."""
         i, j = divmod(int(index), self.max_period)
         ms = float(self.T[i, j])
-        return Selection(self.node_ids[i], int(self.periods[j]), float(self.E[i, j]), ms,
+        return Selection((CachedNode(self.node_ids[i], int(self.periods[j])),), float(self.E[i, j]), ms,
                          self.original_ms / ms if ms > 0 else math.inf)
 
     def original(self) -> Selection:
         """The original shader as a :class:`Selection` (error 0, speed-up 1)."""
-        return Selection(None, None, 0.0, self.original_ms, 1.0)
+        return Selection.original(self.original_ms)
 
 
 def select(table: ModelTable, max_error: float) -> Selection:

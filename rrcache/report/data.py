@@ -1,4 +1,4 @@
-"""What the report and the notebooks show, as plain data taken from a :class:`~rrcache.profile.Profile`
+"""What the report and the notebooks show, as plain data taken from a :class:`~rrcache.profiles.Profile`
 (its nodes, selections and the model table; nothing is rendered here).
 
 - :func:`chart_data`: every trained node's predicted (ms per frame, error) over Δn = 1..50, the

@@ -1,5 +1,5 @@
 """The notebooks' figures and the interactive profiler widget (``notebooks/explore.ipynb`` and
-``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.report.demo_profile`).
+``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.profiler.demo_profile`).
 
 Figures (matplotlib): :func:`tradeoff_figure` (every node path, the original's time, the Pareto
 front, the selections), :func:`node_figure` (a node's measured errors with the fitted error model,
@@ -243,7 +243,7 @@ def measure_choice(prof, node: Optional[str], period: Optional[int], shots: Fram
 class Explorer:
     """The interactive profiler (see the module docstring). ``value`` is the starting threshold
     (default: the profile's e2 level). Attributes: ``slider``, ``button``, ``choice`` (the last
-    :class:`rrcache.model.Selection`), ``select_ms`` (the last re-selection's time), ``render_ms``
+    :class:`rrcache.selection.Selection`), ``select_ms`` (the last re-selection's time), ``render_ms``
     (the last new choice's frames and measurement),
     ``measured`` (the last choice's measurement), ``written`` (files the button wrote into
     ``out_dir``, default ``chosen/`` in the profile folder).

@@ -24,13 +24,13 @@ from pathlib import Path
 from typing import Optional
 
 from rrcache.errors import RRCacheError
-from rrcache.profile.profile import algorithm_line
+from rrcache.profiles.document import algorithm_line
 from rrcache.report import assets
 from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
 from rrcache.report.images import CAPTIONS, FrameShots, data_uri
 
 REPORT_NAME = "report.html"
-#: the figures of :mod:`rrcache.profile.plots` the report shows, with their captions
+#: the figures of :mod:`rrcache.report.plots` the report shows, with their captions
 PLOTS = (("tradeoff.png", "error against run time (static, every node over Δn = 1..50)"),
          ("hitrate.png", "hit rate: measured per node and the fitted γ(Δn) = μ(1 − 1/Δn)"),
          ("validation.png", "validation: predicted against measured error and frame time"))
@@ -72,7 +72,7 @@ def benefit_color(speedup: Optional[float], best: float) -> str:
 def _summary(prof, timing: dict) -> str:
     best = max((s for s in prof.selections if s.measured_speedup is not None),
                key=lambda s: s.measured_speedup, default=None)
-    counts = prof.data.get("counts") or {}
+    counts = prof.counts or {}
     cells = [
         (f"{len(prof.trained_nodes)} / {len(prof.nodes)}", "nodes trained / cacheable"),
         (_f(prof.original_ms, 4, " ms"), "original frame time"),
@@ -155,7 +155,7 @@ def _plots(prof) -> str:
     have = {name: folder / name for name, _ in PLOTS if folder is not None and (folder / name).exists()}
     with tempfile.TemporaryDirectory() as tmp:
         if len(have) < len(PLOTS) and prof.trained_nodes:
-            from rrcache.profile.plots import write_plots
+            from rrcache.report.plots import write_plots
 
             for path in write_plots(prof, tmp):
                 have.setdefault(Path(path).name, Path(path))
@@ -169,9 +169,9 @@ def _settings(prof) -> str:
     rows += [("algorithm used", algorithm_line(prof)), ("shader", prof.shader), ("session", prof.session),
              ("defines", json.dumps(prof.defines) if prof.defines else "–"),
              ("training time", _f(prof.training_wall_s, 4, " s")),
-             ("budget stopped training", str(bool(prof.data.get("budget_stopped")))),
-             ("untrained nodes", str(len(prof.data.get("untrained") or [])))]
-    counts = prof.data.get("counts") or {}
+             ("budget stopped training", str(bool(prof.budget_stopped))),
+             ("untrained nodes", str(len(prof.untrained)))]
+    counts = prof.counts or {}
     rows += [(k.replace("_", " "), str(v)) for k, v in counts.items()]
     return "<table>" + "".join(f"<tr><th>{_e(k)}</th><td><code>{_e(v)}</code></td></tr>" for k, v in rows) + "</table>"
 

@@ -169,7 +169,7 @@ class FrameShots:
         if node not in self._variants:
             from rrcache.pipeline import variant_for
 
-            self._variants[node] = variant_for(self.work, node, None, self.profile.algorithm)
+            self._variants[node] = variant_for(self.work, node, self.profile.algorithm)
         return self._variants[node]
 
     def frame_for(self, period: Optional[int]) -> int:
@@ -202,11 +202,9 @@ class FrameShots:
         from rrcache.harness.cached import CachedRenderer
         from rrcache.harness.metrics import mean_l2
 
-        settings = self.profile.settings
         variant = self.variant(node)
         with CachedRenderer(variant, self.session, self.work.prepared, self.size, period=period,
-                            block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon,
-                            hit_maps=True, keep_payload=True) as cached:
+                            hit_maps=True, keep_payload=True, **self.profile.settings.cache_options()) as cached:
             for index in range(frame + 1):
                 got = cached.render_frame(index)
         mask = ref.mask

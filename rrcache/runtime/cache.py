@@ -66,6 +66,17 @@ ALGORITHMS = {
 
 PAYLOAD_DTYPES = ("f2", "f4")
 
+# The cache's run-time parameters, given here once: every caller that does not choose one
+# (the harness, the profiler's settings, the command line, a variant's manifest) takes these.
+#: the refresh period Δn: every pixel is recomputed at least once in this many frames
+DEFAULT_PERIOD = 8
+#: the side of the square pixel blocks refreshed together (one of BLOCK_SIZES)
+DEFAULT_BLOCK = 4
+#: the refresh pattern (one of REFRESH_MODES)
+DEFAULT_REFRESH = "random"
+#: the relative depth difference beyond which a reprojected sample is a miss
+DEFAULT_DEPTH_EPSILON = 1e-3
+
 DrawCallback = Callable[[moderngl.Program, str], None]
 
 _UNIT_PREV_PAYLOAD, _UNIT_PREV_INVDEPTH, _UNIT_CUR_PAYLOAD = 12, 13, 15
@@ -111,13 +122,13 @@ class CacheRuntime:
         algorithm: str = "three-pass",
         size: tuple[int, int] = (640, 480),
         *,
-        period: int = 8,
-        block: int = 4,
-        refresh: str = "random",
+        period: int = DEFAULT_PERIOD,
+        block: int = DEFAULT_BLOCK,
+        refresh: str = DEFAULT_REFRESH,
         seed: int = 0,
         payload_dtype: str = "f4",
         payload_components: int = 4,
-        depth_epsilon: float = 1e-3,
+        depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
         cull_back_faces: Optional[bool] = None,
         color_format: str = "rgba32f",

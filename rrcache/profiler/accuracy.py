@@ -1,6 +1,6 @@
 """Model accuracy at held-out refresh periods (main paper §4.4): predicted against measured.
 
-:func:`held_out` takes a trained :class:`~rrcache.profile.profile.Profile`, picks the nodes that
+:func:`held_out` takes a trained :class:`~rrcache.profiles.document.Profile`, picks the nodes that
 matter — the nodes on the predicted Pareto front of error against frame time, which are the only
 ones selection can ever choose, plus the four selections' nodes — and measures each at refresh
 periods that training did not use (default Δn = 6, 14, 30), exactly as training measures: the
@@ -27,8 +27,8 @@ import numpy as np
 from rrcache.errors import RRCacheError
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.renderer import Renderer
-from rrcache.profile.plan import Plan
-from rrcache.profile.train import _Meter, _error_run, _timing_run, timing_frame_indices
+from rrcache.profiler.plan import Plan
+from rrcache.profiler.train import _Meter, _error_run, _timing_run, timing_frame_indices
 
 DEFAULT_PERIODS = (6, 14, 30)
 #: at most this many front nodes are measured (the front's nodes spread over its time range)
@@ -144,10 +144,10 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
                            hint="give trained node ids (profile.json lists them)")
     session = load_session(profile.session)
     work = load_for_session(profile.shader, session, profile.defines)
-    if work.shader.hash != profile.data.get("shader_hash"):
+    if work.shader.hash != profile.shader_hash:
         raise RRCacheError("the shader changed since it was profiled", str(profile.shader),
                            hint="run 'rrcache profile' again")
-    plan = Plan.from_json(profile.data.get("plan") or {})
+    plan = Plan.from_json(profile.plan or {})
     full = tuple(int(v) for v in session.resolution)
     train_frames = list(range(settings.frames))
     timing = timing_frame_indices(session.frames, settings.timing_frames)
@@ -163,8 +163,8 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
         for nid in nodes:
             node = profile.node(nid)
             report.training_r2[nid] = node.error_r2
-            variant = variant_for(work, nid, periods[0], profile.algorithm)
-            common = dict(block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon)
+            variant = variant_for(work, nid, profile.algorithm)
+            common = settings.cache_options()
             measured = {}
             with CachedRenderer(variant, session, work.prepared, settings.resolution, period=periods[0],
                                 window=plan.error_window, **common) as cached:

@@ -20,7 +20,7 @@ times t_hit and t_miss do not depend on the window, and the frame time is predic
 whole frame's covered pixels.
 
 The decision depends on a timing, so it is made once and kept in the profile store
-(:meth:`~rrcache.profile.store.ProfileStore.plan`): a resumed run uses the same windows.
+(:meth:`~rrcache.profiles.store.ProfileStore.plan`): a resumed run uses the same windows.
 
 >>> fraction_for(45.0, ERROR_TARGET_MS, 0.25), fraction_for(1400.0, ERROR_TARGET_MS, 0.25, MIN_ERROR_FRACTION)
 (0.25, 0.0625)
@@ -63,11 +63,11 @@ class Plan:
     timing_window: Optional[Window]
     original_ms: float
     #: the cache algorithm of the profile (``auto`` settings: the faster one measured, see
-    #: :func:`rrcache.profile.train.choose_algorithm`), and the median time of each candidate
+    #: :func:`rrcache.profiler.train.choose_algorithm`), and the median time of each candidate
     #: as a fraction of the original's
     algorithm: Optional[str] = None
     algorithm_times: Optional[dict] = None
-    #: the measured ceiling (:class:`rrcache.profile.ceiling.Ceiling` as JSON), once measured
+    #: the measured ceiling (:class:`rrcache.profiler.ceiling.Ceiling` as JSON), once measured
     ceiling: Optional[dict] = None
 
     def to_json(self) -> dict:

@@ -1,11 +1,11 @@
 """Training: the measurements behind the error and performance models (main paper §4.2–4.3).
 
-:func:`train` fills a :class:`~rrcache.profile.store.ProfileStore`, skipping whatever it already
+:func:`train` fills a :class:`~rrcache.profiles.store.ProfileStore`, skipping whatever it already
 holds, and fits the models from what is stored:
 
-0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profile.order`
+0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profiler.order`
    (too-cheap nodes skipped, the rest diversity first). The original is timed at full resolution
-   on the timing frames, and from that time the windows of :mod:`rrcache.profile.plan` are
+   on the timing frames, and from that time the windows of :mod:`rrcache.profiler.plan` are
    chosen (once; kept in the store). With ``algorithm="auto"`` the three-pass and two-pass
    variants of the first node are timed beside the original (:func:`choose_algorithm`) and the
    faster serves the whole profile (kept in the plan too).
@@ -54,14 +54,14 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
-from rrcache.profile.ceiling import Ceiling, measure_ceiling
-from rrcache.profile.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
+from rrcache.profiler.ceiling import Ceiling, measure_ceiling
+from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                    shader_inputs, signature)
-from rrcache.profile.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
+from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
                                   coverage_map,
                                   fraction_for, place_window)
-from rrcache.profile.settings import TrainingSettings
-from rrcache.profile.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
+from rrcache.profiles.settings import TrainingSettings
+from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
 
 #: a ceiling below ``min_gain`` but within this factor of it is measured a second time
 CEILING_RECHECK = 1.3
@@ -129,7 +129,7 @@ class TrainingResult:
     budget_stopped: bool = False
     notes: dict = field(default_factory=dict)
     plan: Optional[Plan] = None
-    #: the measured ceiling (:mod:`rrcache.profile.ceiling`), and whether it stopped the profile
+    #: the measured ceiling (:mod:`rrcache.profiler.ceiling`), and whether it stopped the profile
     #: before training (nothing can reach ``settings.min_gain``)
     ceiling: Optional[Ceiling] = None
     stopped: bool = False
@@ -139,7 +139,7 @@ class TrainingResult:
 
 def training_order(work: ShaderWork, session, settings: TrainingSettings) -> TrainingOrder:
     """The nodes to train in order, and the skipped ones with their reasons
-    (:mod:`rrcache.profile.order`)."""
+    (:mod:`rrcache.profiler.order`)."""
     nodes = [n for _, n in sorted(enumerate(work.table.nodes), key=lambda item: (-item[1].cost, item[0]))]
     keep, skipped = cost_filter(nodes, settings.min_saving)
     changing = per_frame_uniforms(session)
@@ -150,7 +150,7 @@ def training_order(work: ShaderWork, session, settings: TrainingSettings) -> Tra
 
 
 def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames: list[int]) -> Plan:
-    """Choose the error and timing windows (:mod:`rrcache.profile.plan`) for a shader whose
+    """Choose the error and timing windows (:mod:`rrcache.profiler.plan`) for a shader whose
     full frame costs ``original_ms``, placed over the coverage of ``frames``."""
     full = tuple(int(v) for v in session.resolution)
     at_full = tuple(settings.resolution) == full
@@ -229,10 +229,9 @@ def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node
     full = tuple(int(v) for v in session.resolution)
     fractions = {}
     for algorithm in AUTO_CANDIDATES:
-        variant = variant_for(work, node_id, period, algorithm)
-        with CachedRenderer(variant, session, work.prepared, full, period=period, block=settings.block,
-                            refresh=settings.refresh, depth_epsilon=settings.depth_epsilon, window=window,
-                            color_format=settings.timing_format) as cached:
+        variant = variant_for(work, node_id, algorithm)
+        with CachedRenderer(variant, session, work.prepared, full, period=period, window=window,
+                            color_format=settings.timing_format, **settings.cache_options()) as cached:
             frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
         fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
     return min(fractions, key=fractions.get), fractions
@@ -357,12 +356,13 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 budget_stopped = True
                 meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
                 continue
-            variant = variant_for(work, nid, settings.timing_periods[0], algorithm)
+            # one compiled variant serves every period: the period is the runtime's (set per run)
+            variant = variant_for(work, nid, algorithm)
             if todo_error[nid]:
                 built = clock()
-                with CachedRenderer(variant, session, work.prepared, settings.resolution, period=settings.periods[0],
-                                    block=settings.block, refresh=settings.refresh,
-                                    depth_epsilon=settings.depth_epsilon, window=plan.error_window) as cached:
+                with CachedRenderer(variant, session, work.prepared, settings.resolution,
+                                    period=todo_error[nid][0], window=plan.error_window,
+                                    **settings.cache_options()) as cached:
                     compile_s = clock() - built
                     for period in todo_error[nid]:
                         run, frames = _error_run(cached, nid, period, refs, meter)
@@ -371,10 +371,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                         store.add_error_run(run, frames)
             if todo_timing[nid]:
                 built = clock()
-                with CachedRenderer(variant, session, work.prepared, full, period=settings.timing_periods[0],
-                                    block=settings.block, refresh=settings.refresh,
-                                    depth_epsilon=settings.depth_epsilon, window=plan.timing_window,
-                                    color_format=fmt) as cached:
+                with CachedRenderer(variant, session, work.prepared, full, period=todo_timing[nid][0],
+                                    window=plan.timing_window, color_format=fmt, **settings.cache_options()) as cached:
                     compile_s = clock() - built
                     for period in todo_timing[nid]:
                         t0 = clock()
@@ -448,11 +446,10 @@ def _prune(work: ShaderWork, order: TrainingOrder, ceiling: Ceiling, settings: T
 
 
 def _measure_overhead(work, session, settings, store, node_id, timing, meter, algorithm: str) -> None:
-    variant = variant_for(work, node_id, settings.timing_periods[-1], algorithm)
+    variant = variant_for(work, node_id, algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
-                        block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon,
-                        color_format=settings.timing_format) as cached:
+                        color_format=settings.timing_format, **settings.cache_options()) as cached:
         for index in timing:
             cached.reset()
             cached.render_frame(index - 1)

@@ -25,15 +25,18 @@ from pathlib import Path
 from typing import Iterable, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.selection import Selection, parts_from_json, parts_to_json
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: the store's file name in a profile folder
+STORE_NAME = "profile.sqlite"
 
 SCHEMA = """\
 -- rrcache profile store; the schema version is in meta('schema_version').
 --
 -- meta: what the file belongs to. Keys: schema_version, rrcache_version, shader_hash,
 --   session_hash, settings_json, settings_hash, created, updated (unix seconds); and, once the
---   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profile.plan),
+--   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profiler.plan),
 --   kept so that a resumed run renders exactly what the first one did.
 CREATE TABLE meta (
     key TEXT PRIMARY KEY,
@@ -136,13 +139,14 @@ CREATE TABLE overhead (
 );
 
 -- validation: a selection (label e1..e4 at max_error) rendered beside the original at full
---   resolution; predicted figures from the models, measured ones from the render. node NULL =
---   the original shader (nothing rendered: error 0, speed-up 1).
+--   resolution; predicted figures from the models, measured ones from the render. parts: what is
+--   cached, as the JSON list of rrcache.selection.parts_to_json ([] = the original shader:
+--   nothing rendered, error 0, speed-up 1); algorithm: the cache algorithm it ran with.
 CREATE TABLE validation (
     label TEXT PRIMARY KEY,
     max_error REAL NOT NULL,
-    node TEXT,
-    period INTEGER,
+    parts TEXT NOT NULL,
+    algorithm TEXT,
     predicted_error REAL NOT NULL,
     predicted_ms REAL NOT NULL,
     predicted_speedup REAL NOT NULL,
@@ -155,6 +159,10 @@ CREATE TABLE validation (
     frames INTEGER NOT NULL
 );
 """
+
+_VALIDATION_COLUMNS = ("label", "max_error", "parts", "algorithm", "predicted_error", "predicted_ms",
+                       "predicted_speedup", "measured_error", "measured_psnr", "measured_ms", "measured_original_ms",
+                       "measured_speedup", "hit_rate", "frames")
 
 _TABLES = ("meta", "run_log", "reference_frame", "error_run", "error_frame", "timing_run", "timing_frame",
            "reference_timing", "overhead", "validation")
@@ -228,24 +236,6 @@ class TimingFrame:
     misses: int
     ms: float
     original_ms: float
-
-
-@dataclass
-class ValidationRow:
-    label: str
-    max_error: float
-    node: Optional[str]
-    period: Optional[int]
-    predicted_error: float
-    predicted_ms: float
-    predicted_speedup: float
-    measured_error: float
-    measured_psnr: float
-    measured_ms: float
-    measured_original_ms: float
-    measured_speedup: float
-    hit_rate: float
-    frames: int
 
 
 def _refuse(path: Path, message: str, hint: str) -> RRCacheError:
@@ -350,6 +340,9 @@ class ProfileStore:
         except sqlite3.DatabaseError as err:
             raise _refuse(path, f"an SQLite file that is not a profile store ({err})", _FRESH_HINT) from None
         version = meta.get("schema_version")
+        if version in _MIGRATIONS and "validation" in tables:
+            _MIGRATIONS[version](self.conn)
+            version = str(SCHEMA_VERSION)
         if version != str(SCHEMA_VERSION):
             raise _refuse(path, f"profile store schema {version!r}, this rrcache reads schema {SCHEMA_VERSION}"
                           if version else "an SQLite file that is not a profile store (no schema version)", _FRESH_HINT)
@@ -442,18 +435,23 @@ class ProfileStore:
         self._write([("INSERT OR REPLACE INTO overhead VALUES (1, ?, ?, ?, ?, ?)",
                       (node, int(size[0]), int(size[1]), int(frames), float(ms)))])
 
-    def add_validation(self, row: ValidationRow) -> None:
-        self._write([("INSERT OR REPLACE INTO validation VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                      (row.label, row.max_error, row.node, row.period, row.predicted_error, row.predicted_ms,
-                       row.predicted_speedup, row.measured_error, row.measured_psnr, row.measured_ms,
-                       row.measured_original_ms, row.measured_speedup, row.hit_rate, row.frames))])
+    def add_validation(self, sel: Selection) -> None:
+        """A measured selection (its ``label`` is the key; a later one replaces it)."""
+        if not sel.measured:
+            raise ValueError("add_validation needs a measured selection")
+        self._write([(f"INSERT OR REPLACE INTO validation({', '.join(_VALIDATION_COLUMNS)}) "
+                      f"VALUES ({', '.join('?' * len(_VALIDATION_COLUMNS))})",
+                      (sel.label, sel.max_error, json.dumps(parts_to_json(sel.parts)), sel.algorithm,
+                       sel.predicted_error, sel.predicted_ms, sel.predicted_speedup, sel.measured_error,
+                       sel.measured_psnr, sel.measured_ms, sel.measured_original_ms, sel.measured_speedup,
+                       sel.hit_rate, sel.frames))])
 
     # ------------------------------------------------------------------ readers
     def meta(self) -> dict:
         return dict(self.conn.execute("SELECT key, value FROM meta"))
 
     def plan(self) -> Optional[dict]:
-        """The windows the first run chose (``rrcache.profile.plan.Plan.to_json``), or None."""
+        """The windows the first run chose (``rrcache.profiler.plan.Plan.to_json``), or None."""
         row = self.conn.execute("SELECT value FROM meta WHERE key = 'plan'").fetchone()
         if row is None:
             return None
@@ -509,9 +507,20 @@ class ProfileStore:
             return None
         return dict(zip(("node", "width", "height", "frames", "ms"), row))
 
-    def validations(self) -> list[ValidationRow]:
-        rows = self.conn.execute("SELECT * FROM validation ORDER BY label")
-        return [ValidationRow(*r) for r in rows]
+    def validations(self) -> list[Selection]:
+        """The measured selections, in label order."""
+        rows = self.conn.execute(f"SELECT {', '.join(_VALIDATION_COLUMNS)} FROM validation ORDER BY label")
+        out = []
+        for label, max_error, parts, algorithm, *figures in rows:
+            try:
+                decoded = parts_from_json(json.loads(parts), f"validation[{label}].parts")
+            except ValueError:
+                raise _refuse(self.path, f"validation {label!r}: its parts are not JSON", _FRESH_HINT) from None
+            except RRCacheError as err:
+                raise _refuse(self.path, str(err), _FRESH_HINT) from None
+            out.append(Selection(decoded, *figures[:3], label=label, max_error=max_error,
+                                 algorithm=algorithm).with_measurement(*figures[3:]))
+        return out
 
     def spent_s(self) -> float:
         """Training seconds stored so far (error and timing runs): what the budget has spent."""
@@ -551,6 +560,35 @@ class ProfileStore:
         self.close()
 
 
+def _migrate_1(conn: sqlite3.Connection) -> None:
+    """Schema 1 → 2 in one transaction: the validation rows' ``node``/``period`` columns become
+    ``parts`` (the algorithm was not recorded: NULL)."""
+    conn.execute("BEGIN IMMEDIATE")
+    try:
+        old = conn.execute("SELECT label, max_error, node, period, predicted_error, predicted_ms, predicted_speedup, "
+                           "measured_error, measured_psnr, measured_ms, measured_original_ms, measured_speedup, "
+                           "hit_rate, frames FROM validation").fetchall()
+        conn.execute("DROP TABLE validation")
+        table = SCHEMA[SCHEMA.index("CREATE TABLE validation"):]
+        conn.execute(table[:table.index(";")])
+        for label, max_error, node, period, *figures in old:
+            parts = [] if node is None else [{"kind": "cache", "node": node, "period": int(period)}]
+            conn.execute(f"INSERT INTO validation({', '.join(_VALIDATION_COLUMNS)}) VALUES "
+                         f"({', '.join('?' * len(_VALIDATION_COLUMNS))})",
+                         (label, max_error, json.dumps(parts), None, *figures))
+        conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
+        conn.execute("COMMIT")
+    except BaseException:
+        if conn.in_transaction:
+            conn.execute("ROLLBACK")
+        raise
+
+
+#: older schema version -> the function that upgrades a store in place (schema 1 kept a
+#: validation's node and period in two columns; schema 2 keeps its parts)
+_MIGRATIONS = {"1": _migrate_1}
+
+
 def _statements(script: str) -> list[str]:
     """The statements of :data:`SCHEMA` (comments dropped)."""
     lines = [line for line in script.splitlines() if not line.lstrip().startswith("--")]
@@ -567,7 +605,11 @@ def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     store = ProfileStore(path, conn)
     try:
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-        if "meta" not in tables or dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") != str(SCHEMA_VERSION):
+        version = dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") if "meta" in tables else None
+        if version in _MIGRATIONS and "validation" in tables:
+            _MIGRATIONS[version](conn)
+            version = str(SCHEMA_VERSION)
+        if version != str(SCHEMA_VERSION):
             raise _refuse(path, "an SQLite file that is not a profile store", _FRESH_HINT)
     except sqlite3.DatabaseError as err:
         conn.close()

@@ -3,13 +3,13 @@
 :class:`TrainingSettings` is a frozen, JSON-able dataclass. The fields that change what is
 *measured* (periods, resolution, frames, timing frames and periods, algorithm, refresh block,
 refresh pattern, depth epsilon, validation frames) are hashed into the key of the profile store
-(:mod:`rrcache.profile.store`): a store trained with other settings is refused rather than mixed.
+(:mod:`rrcache.profiles.store`): a store trained with other settings is refused rather than mixed.
 ``budget_s`` and ``validate`` only decide how much is done, so they are left out of the key and
 may change between a run and its resumption.
 
 The error is measured over the first ``frames`` consecutive frames (default 64: the steady state
 of the largest paper period, 50, plus 14 frames) at the session's full resolution, inside a
-window of the frame chosen from the original's cost (:mod:`rrcache.profile.plan`), or at an
+window of the frame chosen from the original's cost (:mod:`rrcache.profiler.plan`), or at an
 explicit reduced ``resolution`` (errors are then larger: the resampling blur grows with the
 pixel size). The times are measured on ``timing_frames`` frames at the session's full
 resolution.
@@ -34,22 +34,24 @@ from typing import Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.gl.formats import COLOR_FORMATS
-from rrcache.runtime import ALGORITHMS, REFRESH_MODES
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH,
+                             REFRESH_MODES)
 
-#: the paper's training periods (main paper §4.2)
 #: the cache algorithms a profile may use; ``auto`` measures which is faster on this machine
 ALGORITHM_CHOICES = ("auto",) + tuple(ALGORITHMS)
 #: what ``auto`` stands for when nothing was measured (no node to time)
 DEFAULT_ALGORITHM = "three-pass"
 
+#: the paper's training periods (main paper §4.2)
 DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
 #: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
 DEFAULT_TIMING_PERIODS = (2, 8, 50)
-BLOCK_SIZES = (1, 2, 4, 8)
 #: consecutive frames of the error runs when the session has that many
 DEFAULT_TRAINING_FRAMES = 64
 #: the fields that do not change a measurement (left out of the store key)
-UNKEYED = ("budget_s", "validate", "min_saving", "min_gain")
+UNKEYED = ("budget_s", "validate", "min_saving", "min_gain", "levels")
+#: how the four selection levels are chosen
+LEVEL_KINDS = ("psnr", "relative")
 
 
 def _fail(field_name: str, message: str, hint: str) -> RRCacheError:
@@ -80,7 +82,7 @@ class TrainingSettings:
     - ``periods``: the refresh periods Δn of the error runs.
     - ``resolution``: (w, h) of the error runs; None: the session's, rendered in a window.
     - ``error_window``: the share of the frame's area the error runs render (1: all of it);
-      None: chosen from the original's cost (:mod:`rrcache.profile.plan`). Only at the
+      None: chosen from the original's cost (:mod:`rrcache.profiler.plan`). Only at the
       session's resolution.
     - ``frames``: the first N consecutive session frames of the error runs; None: 64 (or all,
       when the session is shorter).
@@ -89,19 +91,22 @@ class TrainingSettings:
     - ``algorithm``, ``block``, ``refresh``, ``depth_epsilon``: the cache's own settings.
       ``algorithm="auto"`` (the default) times the three-pass and two-pass variants of the first
       node to train side by side with the original and keeps the faster for the whole profile
-      (:func:`rrcache.profile.train.choose_algorithm`; the choice is kept in the plan).
+      (:func:`rrcache.profiler.train.choose_algorithm`; the choice is kept in the plan).
     - ``validation_frames``: consecutive frames of each validation render; None: all.
     - ``budget_s``: node training starts no new node once this many seconds are spent.
     - ``validate``: render the four selections against the original after training.
     - ``min_saving``: nodes whose static cost is below this share of the costliest node's are
-      not trained (:mod:`rrcache.profile.order`).
+      not trained (:mod:`rrcache.profiler.order`).
     - ``min_gain``: the least speed-up worth having: when the measured ceiling
-      (:mod:`rrcache.profile.ceiling`) is below it the profile stops before training and answers
+      (:mod:`rrcache.profiler.ceiling`) is below it the profile stops before training and answers
       "the original"; nodes whose best case is below it are not trained. 0 measures the ceiling
       but neither stops nor prunes.
     - ``timing_format``: the colour target of every timed run, the original's and the variants'
       alike (``rgba8`` as applications draw; ``rgba16f``, ``rgba32f``); error runs always draw
       into ``rgba32f``.
+    - ``levels``: the four selection levels e1..e4: ``psnr`` (predicted PSNR against the original
+      ≥ 45, 40, 35, 30 dB) or ``relative`` (the paper's error thresholds, fractions of the
+      largest error seen).
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -111,15 +116,21 @@ class TrainingSettings:
     timing_frames: int = 8
     timing_periods: tuple[int, ...] = DEFAULT_TIMING_PERIODS
     algorithm: str = "auto"
-    block: int = 4
-    refresh: str = "random"
-    depth_epsilon: float = 1e-3
+    block: int = DEFAULT_BLOCK
+    refresh: str = DEFAULT_REFRESH
+    depth_epsilon: float = DEFAULT_DEPTH_EPSILON
     validation_frames: Optional[int] = None
     budget_s: float = 360.0
     validate: bool = True
     min_saving: float = 0.1
     min_gain: float = 1.1
     timing_format: str = "rgba8"
+    levels: str = "psnr"
+
+    def cache_options(self) -> dict:
+        """The cache's run-time parameters besides the period, as the keyword arguments of
+        :class:`rrcache.runtime.CacheRuntime` (and of the harness that wraps it)."""
+        return {"block": self.block, "refresh": self.refresh, "depth_epsilon": self.depth_epsilon}
 
     @property
     def fixed_algorithm(self) -> str:
@@ -148,7 +159,8 @@ class TrainingSettings:
         if self.algorithm not in ALGORITHM_CHOICES:
             raise _fail("algorithm", f"unknown algorithm {self.algorithm!r}", f"one of {', '.join(ALGORITHM_CHOICES)}")
         if self.block not in BLOCK_SIZES:
-            raise _fail("block", f"{self.block!r} is not a refresh block size", "one of 1, 2, 4, 8")
+            raise _fail("block", f"{self.block!r} is not a refresh block size",
+                        f"one of {', '.join(str(b) for b in BLOCK_SIZES)}")
         if self.refresh not in REFRESH_MODES:
             raise _fail("refresh", f"unknown refresh pattern {self.refresh!r}", f"one of {', '.join(REFRESH_MODES)}")
         if not (isinstance(self.depth_epsilon, (int, float)) and 0 < self.depth_epsilon < 1):
@@ -168,6 +180,8 @@ class TrainingSettings:
                 or not 0 <= self.min_gain < 100:
             raise _fail("min_gain", f"{self.min_gain!r} is not a speed-up in [0, 100)", "the default is 1.1")
         object.__setattr__(self, "min_gain", float(self.min_gain))
+        if self.levels not in LEVEL_KINDS:
+            raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
         if self.timing_format not in COLOR_FORMATS:
             raise _fail("timing_format", f"unknown colour format {self.timing_format!r}",
                         f"one of {', '.join(COLOR_FORMATS)}")

@@ -31,8 +31,6 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-#: nodes saving less than this share of the costliest node's static cost are not trained
-DEFAULT_MIN_SAVING = 0.1
 #: glslViewer built-in uniforms that change from frame to frame in every session, and those that
 #: follow the camera or the light (they change when it moves)
 _ALWAYS = ("u_time", "u_frame")

@@ -201,7 +201,7 @@ def measure_ceiling(work, session, settings, node, algorithms, timing_frames, pi
     full = tuple(int(v) for v in session.resolution)
     results, noise = {}, []
     for algorithm in algorithms:
-        variant = variant_for(work, node.id, period, algorithm)
+        variant = variant_for(work, node.id, algorithm)
         big = all_hit_limit(variant, session, work.prepared, frames, full, window=window, **common)
         if step is not None:
             step(f"{algorithm} all hits")

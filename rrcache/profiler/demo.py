@@ -23,7 +23,8 @@ DEMO_SETTINGS = dict(periods=(2, 4, 8, 16), timing_frames=6, timing_periods=(2, 
 def demo_profile(out_dir="demo.rrprofile", progress=None):
     """The demo scene's profile in ``out_dir``: loaded when a profile is there, made otherwise
     (seconds; the report is written with it)."""
-    from rrcache.profile import TrainingSettings, load_profile, profile
+    from rrcache.profiler.run import profile
+    from rrcache.profiles import TrainingSettings, load_profile
 
     out = Path(out_dir)
     if (out / "profile.json").exists():

@@ -1,0 +1,196 @@
+"""The profiling run: train, select, validate, and write the profile folder (main paper §4, Fig. 3).
+
+:func:`profile` (``rrcache.profile``, ``rrcache profile``) is the orchestrator: it sits above
+the data it writes (:mod:`rrcache.profiles`) and the report that shows it (:mod:`rrcache.report`),
+and nothing below imports it. Into the output folder it writes:
+
+- ``profile.sqlite``: every measurement (:mod:`rrcache.profiles.store`); rerunning with the same
+  arguments resumes from it, skipping what is stored;
+- ``optimized/e1`` … ``optimized/e4``: the shader files of each selection;
+- ``tradeoff.png``/``.svg``, ``hitrate.png``, ``validation.png`` (:mod:`rrcache.report.plots`) and
+  ``report.html`` (:mod:`rrcache.report.html`), unless ``plots=False``;
+- ``profile.json`` (:mod:`rrcache.profiles.document`), last and once.
+
+>>> p = profile("marble.frag", "marble.json", settings=TrainingSettings(budget_s=60))   # doctest: +SKIP
+>>> [s.label for s in p.selections]                                                     # doctest: +SKIP
+['e1', 'e2', 'e3', 'e4']
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Mapping, Optional
+
+from rrcache.errors import RRCacheError
+from rrcache.harness.timing import UNRELIABLE_NOISE
+from rrcache.profiler.train import ProgressFn, TrainingResult, train
+from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
+from rrcache.profiles.settings import TrainingSettings
+from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
+from rrcache.selection import Selection
+
+
+def default_out_dir(shader_path, session_path) -> Path:
+    """``<shader stem>-<session stem>.rrprofile`` in the current folder.
+
+    >>> default_out_dir("shaders/marble.glsl", "sessions/orbit.json").name
+    'marble-orbit.rrprofile'
+    """
+    return Path.cwd() / f"{Path(shader_path).stem}-{Path(session_path).stem}.rrprofile"
+
+
+def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
+            defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
+            fresh: bool = False, plots: bool = True) -> Profile:
+    """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
+    module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
+    store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
+    moves it aside first. ``progress`` receives :class:`~rrcache.profiler.train.ProgressEvent`
+    objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
+    propagates.
+
+    >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
+    """
+    import rrcache
+    from rrcache.pipeline import load_for_session
+    from rrcache.session import load_session
+
+    session = load_session(session_path)
+    work = load_for_session(shader_path, session, defines)
+    resolved = (settings or TrainingSettings()).resolved(session)
+    out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
+    if out.exists() and not out.is_dir():
+        raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
+    key = StoreKey(work.shader.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
+    store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
+    started = time.time()
+    try:
+        store.begin_run()
+        result = train(work, session, resolved, store, progress)
+        prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+        prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+        _write_outputs(prof, out, work, plots)
+        store.end_run("done")
+        _add_times(prof, store, time.time() - started)
+        prof.write(out)
+    except KeyboardInterrupt:
+        store.end_run("interrupted")
+        store.close()
+        raise
+    except BaseException:
+        try:
+            store.end_run("failed")
+        finally:
+            store.close()
+        raise
+    store.close()
+    return prof
+
+
+def _add_times(prof: Profile, store, run_wall_s: float) -> None:
+    """The wall time of this invocation (``run_wall_s``) and the precomputation time: every
+    invocation on this store added up (``precompute_s``), so a resumed profile counts the time of
+    its earlier runs too (an invocation killed outright left no finish time and is not counted)."""
+    log = store.run_log()
+    prof.run_wall_s = run_wall_s
+    prof.precompute_s = sum(float(r["finished"]) - float(r["started"]) for r in log if r["finished"] is not None)
+    prof.invocations = len(log)
+
+
+def _assemble(work, session, shader_path, session_path, settings, result: TrainingResult, store,
+              out: Path) -> Profile:
+    """The profile of a training result, before its selections (read back from its own
+    document, so that what the run goes on with is what a reader gets)."""
+    by_id = {n.id: n for n in work.table.nodes}
+    nodes = []
+    for nid in result.order:
+        entry = by_id[nid]
+        node = NodeProfile(nid, entry.type, entry.line, entry.column, entry.text, list(entry.call_chain),
+                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid))
+        runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
+        node.periods = [r.period for r in runs]
+        node.errors = [r.mean_error for r in runs]
+        node.hit_rates = [r.hit_rate for r in runs]
+        node.psnrs = [r.psnr for r in runs]
+        if node.trained:
+            ef, pf = result.error_fits[nid], result.perf_fits[nid]
+            node.alpha, node.lam = float(ef.alpha), float(ef.lam)
+            node.error_quality, node.error_r2 = str(ef.quality), float(ef.r2)
+            node.t_hit, node.t_miss, node.perf_quality = float(pf.t_hit), float(pf.t_miss), str(pf.quality)
+            node.error_fit, node.perf_fit = _fit_json(ef), _fit_json(pf)
+        nodes.append(node)
+    hit = result.hit_fit
+    plan = result.plan
+    draft = Profile(
+        shader=str(Path(shader_path).resolve()), session=str(Path(session_path).resolve()),
+        shader_hash=work.shader.hash, session_hash=session.hash, settings=settings,
+        algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
+        algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
+        nodes=nodes, defines=dict(work.defines), plan=plan.to_json() if plan is not None else None,
+        untrained=list(result.untrained), budget_stopped=result.budget_stopped,
+        mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,
+        hit_fit=_fit_json(hit), overhead_ms=result.overhead_ms, original_ms=result.original_ms,
+        pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts),
+        ceiling=result.ceiling.to_json() if result.ceiling is not None else None,
+        verdict=_verdict(result.ceiling) if result.stopped else None,
+        timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE)
+    prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
+    prof.path = out
+    return prof
+
+
+def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
+    """The e1..e4 selections: measured beside the original when ``settings.validate``
+    (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
+    if not result.trained:
+        return []
+    choices = prof.threshold_selections()
+    if not settings.validate:
+        return choices
+    from rrcache.profiler.validate import validate
+
+    measured = validate(work, session, settings, store, choices, progress,
+                        window=result.plan.timing_window if result.plan is not None else None,
+                        candidates=prof.front_candidates)
+    # the counts were taken before validation: count the validations now
+    prof.counts = dict(prof.counts, validations=store.counts()["validations"])
+    return measured
+
+
+def _verdict(ceiling) -> dict:
+    """What profile.json says when the ceiling stopped the profile before training."""
+    return {"choice": "original", "ceiling": ceiling.speedup, "min_gain": ceiling.min_gain,
+            "answer": f"keep the original shader: no cached variant can reach {ceiling.min_gain:.2f}× here "
+                      f"(ceiling {ceiling.speedup:.2f}×)",
+            "reason": ceiling.reason(), "changes": ceiling.changes()}
+
+
+def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
+    """The shader files of each selection, then (with ``plots``) the plots and the report."""
+    from rrcache.pipeline import variant_for_selection
+
+    out.mkdir(parents=True, exist_ok=True)
+    kept = []
+    for sel in prof.selections:
+        folder = out / "optimized" / sel.label
+        if folder.exists():
+            for old in folder.iterdir():
+                if old.is_file():
+                    old.unlink()
+        if not sel.parts:
+            prof.write_variant(sel, folder)
+        else:
+            variant, period = variant_for_selection(work, sel)
+            variant.write(folder, period=period, runtime=prof.settings.cache_options())
+        kept.append(sel.replace(files=str(folder.relative_to(out))))
+    prof.selections = kept
+    prof.path = out
+    if prof.verdict is not None:  # stopped before training: nothing to plot or report
+        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
+        plots = False
+    if plots:
+        from rrcache.report import write_report
+        from rrcache.report.plots import write_plots
+
+        prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
+        write_report(prof, out, work=work)

@@ -1,0 +1,576 @@
+"""``profile.json``: the profile document, its declared shape, and reading and writing it.
+
+A profile folder (written by :func:`rrcache.profile`, :mod:`rrcache.profiler.run`) holds
+``profile.sqlite`` (every measurement, :mod:`rrcache.profiles.store`), the plots, the report, the
+shader files of the selections and this document: the fitted models per node, μ, the overhead,
+the original's frame time and the selections (:class:`rrcache.selection.Selection`).
+
+The shape is declared once, by the dataclasses below (:class:`Profile`, :class:`NodeProfile`,
+and :class:`~rrcache.selection.Selection` for each selection): each field's type and, in its
+metadata, its range. :func:`load_profile` checks a document against them before anything uses
+it (types, finite numbers, ranges, unknown and missing keys, the version
+:data:`PROFILE_VERSION`) and refuses a bad one with the key path::
+
+    profile.json: nodes[3].alpha: must be a finite number >= 0
+
+:meth:`Profile.write` writes it (once per profiling run, atomically); :meth:`Profile.select`
+re-selects for any error threshold from the models alone, in milliseconds.
+
+>>> p = load_profile("marble-marble.rrprofile")        # doctest: +SKIP
+>>> choice = p.select(0.02)                            # doctest: +SKIP
+>>> choice.node, choice.period, round(choice.predicted_speedup, 1)   # doctest: +SKIP
+('n102', 35, 2.7)
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Optional
+
+from rrcache.errors import RRCacheError
+from rrcache.jsonable import finite_json
+from rrcache.profiles.settings import TrainingSettings
+from rrcache.selection import Selection, parts_from_json
+
+#: the version of the document's shape; a document of another version is refused
+PROFILE_VERSION = 2
+JSON_NAME = "profile.json"
+#: the labels of the selections a profile keeps, from the smallest error threshold up
+LABELS = ("e1", "e2", "e3", "e4")
+
+_HINT = "the file is damaged, edited or from another rrcache version; run 'rrcache profile' again"
+
+
+def _range(default=dataclasses.MISSING, *, minimum=None, maximum=None, factory=dataclasses.MISSING):
+    """A dataclass field whose numbers (or list items) must lie in [minimum, maximum]."""
+    meta = {"minimum": minimum, "maximum": maximum}
+    if factory is not dataclasses.MISSING:
+        return field(default_factory=factory, metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+@dataclass
+class NodeProfile:
+    """One cacheable node in a profile: where it is, its static cost, and (when ``trained``) its
+    fitted models: error α, λ (``lam``) with their fit quality and R², per-pixel times t_hit,
+    t_miss (ms) with the performance fit's quality, and the measured error runs (``periods``,
+    ``errors``, ``hit_rates``, ``psnrs``); ``note`` says why an untrained node was not trained."""
+
+    id: str
+    type: str
+    line: int = _range(minimum=0)
+    column: int = _range(minimum=0)
+    text: str = ""
+    call_chain: list[str] = field(default_factory=list)
+    cost: int = _range(0, minimum=0)
+    trained: bool = False
+    alpha: Optional[float] = _range(None, minimum=0)
+    lam: Optional[float] = _range(None, minimum=0)
+    error_quality: Optional[str] = None
+    error_r2: Optional[float] = None
+    t_hit: Optional[float] = _range(None, minimum=0)
+    t_miss: Optional[float] = _range(None, minimum=0)
+    perf_quality: Optional[str] = None
+    periods: list[int] = _range(minimum=1, factory=list)
+    errors: list[float] = _range(minimum=0, factory=list)
+    hit_rates: list[float] = _range(minimum=0, maximum=1, factory=list)
+    psnrs: list[float] = field(default_factory=list)
+    error_fit: dict = field(default_factory=dict)
+    perf_fit: dict = field(default_factory=dict)
+    note: Optional[str] = None
+
+
+def _fit_json(fit) -> dict:
+    if fit is None:
+        return {}
+    if dataclasses.is_dataclass(fit):
+        data = {f.name: getattr(fit, f.name) for f in dataclasses.fields(fit)}
+    else:
+        data = {k: v for k, v in vars(fit).items() if not k.startswith("_")}
+    return finite_json(data)
+
+
+def _fit_from_json(cls, data: dict, where: str):
+    if not data:
+        return None
+    try:
+        names = {f.name for f in dataclasses.fields(cls)} if dataclasses.is_dataclass(cls) else set(data)
+        values = {k: (float("nan") if v is None and k not in ("quality", "dropped") else v)
+                  for k, v in data.items() if k in names}
+        return cls(**values)
+    except (TypeError, ValueError) as err:
+        raise RRCacheError(f"cannot read a fitted model ({err})", where, hint=_HINT) from None
+
+
+@dataclass
+class Profile:
+    """A trained profile: the document's fields (see the module docstring) and, outside the
+    document, ``path`` (the folder it was read from or written to).
+
+    ``nodes`` costliest first (the training order, then the skipped nodes); ``selections`` e1..e4;
+    ``algorithm`` the cache algorithm trained and validated with (``algorithm_times``: what
+    ``auto`` measured, each as a fraction of the original's time); ``plan`` the training windows
+    (:mod:`rrcache.profiler.plan`); ``counts`` what the last run computed and skipped;
+    ``run_wall_s``, ``precompute_s`` (every run on the store added up) and ``invocations``.
+    """
+
+    shader: str
+    session: str
+    shader_hash: str
+    session_hash: str
+    settings: TrainingSettings
+    algorithm: str
+    nodes: list[NodeProfile]
+    defines: dict[str, str] = field(default_factory=dict)
+    algorithm_times: dict[str, float] = _range(minimum=0, factory=dict)
+    plan: Optional[dict] = None
+    untrained: list[str] = field(default_factory=list)
+    budget_stopped: bool = False
+    mu: Optional[float] = _range(None, minimum=0, maximum=1)
+    mu_quality: Optional[str] = None
+    hit_fit: dict = field(default_factory=dict)
+    overhead_ms: Optional[float] = _range(None, minimum=0)
+    original_ms: Optional[float] = _range(None, minimum=0)
+    pixels: float = _range(0.0, minimum=0)
+    training_wall_s: Optional[float] = _range(None, minimum=0)
+    counts: dict[str, int] = _range(minimum=0, factory=dict)
+    selections: list[Selection] = field(default_factory=list)
+    plots: list[str] = field(default_factory=list)
+    run_wall_s: Optional[float] = _range(None, minimum=0)
+    precompute_s: Optional[float] = _range(None, minimum=0)
+    invocations: int = _range(0, minimum=0)
+    #: the measured ceiling (:class:`rrcache.profiler.ceiling.Ceiling` as JSON; :attr:`measured_ceiling`)
+    ceiling: Optional[dict] = None
+    #: when the ceiling stopped the profile before training: ``choice`` ("original"), ``ceiling``,
+    #: ``min_gain``, ``answer``, ``reason``, ``changes``
+    verdict: Optional[dict] = None
+    #: the relative noise of the original's repeated timing-run times (1.4826 × MAD / median, the
+    #: median over the timing frames) and whether it was low enough to rely on (≤ 10%)
+    timing_noise: Optional[float] = _range(None, minimum=0)
+    timing_reliable: bool = True
+    path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
+
+    def __post_init__(self):
+        self._table = None
+
+    @property
+    def _where(self) -> str:
+        return str(self.path / JSON_NAME) if self.path is not None else JSON_NAME
+
+    # ------------------------------------------------------------------ models
+    @property
+    def trained_nodes(self) -> list[NodeProfile]:
+        return [n for n in self.nodes if n.trained]
+
+    def node(self, node_id: str) -> NodeProfile:
+        for n in self.nodes:
+            if n.id == node_id:
+                return n
+        raise RRCacheError(f"no node '{node_id}' in this profile", self._where,
+                           hint="the profile lists its nodes in profile.json")
+
+    def texts(self) -> dict[str, str]:
+        """Node id → expression text."""
+        return {n.id: n.text for n in self.nodes}
+
+    def fits(self):
+        """``(error_fits, perf_fits, hit_fit)`` rebuilt as :mod:`rrcache.model` objects (trained
+        nodes only, in the order of :attr:`trained_nodes`)."""
+        from rrcache.model import ErrorFit, HitRateFit, PerfFit
+
+        trained = self.trained_nodes
+        index = {n.id: i for i, n in enumerate(self.nodes)}
+        errors = [_fit_from_json(ErrorFit, n.error_fit, f"{self._where}: nodes[{index[n.id]}].error_fit")
+                  for n in trained]
+        perfs = [_fit_from_json(PerfFit, n.perf_fit, f"{self._where}: nodes[{index[n.id]}].perf_fit")
+                 for n in trained]
+        return errors, perfs, _fit_from_json(HitRateFit, self.hit_fit, f"{self._where}: hit_fit")
+
+    @property
+    def measured_ceiling(self):
+        """The measured :class:`~rrcache.profiler.ceiling.Ceiling` (None when not measured)."""
+        from rrcache.profiler.ceiling import Ceiling
+
+        return Ceiling.from_json(self.ceiling)
+
+    @property
+    def table(self):
+        """The ``rrcache.model.ModelTable`` of the trained nodes (built once)."""
+        if self._table is None:
+            from rrcache.model import ModelTable
+
+            errors, perfs, hit = self.fits()
+            if self.verdict is not None:
+                raise RRCacheError(f"no node was trained: {self.verdict['answer']}", self._where,
+                                   hint="; ".join(self.verdict["changes"]))
+            if hit is None or not errors:
+                raise RRCacheError("this profile has no trained node", self._where,
+                                   hint="run 'rrcache profile' with a larger --budget")
+            self._table = ModelTable.from_fits([n.id for n in self.trained_nodes], errors, perfs, hit,
+                                               self.pixels, self.original_ms)
+        return self._table
+
+    def select(self, max_error: float) -> Selection:
+        """The choice predicted fastest with error ≤ ``max_error``, from the models only: a
+        :class:`~rrcache.selection.Selection` with this profile's algorithm and the node's
+        expression (no part: the original shader).
+
+        >>> choice = load_profile("marble-marble.rrprofile").select(0.01)   # doctest: +SKIP
+        """
+        from rrcache.model import select as model_select
+
+        try:
+            level = float(max_error)
+        except (TypeError, ValueError):
+            level = float("nan")
+        if not math.isfinite(level) or level < 0:
+            raise RRCacheError(f"{max_error!r} is not an error threshold", "--max-error",
+                               hint="give a mean RGB L2 error >= 0, e.g. 0.01 (profile.json lists the e1..e4 levels)")
+        if self.verdict is not None:  # the ceiling answered before training: the original
+            return Selection.original(float(self.original_ms), algorithm=self.algorithm, max_error=level)
+        return self.adopt(model_select(self.table, level), max_error=level)
+
+    def threshold_selections(self, labels=LABELS) -> list[Selection]:
+        """The labelled choices at the profile's levels (``settings.levels``), predicted only:
+        ``psnr`` (the default): predicted PSNR ≥ 45, 40, 35, 30 dB against the original
+        (:data:`rrcache.model.psnr.DEFAULT_LEVELS_DB`; :meth:`select_psnr`); ``relative``: the
+        paper's ε1…ε4, error thresholds spread over the errors seen (:func:`rrcache.model.thresholds`)."""
+        from rrcache.model import select as model_select, thresholds
+        from rrcache.model.psnr import DEFAULT_LEVELS_DB
+
+        if self.settings.levels == "psnr":
+            return [self.select_psnr(db).replace(label=label) for label, db in zip(labels, DEFAULT_LEVELS_DB)]
+        levels = [float(t) for t in thresholds(self.table, len(labels))]
+        return [self.adopt(model_select(self.table, level), label=label, max_error=level)
+                for label, level in zip(labels, levels)]
+
+    def psnr_fits(self) -> list:
+        """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
+        training runs), in the order of :attr:`trained_nodes`."""
+        from rrcache.model.psnr import fit_psnr
+
+        return [fit_psnr(n.errors, n.psnrs) for n in self.trained_nodes]
+
+    def select_psnr(self, min_psnr: float) -> Selection:
+        """The choice predicted fastest whose predicted PSNR against the original is ≥
+        ``min_psnr`` dB (:func:`rrcache.model.psnr.select_min_psnr`), from the models only; its
+        ``max_error`` is the largest error its node may have at that PSNR."""
+        from rrcache.model.psnr import select_min_psnr
+
+        try:
+            level = float(min_psnr)
+        except (TypeError, ValueError):
+            level = float("nan")
+        if not math.isfinite(level):
+            raise RRCacheError(f"{min_psnr!r} is not a PSNR", "--min-psnr", hint="give decibels, e.g. 40")
+        if self.verdict is not None:
+            return Selection.original(float(self.original_ms), algorithm=self.algorithm, min_psnr=level,
+                                      max_error=0.0, exact=True, predicted_psnr=math.inf,
+                                      predicted_psnr_uncertainty=0.0)
+        fits = self.psnr_fits()
+        choice = select_min_psnr(self.table, fits, level)
+        bound = 0.0
+        if choice.parts:
+            bound = max(fits[self.table.node_ids.index(choice.node)].max_error(level), 0.0)
+        return self.adopt(choice, min_psnr=level, max_error=bound)
+
+    def adopt(self, choice: Selection, **changes) -> Selection:
+        """``choice`` (from the models) as this profile runs it: its algorithm, the nodes'
+        expressions, the predictions' uncertainty (:meth:`predictions`) and ``changes`` (label,
+        max_error …)."""
+        chosen = choice.with_texts(self.texts()).replace(algorithm=self.algorithm, **changes)
+        return chosen.replace(**self.predictions(chosen))
+
+    def predictions(self, choice: Selection) -> dict:
+        """The predicted PSNR of ``choice`` with its uncertainty (the node's PSNR fit residual),
+        the predicted speed-up's range (the node's performance fit residual on the predicted
+        frame time), ``exact`` and ``visible_artifacts`` (predicted PSNR below 30 dB)."""
+        from rrcache.model.psnr import VISIBLE_DB, predicted_psnr
+
+        if not choice.parts or not choice.predicted_error > 0:
+            return {"predicted_psnr": math.inf, "predicted_psnr_uncertainty": 0.0, "exact": True,
+                    "visible_artifacts": False,
+                    "predicted_speedup_range": (choice.predicted_speedup, choice.predicted_speedup)}
+        trained = [n.id for n in self.trained_nodes]
+        i = trained.index(choice.node)
+        value, spread = predicted_psnr(self.psnr_fits()[i], choice.predicted_error)
+        rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
+        ms = float(choice.predicted_ms)
+        lo = self.original_ms / (ms + rms) if ms + rms > 0 else math.inf
+        hi = self.original_ms / (ms - rms) if ms - rms > 0 else math.inf
+        return {"predicted_psnr": value, "predicted_psnr_uncertainty": spread, "exact": False,
+                "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": (lo, hi)}
+
+    def front_candidates(self, choice: Selection) -> list[Selection]:
+        """The options that could stand in for ``choice`` at its level when it measures slower
+        than the original: the predicted Pareto front's points admissible at the level (error ≤
+        ``max_error``, or predicted PSNR ≥ ``min_psnr``) and predicted faster than the original,
+        fastest first, ``choice`` itself left out."""
+        from rrcache.model import pareto_front
+
+        fits = self.psnr_fits() if choice.min_psnr is not None else None
+        ids = [n.id for n in self.trained_nodes]
+        out = []
+        for point in pareto_front(self.table):
+            if point.node is None or not point.predicted_ms < self.original_ms or point.period < 2:
+                continue
+            if fits is not None:
+                ok = fits[ids.index(point.node)].predict(point.predicted_error) >= choice.min_psnr
+            else:
+                ok = point.predicted_error <= (choice.max_error or 0.0)
+            if not ok:
+                continue
+            option = self.table.option(ids.index(point.node) * self.table.max_period + point.period - 1)
+            if option.key == choice.key:
+                continue
+            out.append(self.adopt(option, label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr))
+        return sorted(out, key=lambda s: s.predicted_ms)
+
+    def write_variant(self, choice: Selection, out_dir) -> list[str]:
+        """Write the shader files of ``choice`` into ``out_dir``: the variant's passes and
+        ``manifest.json`` (recording the period it runs with); for the original shader only a
+        ``manifest.json`` saying so. The shader is loaded again and must still have the profiled
+        hash."""
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        if not choice.parts:
+            note = (self.verdict["answer"] if self.verdict is not None else
+                    choice.fallback or "no cached variant is predicted to beat the original at this error")
+            path = out / "manifest.json"
+            path.write_text(json.dumps({"rrcache_selection": 1, "node": None, "shader": self.shader,
+                                        "note": note}, indent=2) + "\n")
+            return [str(path)]
+        from rrcache.pipeline import load_for_session, variant_for_selection
+        from rrcache.session import load_session
+
+        work = load_for_session(self.shader, load_session(self.session), self.defines)
+        if work.shader.hash != self.shader_hash:
+            raise RRCacheError("the shader changed since it was profiled", str(self.shader),
+                               hint="run 'rrcache profile' again")
+        variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
+        return variant.write(out, period=period, runtime=self.settings.cache_options())
+
+    # ------------------------------------------------------------------ the document
+    def to_json(self) -> dict:
+        """The document (JSON-able; non-finite numbers become null)."""
+        return {"rrcache_profile": PROFILE_VERSION, **finite_json(_to_json(self))}
+
+    def write(self, folder=None) -> Path:
+        """Write ``profile.json`` into ``folder`` (default :attr:`path`), atomically."""
+        out = Path(folder) if folder is not None else self.path
+        if out is None:
+            raise ValueError("Profile.write needs a folder")
+        out.mkdir(parents=True, exist_ok=True)
+        self.path = out
+        target = out / JSON_NAME
+        tmp = out / (JSON_NAME + ".tmp")
+        tmp.write_text(json.dumps(self.to_json(), indent=2) + "\n", encoding="utf-8")
+        os.replace(tmp, target)
+        return target
+
+    @classmethod
+    def from_json(cls, data: Any, file: str = JSON_NAME) -> "Profile":
+        """The profile of a document; :class:`RRCacheError` ``<file>: <key path>: <what is
+        wrong>`` for anything the declared shape does not allow."""
+        if not isinstance(data, dict) or "rrcache_profile" not in data:
+            raise RRCacheError("not an rrcache profile (no 'rrcache_profile' key)", file,
+                               hint="give the profile.json that 'rrcache profile' wrote")
+        version = data["rrcache_profile"]
+        if version != PROFILE_VERSION:
+            raise RRCacheError(f"profile version {version!r}; this rrcache reads {PROFILE_VERSION}", file,
+                               hint="run 'rrcache profile' again with this rrcache")
+        body = {k: v for k, v in data.items() if k != "rrcache_profile"}
+        return _read_dataclass(cls, body, "", file)
+
+    def __repr__(self) -> str:
+        ms = f"original {self.original_ms:.2f} ms" if isinstance(self.original_ms, float) else "no timing"
+        return f"Profile({self.shader!r}, {len(self.trained_nodes)}/{len(self.nodes)} nodes trained, {ms})"
+
+
+# ---------------------------------------------------------------------- the declared shape
+def _document_fields(cls):
+    return [f for f in dataclasses.fields(cls) if f.metadata.get("document", True)]
+
+
+def _to_json(value):
+    if isinstance(value, Selection):
+        return value.to_json()
+    if isinstance(value, TrainingSettings):
+        return value.to_json()
+    if dataclasses.is_dataclass(value):
+        return {f.name: _to_json(getattr(value, f.name)) for f in _document_fields(value)}
+    if isinstance(value, dict):
+        return {k: _to_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_to_json(v) for v in value]
+    return value
+
+
+def _fail(file: str, path: str, message: str) -> RRCacheError:
+    return RRCacheError(message, f"{file}: {path}" if path else file, hint=_HINT)
+
+
+def _bounds(meta) -> str:
+    low, high = meta.get("minimum"), meta.get("maximum")
+    if low is not None and high is not None:
+        return f" in [{low}, {high}]"
+    if low is not None:
+        return f" >= {low}"
+    if high is not None:
+        return f" <= {high}"
+    return ""
+
+
+def _read(value, tp, path: str, file: str, meta):
+    """``value`` checked against the type hint ``tp`` (and the field's range ``meta``)."""
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if origin is typing.Union:
+        inner = [a for a in args if a is not type(None)]
+        if value is None:
+            return None
+        return _read(value, inner[0], path, file, meta)
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise _fail(file, path, "must be true or false")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int) or not _in_range(value, meta):
+            raise _fail(file, path, "must be a whole number" + _bounds(meta))
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                or not _in_range(value, meta):
+            raise _fail(file, path, "must be a finite number" + _bounds(meta))
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise _fail(file, path, "must be a string")
+        return value
+    if tp is dict or origin is dict:
+        if not isinstance(value, dict):
+            raise _fail(file, path, "must be an object")
+        if not args:
+            return dict(value)
+        return {k: _read(v, args[1], f"{path}.{k}", file, meta) for k, v in value.items()}
+    if origin is list:
+        if not isinstance(value, list):
+            raise _fail(file, path, "must be a list")
+        return [_read(v, args[0], f"{path}[{i}]", file, meta) for i, v in enumerate(value)]
+    if tp is TrainingSettings:
+        try:
+            return TrainingSettings.from_json(value, "settings")
+        except RRCacheError as err:  # "settings: block: ..." with the file in front
+            raise RRCacheError(err.message, f"{file}: {path}", hint=err.hint) from None
+    if tp is Selection:
+        return _read_selection(value, path, file)
+    if dataclasses.is_dataclass(tp):
+        return _read_dataclass(tp, value, path, file)
+    raise TypeError(f"no reader for {tp!r}")  # a shape declared with a type this module cannot check
+
+
+def _in_range(value, meta) -> bool:
+    low, high = meta.get("minimum"), meta.get("maximum")
+    return (low is None or value >= low) and (high is None or value <= high)
+
+
+def _read_dataclass(cls, value, path: str, file: str, skip=()):
+    if not isinstance(value, dict):
+        raise _fail(file, path, "must be an object")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in _document_fields(cls) if f.name not in skip}
+    unknown = sorted(set(value) - set(fields) - set(skip))
+    if unknown:
+        raise _fail(file, f"{path}.{unknown[0]}" if path else unknown[0], "unknown key")
+    kwargs = {}
+    for name, f in fields.items():
+        at = f"{path}.{name}" if path else name
+        if name not in value:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise _fail(file, at, "is missing")
+            continue
+        kwargs[name] = _read(value[name], hints[name], at, file, f.metadata)
+    return cls(**kwargs)
+
+
+_SELECTION_RANGES = {"predicted_error": (0, None), "predicted_ms": (0, None), "predicted_speedup": (0, None),
+                     "max_error": (0, None), "measured_error": (0, None), "measured_ms": (0, None),
+                     "measured_original_ms": (0, None), "measured_speedup": (0, None), "hit_rate": (0, 1),
+                     "frames": (0, None), "predicted_psnr_uncertainty": (0, None), "measured_noise": (0, None)}
+
+
+#: the selection's tuple fields (lists of numbers in the document)
+_TUPLES = ("speedups", "predicted_speedup_range")
+
+
+def _read_selection(value, path: str, file: str) -> Selection:
+    if not isinstance(value, dict):
+        raise _fail(file, path, "must be an object")
+    try:
+        parts = parts_from_json(value.get("parts", []), f"{path}.parts")
+    except RRCacheError as err:
+        raise RRCacheError(err.message, f"{file}: {err.where}", hint=_HINT) from None
+    hints = typing.get_type_hints(Selection)
+    names = {f.name for f in dataclasses.fields(Selection)}
+    unknown = sorted(set(value) - names)
+    if unknown:
+        raise _fail(file, f"{path}.{unknown[0]}", "unknown key")
+    kwargs = {"parts": parts}
+    for name in names - {"parts"}:
+        if name not in value:
+            continue
+        low, high = _SELECTION_RANGES.get(name, (None, None))
+        hint = hints[name]
+        if name in _TUPLES:
+            hint = list[float]
+        read = _read(value[name], hint, f"{path}.{name}", file, {"minimum": low, "maximum": high})
+        kwargs[name] = tuple(read) if name in _TUPLES else read
+    return Selection(**kwargs)
+
+
+# ---------------------------------------------------------------------- reading
+def algorithm_line(prof: Profile) -> str:
+    """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
+    0.377, three-pass 0.41 of the original's time)'."""
+    times = prof.algorithm_times or {}
+    if prof.settings.algorithm != "auto" or not times:
+        return prof.algorithm
+    measured = ", ".join(f"{name} {value:.3f}" for name, value in sorted(times.items(), key=lambda kv: kv[1]))
+    return f"{prof.algorithm} (auto: {measured} of the original's time)"
+
+
+def load_profile(path) -> Profile:
+    """The profile in folder ``path`` (or the ``profile.json`` file itself), checked against the
+    declared shape (see the module docstring).
+
+    >>> p = load_profile("marble-marble.rrprofile")    # doctest: +SKIP
+    """
+    path = Path(path)
+    file = path / JSON_NAME if path.is_dir() else path
+    if not file.exists():
+        raise RRCacheError("no profile here", str(file), hint="give the folder 'rrcache profile' wrote (--out)")
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"), parse_constant=_no_constant)
+    except (OSError, UnicodeDecodeError, ValueError) as err:
+        raise RRCacheError(f"cannot read the profile ({err})", str(file), hint="run 'rrcache profile' again") from None
+    prof = Profile.from_json(data, str(file))
+    prof.path = file.parent
+    return prof
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def select(profile_or_path, max_error: float) -> Selection:
+    """``rrcache.select(profile, max_error)``: the choice for a :class:`Profile` or a profile path.
+
+    >>> rrcache.select("marble-marble.rrprofile", 0.02).period    # doctest: +SKIP
+    35
+    """
+    prof = profile_or_path if isinstance(profile_or_path, Profile) else load_profile(profile_or_path)
+    return prof.select(max_error)

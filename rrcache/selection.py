@@ -1,0 +1,237 @@
+"""The selection record: what a profile chooses to cache, with its predicted and measured figures.
+
+One :class:`Selection` travels the whole way unchanged in kind: the models choose it
+(:func:`rrcache.model.select`), the profile store keeps its measurement
+(:mod:`rrcache.profiles.store`), ``profile.json`` holds it (:mod:`rrcache.profiles.document`), the
+report and the notebooks show it and the bench measures it again. Each stage only fills in what
+it knows: the model the predicted figures, the profile the label, the threshold, the algorithm
+and the node's expression text, the validation (or the bench) the measured figures.
+
+*What* is chosen is a tuple of **parts**, each a small frozen dataclass tagged by its ``KIND``:
+no part is the original shader; one :class:`CachedNode` is today's choice (one node cached,
+refreshed every ``period`` frames). A new kind of choice (an amortized loop with its (m, λ),
+several nodes each with its own period) is a new part class registered in :data:`PART_KINDS`
+(its JSON and its validation come with it); the store, the document, the report and the bench
+carry it without change, and :func:`rrcache.pipeline.variant_for_selection` is where a kind
+becomes a compiled variant.
+
+>>> s = Selection((CachedNode("n12", 16),), predicted_error=0.01, predicted_ms=2.0, predicted_speedup=1.5)
+>>> s.kind, s.node, s.period, s.key
+('cache', 'n12', 16, (('cache', 'n12', 16),))
+>>> Selection.original(4.0).kind, Selection.original(4.0).node
+('original', None)
+>>> parts_from_json(parts_to_json(s.parts), "parts") == s.parts
+True
+>>> parts_from_json([{"kind": "cache", "node": "n1", "period": 0}], "selections[2].parts")
+Traceback (most recent call last):
+    ...
+rrcache.errors.RRCacheError: selections[2].parts[0].period: must be a whole number >= 1
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar, Optional
+
+from rrcache.errors import RRCacheError
+
+
+@dataclass(frozen=True)
+class CachedNode:
+    """Part ``cache``: the value of node ``node`` (an id such as ``n42``) held in the
+    reprojection cache and recomputed every ``period`` frames (Δn ≥ 1). ``text`` is the node's
+    expression, for people (left out of :attr:`key` and of equality)."""
+
+    KIND: ClassVar[str] = "cache"
+
+    node: str
+    period: int
+    text: Optional[str] = field(default=None, compare=False)
+
+    def key(self) -> tuple:
+        return (self.KIND, self.node, int(self.period))
+
+    def describe(self) -> str:
+        return f"{self.node} Δn={self.period}"
+
+    @classmethod
+    def from_json(cls, data: dict, where: str) -> "CachedNode":
+        _only(data, ("kind", "node", "period", "text"), where)
+        node = data.get("node")
+        if not isinstance(node, str) or not node:
+            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
+        period = data.get("period")
+        if isinstance(period, bool) or not isinstance(period, int) or period < 1:
+            raise RRCacheError("must be a whole number >= 1", f"{where}.period")
+        text = data.get("text")
+        if text is not None and not isinstance(text, str):
+            raise RRCacheError("must be a string or null", f"{where}.text")
+        return cls(node, period, text)
+
+
+#: part kind -> part class: the one place a new kind of choice is declared
+PART_KINDS: dict[str, type] = {CachedNode.KIND: CachedNode}
+
+
+def _only(data: dict, keys: tuple, where: str) -> None:
+    unknown = sorted(set(data) - set(keys))
+    if unknown:
+        raise RRCacheError(f"unknown key {unknown[0]!r} (known: {', '.join(keys)})", where)
+
+
+def parts_to_json(parts) -> list:
+    """The parts as JSON objects, each with its ``kind`` first."""
+    return [{"kind": p.KIND, **dataclasses.asdict(p)} for p in parts]
+
+
+def parts_from_json(data, where: str) -> tuple:
+    """The parts of :func:`parts_to_json`'s list; RRCacheError naming ``where[i]`` and the key
+    for anything else."""
+    if not isinstance(data, list):
+        raise RRCacheError("must be a list of parts", where)
+    out = []
+    for i, item in enumerate(data):
+        at = f"{where}[{i}]"
+        if not isinstance(item, dict):
+            raise RRCacheError("must be an object with a 'kind'", at)
+        cls = PART_KINDS.get(item.get("kind"))
+        if cls is None:
+            raise RRCacheError(f"unknown kind {item.get('kind')!r} (known: {', '.join(PART_KINDS)})", f"{at}.kind")
+        out.append(cls.from_json(item, at))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class Selection:
+    """A choice of what to cache and its figures (see the module docstring).
+
+    - ``parts``: what is cached (empty: the original shader).
+    - ``predicted_error`` (mean RGB L2), ``predicted_ms`` (per frame), ``predicted_speedup``
+      (the original's ms / ``predicted_ms``): from the models.
+    - ``label`` (``e1`` … ``e4``), ``max_error`` (the threshold it was selected at),
+      ``algorithm`` (the cache algorithm it runs with): set by the profile.
+    - ``measured_*``, ``hit_rate``, ``frames`` (rendered frames), ``speedups`` (one per
+      side-by-side repeat): set by a measurement beside the original; None until then.
+    - ``files``: the folder of its shader files, relative to the profile folder.
+    - ``min_psnr``, ``predicted_psnr`` (± ``predicted_psnr_uncertainty``),
+      ``predicted_speedup_range``, ``measured_noise``, ``exact``, ``visible_artifacts``,
+      ``fallback``: the PSNR level, the predictions' uncertainty and what validation found
+      (see the field comments).
+    """
+
+    parts: tuple = ()
+    predicted_error: float = 0.0
+    predicted_ms: float = math.nan
+    predicted_speedup: float = 1.0
+    label: Optional[str] = None
+    max_error: Optional[float] = None
+    algorithm: Optional[str] = None
+    measured_error: Optional[float] = None
+    measured_psnr: Optional[float] = None
+    measured_ms: Optional[float] = None
+    measured_original_ms: Optional[float] = None
+    measured_speedup: Optional[float] = None
+    hit_rate: Optional[float] = None
+    frames: int = 0
+    speedups: tuple = ()
+    files: Optional[str] = None
+    #: the PSNR level (dB) it was selected at (None: selected at ``max_error``)
+    min_psnr: Optional[float] = None
+    #: the PSNR predicted from the error (:mod:`rrcache.model.psnr`) and its ± uncertainty (dB)
+    predicted_psnr: Optional[float] = None
+    predicted_psnr_uncertainty: Optional[float] = None
+    #: the predicted speed-up's range from the performance fits' residuals (low, high)
+    predicted_speedup_range: tuple = ()
+    #: the relative noise of the original's frame times while it was measured
+    measured_noise: Optional[float] = None
+    #: the image is the original's (nothing cached, or every pixel recomputed): PSNR ∞
+    exact: bool = False
+    #: below 30 dB (measured, else predicted): a choice with visible artifacts
+    visible_artifacts: bool = False
+    #: why this selection stands instead of the models' first choice (a measured slowdown)
+    fallback: Optional[str] = None
+
+    @classmethod
+    def original(cls, original_ms: float, **kw) -> "Selection":
+        """The original shader: error 0, speed-up 1."""
+        return cls((), 0.0, float(original_ms), 1.0, **kw)
+
+    @property
+    def kind(self) -> str:
+        """``original`` (no part), the part's kind for one part, else the kinds joined by ``+``."""
+        if not self.parts:
+            return "original"
+        return "+".join(p.KIND for p in self.parts)
+
+    @property
+    def key(self) -> tuple:
+        """What is cached, comparable across stages (the parts without their texts)."""
+        return tuple(p.key() for p in self.parts)
+
+    @property
+    def measured(self) -> bool:
+        """Whether the measured figures are filled in."""
+        return self.measured_error is not None
+
+    def _single(self) -> Optional[CachedNode]:
+        if not self.parts:
+            return None
+        if len(self.parts) == 1 and isinstance(self.parts[0], CachedNode):
+            return self.parts[0]
+        raise RRCacheError(f"a selection of kind {self.kind!r} has no single node and period", "selection",
+                           hint="read its parts")
+
+    @property
+    def node(self) -> Optional[str]:
+        """The cached node's id (kind ``cache``); None for the original shader."""
+        part = self._single()
+        return part.node if part is not None else None
+
+    @property
+    def period(self) -> Optional[int]:
+        """The cached node's refresh period Δn (kind ``cache``); None for the original shader."""
+        part = self._single()
+        return int(part.period) if part is not None else None
+
+    @property
+    def text(self) -> Optional[str]:
+        """The cached node's expression (kind ``cache``, when known); None for the original."""
+        part = self._single()
+        return part.text if part is not None else None
+
+    def describe(self) -> str:
+        """``n12 Δn=16``, or ``the original shader``."""
+        return ", ".join(p.describe() for p in self.parts) if self.parts else "the original shader"
+
+    def with_texts(self, texts: dict) -> "Selection":
+        """This selection with each part's ``text`` looked up in ``texts`` (node id → expression)."""
+        parts = tuple(dataclasses.replace(p, text=texts.get(p.node, p.text)) if hasattr(p, "node") else p
+                      for p in self.parts)
+        return dataclasses.replace(self, parts=parts)
+
+    def with_measurement(self, measured_error: float, measured_psnr: float, measured_ms: float,
+                         measured_original_ms: float, measured_speedup: float, hit_rate: float, frames: int,
+                         speedups=()) -> "Selection":
+        """This selection with its measured figures."""
+        return dataclasses.replace(self, measured_error=measured_error, measured_psnr=measured_psnr,
+                                   measured_ms=measured_ms, measured_original_ms=measured_original_ms,
+                                   measured_speedup=measured_speedup, hit_rate=hit_rate, frames=int(frames),
+                                   speedups=tuple(speedups))
+
+    def replace(self, **changes) -> "Selection":
+        return dataclasses.replace(self, **changes)
+
+    def to_json(self) -> dict:
+        """The record as JSON (parts as :func:`parts_to_json`; tuples as lists). The reader, with
+        its checks, is :mod:`rrcache.profiles.document`'s."""
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        out["parts"] = parts_to_json(self.parts)
+        out["speedups"] = list(self.speedups)
+        out["predicted_speedup_range"] = list(self.predicted_speedup_range)
+        return out
+
+    @property
+    def speedup_range(self) -> tuple:
+        """(lowest, highest) measured speed-up of the repeats (empty when not measured)."""
+        return (min(self.speedups), max(self.speedups)) if self.speedups else ()
