@@ -109,7 +109,9 @@ def test_select_json_and_out(full, tmp_path):
     out = folder / "out"
     proc = rrcache("select", out, "--max-error", "1e9", "--json")
     choice = json.loads(proc.stdout)
-    assert set(choice) == {"node", "period", "predicted_error", "predicted_ms", "predicted_speedup"}
+    assert set(choice) == {"node", "period", "predicted_error", "predicted_ms", "predicted_speedup",
+                           "predicted_speedup_range", "predicted_psnr", "predicted_psnr_uncertainty", "exact",
+                           "visible_artifacts"}
     data = json.loads((out / "profile.json").read_text())
     if choice["node"] is not None:
         assert choice["node"] in {n["id"] for n in data["nodes"]} and 1 <= choice["period"] <= 50

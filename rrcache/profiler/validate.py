@@ -32,7 +32,6 @@ A choice already measured in the store (a resumed run) is not rendered again.
 """
 from __future__ import annotations
 
-import math
 import statistics
 from typing import Callable, Optional
 
@@ -68,11 +67,13 @@ def _range_text(sel: Selection) -> str:
 
 def validate(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore, choices: list[Selection],
              progress: Optional[ProgressFn] = None, window=None,
-             candidates: Optional[Callable[[Selection], list[Selection]]] = None) -> list[Selection]:
+             candidates: Optional[Callable[[Selection], list[Selection]]] = None,
+             fallback: bool = True) -> list[Selection]:
     """Measure each of ``choices`` (labelled selections with their algorithm) beside the original
-    inside ``window`` when given, falling back along ``candidates(choice)`` when one measures
-    slower than the original beyond the noise (see the module docstring); store every
-    measurement and return the selections that stand, in order."""
+    inside ``window`` when given, falling back along ``candidates(choice)`` (then to the
+    original) when one measures slower than the original beyond the noise (see the module
+    docstring; ``fallback=False`` keeps every choice as measured); store every measurement and
+    return the selections that stand, in order."""
     frames = list(range(settings.validation_frames))
     short = frames[:max(2, min(SHORT_FRAMES, len(frames)))]
     # measurements already stored (a resumed run) are reused, keyed by what is cached
@@ -87,7 +88,8 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
             return choice.with_measurement(m.measured_error, m.measured_psnr, m.measured_ms, m.measured_original_ms,
                                            m.measured_speedup, m.hit_rate, m.frames,
                                            m.speedups or (m.measured_speedup,)).replace(
-                measured_noise=m.measured_noise, exact=m.exact or m.measured_error == 0.0)
+                measured_noise=m.measured_noise, exact=m.exact or m.measured_error == 0.0,
+                measured_psnr=None if m.measured_error == 0.0 else m.measured_psnr)
         variant, period = variant_for_selection(work, choice)
         if choice.key not in todo:  # a fallback candidate: more work than planned
             state["total"] += 2 * per
@@ -105,12 +107,12 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
         first = runs[0]
         speedups = tuple(r.speedup for r in runs)
         exact = first.mean_error == 0.0
-        psnr = math.inf if exact else min(first.psnr, PSNR_CAP)
+        psnr = None if exact else min(first.psnr, PSNR_CAP)  # exact: PSNR ∞, kept as null
         sel = choice.with_measurement(first.mean_error, psnr, statistics.median(r.ms_per_frame for r in runs),
                                       statistics.median(r.original_ms_per_frame for r in runs),
                                       float(statistics.median(speedups)), first.hit_rate, len(first.frames), speedups)
         sel = sel.replace(measured_noise=max(frame_noise([f.original_ms for f in r.frames[1:]]) for r in runs),
-                          exact=exact, visible_artifacts=bool(not exact and psnr < VISIBLE_DB))
+                          exact=exact, visible_artifacts=bool(psnr is not None and psnr < VISIBLE_DB))
         measured[choice.key] = sel
         return sel
 
@@ -123,7 +125,7 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
             sel = measure(choice)
             rejected: list[Selection] = []
             pool = list(candidates(choice)) if candidates is not None else []
-            while sel.parts and slower_beyond_noise(sel.speedups or (sel.measured_speedup,)):
+            while fallback and sel.parts and slower_beyond_noise(sel.speedups or (sel.measured_speedup,)):
                 rejected.append(sel)
                 rejected_count += 1
                 # every measurement is kept in the store (the rejected ones under their own label)
@@ -148,8 +150,8 @@ def _original(choice: Selection) -> Selection:
     original = choice if not choice.parts else base.replace(
         label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr, algorithm=choice.algorithm,
         predicted_ms=choice.predicted_ms * choice.predicted_speedup)
-    return original.with_measurement(0.0, math.inf, float(original.predicted_ms), float(original.predicted_ms),
-                                     1.0, 0.0, 0).replace(exact=True, predicted_psnr=float("inf"),
+    return original.with_measurement(0.0, None, float(original.predicted_ms), float(original.predicted_ms),
+                                     1.0, 0.0, 0).replace(exact=True, predicted_psnr=None,
                                                           predicted_psnr_uncertainty=0.0, visible_artifacts=False,
                                                           predicted_error=0.0, predicted_speedup=1.0,
                                                           predicted_speedup_range=(1.0, 1.0))

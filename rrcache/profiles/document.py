@@ -270,8 +270,7 @@ class Profile:
             raise RRCacheError(f"{min_psnr!r} is not a PSNR", "--min-psnr", hint="give decibels, e.g. 40")
         if self.verdict is not None:
             return Selection.original(float(self.original_ms), algorithm=self.algorithm, min_psnr=level,
-                                      max_error=0.0, exact=True, predicted_psnr=math.inf,
-                                      predicted_psnr_uncertainty=0.0)
+                                      max_error=0.0, exact=True, predicted_psnr_uncertainty=0.0)
         fits = self.psnr_fits()
         choice = select_min_psnr(self.table, fits, level)
         bound = 0.0
@@ -289,11 +288,12 @@ class Profile:
     def predictions(self, choice: Selection) -> dict:
         """The predicted PSNR of ``choice`` with its uncertainty (the node's PSNR fit residual),
         the predicted speed-up's range (the node's performance fit residual on the predicted
-        frame time), ``exact`` and ``visible_artifacts`` (predicted PSNR below 30 dB)."""
+        frame time), ``exact`` (the original's image: PSNR ∞, kept as null) and ``visible_artifacts``
+        (predicted PSNR below 30 dB)."""
         from rrcache.model.psnr import VISIBLE_DB, predicted_psnr
 
-        if not choice.parts or not choice.predicted_error > 0:
-            return {"predicted_psnr": math.inf, "predicted_psnr_uncertainty": 0.0, "exact": True,
+        if not choice.parts or not choice.predicted_error > 0:  # exact: PSNR ∞ (null in JSON)
+            return {"predicted_psnr": None, "predicted_psnr_uncertainty": 0.0, "exact": True,
                     "visible_artifacts": False,
                     "predicted_speedup_range": (choice.predicted_speedup, choice.predicted_speedup)}
         trained = [n.id for n in self.trained_nodes]
