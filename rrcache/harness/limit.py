@@ -48,6 +48,15 @@ class AllHitLimit:
         return statistics.median(self.original_ms) if self.original_ms else float("nan")
 
     @property
+    def fastest_limit_ms(self) -> float:
+        """The fastest probe frame's all-hit time (other work on the machine only adds time)."""
+        return min(self.cached_ms) if self.cached_ms else float("nan")
+
+    @property
+    def fastest_original_ms(self) -> float:
+        return min(self.samples) if self.samples else float("nan")
+
+    @property
     def covered_pixels(self) -> float:
         return statistics.mean(self.covered) if self.covered else 0.0
 

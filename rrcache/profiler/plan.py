@@ -67,7 +67,7 @@ class Plan:
     #: as a fraction of the original's
     algorithm: Optional[str] = None
     algorithm_times: Optional[dict] = None
-    #: the measured ceiling (:class:`rrcache.profiler.ceiling.Ceiling` as JSON), once measured
+    #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON), once measured
     ceiling: Optional[dict] = None
 
     def to_json(self) -> dict:

@@ -54,7 +54,8 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
-from rrcache.profiler.ceiling import Ceiling, measure_ceiling
+from rrcache.model.ceiling import Ceiling
+from rrcache.profiler.ceiling import measure_ceiling
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                    shader_inputs, signature)
 from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
@@ -271,11 +272,15 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     need_refs = any(todo_error.values())
     need_ref_timing = not store.reference_timing()
     need_overhead = store.overhead() is None
-    plan_total = ((len(train_frames) if need_refs else 0) + (len(timing) if need_ref_timing else 0)
-                  + sum(len(v) * len(train_frames) for v in todo_error.values())
-                  + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
-                  + (len(timing) if need_overhead else 0))
-    meter = _Meter(progress, plan_total)
+
+    def training_total() -> int:
+        return ((len(train_frames) if need_refs else 0)
+                + sum(len(v) * len(train_frames) for v in todo_error.values())
+                + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
+                + (len(timing) if need_overhead else 0))
+
+    # the training is planned once the ceiling has said whether it happens, and for which nodes
+    meter = _Meter(progress, len(timing) if need_ref_timing else 0)
     budget_stopped = False
     notes = dict(order.skipped)
 
@@ -324,12 +329,13 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             pruned = _prune(work, order, ceiling, settings)
             for nid, why in pruned.items():
                 notes[nid] = why
-                meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing),
-                             "ceiling", f"{len(pruned)} nodes cannot pay")
                 todo_error[nid], todo_timing[nid] = [], []
             order.nodes = [n for n in order.nodes if n.id not in pruned]
             order.skipped.update(pruned)
             ids = [n.id for n in order.nodes]
+            if pruned and progress is not None:
+                progress(ProgressEvent("ceiling", meter.done, meter.total, f"{len(pruned)} nodes cannot pay"))
+        meter.grow(training_total())
         if plan.algorithm is None:
             if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
                 meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
@@ -379,6 +385,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                         frames = _timing_run(cached, timed_original, nid, period, timing, meter)
                         store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
                         compile_s = 0.0
+            _plan_within_budget(meter, store, settings, order.nodes, node, todo_error, todo_timing,
+                                len(train_frames), len(timing))
     finally:
         if original is not None:
             original.release()
@@ -399,6 +407,26 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     result.wall_s = clock() - start
     result.spent_s = store.spent_s()
     return result
+
+
+def _plan_within_budget(meter: _Meter, store: ProfileStore, settings: TrainingSettings, nodes, last, todo_error,
+                        todo_timing, n_frames: int, n_timing: int) -> None:
+    """After each trained node, plan only the nodes the budget is expected to reach (at the mean
+    seconds per node stored so far), so that the progress's total and ETA are those of the run
+    that will happen, not of every node in the order."""
+    done_nodes = sum(1 for n in nodes if _node_complete(store, n.id, settings))
+    spent = store.spent_s()
+    if not done_nodes or spent <= 0:
+        return
+    per_node_s = spent / done_nodes
+    index = [n.id for n in nodes].index(last.id)
+    rest = [n.id for n in nodes[index + 1:] if todo_error[n.id] or todo_timing[n.id]]
+    fit = max(0, int((settings.budget_s - spent) / per_node_s) + 1) if per_node_s > 0 else len(rest)
+    per_node = len(settings.periods) * n_frames + len(settings.timing_periods) * 3 * n_timing
+    planned = sum(len(todo_error[n]) * n_frames + len(todo_timing[n]) * 3 * n_timing for n in rest)
+    expected = min(len(rest), fit) * per_node
+    tail = n_timing if store.overhead() is None else 0  # the overhead measurement still to come
+    meter.total = max(meter.done, meter.done + min(planned, expected) + tail)
 
 
 def _skipped_ids(work: ShaderWork, order: TrainingOrder) -> list[str]:

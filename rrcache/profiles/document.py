@@ -144,7 +144,7 @@ class Profile:
     run_wall_s: Optional[float] = _range(None, minimum=0)
     precompute_s: Optional[float] = _range(None, minimum=0)
     invocations: int = _range(0, minimum=0)
-    #: the measured ceiling (:class:`rrcache.profiler.ceiling.Ceiling` as JSON; :attr:`measured_ceiling`)
+    #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON; :attr:`measured_ceiling`)
     ceiling: Optional[dict] = None
     #: when the ceiling stopped the profile before training: ``choice`` ("original"), ``ceiling``,
     #: ``min_gain``, ``answer``, ``reason``, ``changes``
@@ -193,8 +193,8 @@ class Profile:
 
     @property
     def measured_ceiling(self):
-        """The measured :class:`~rrcache.profiler.ceiling.Ceiling` (None when not measured)."""
-        from rrcache.profiler.ceiling import Ceiling
+        """The measured :class:`~rrcache.model.ceiling.Ceiling` (None when not measured)."""
+        from rrcache.model.ceiling import Ceiling
 
         return Ceiling.from_json(self.ceiling)
 
