@@ -151,10 +151,18 @@ def _verdict(prof, console: Console) -> None:
     console.print(f"answer: {v['answer']}", highlight=False)
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
+    _ceiling_noise(ceiling, console)
     console.print(f"why: {v['reason']}", highlight=False)
     console.print("what would change it:", highlight=False)
     for change in v["changes"]:
         console.print(f"  - {change}", highlight=False)
+
+
+def _ceiling_noise(ceiling, console: Console) -> None:
+    if ceiling is not None and ceiling.noise > UNRELIABLE_NOISE:
+        console.print(f"warning: the original's repeated frames varied by ±{ceiling.noise:.0%} while the ceiling was "
+                      "measured: other work on the machine made it unreliable; profile again on a quieter machine "
+                      "(the profile folder keeps it: use --fresh)", highlight=False)
 
 
 def _summary(prof, console: Console) -> None:
@@ -164,10 +172,14 @@ def _summary(prof, console: Console) -> None:
     c = prof.counts
     trained = len(prof.trained_nodes)
     console.print(f"profile: {prof.path}", highlight=False)
-    cheap = sum(1 for n in prof.nodes if not n.trained and n.note and "static cost" in n.note)
+    pruned = sum(1 for n in prof.nodes if not n.trained and n.note and "best case" in n.note)
+    cheap = sum(1 for n in prof.nodes if not n.trained and n.note and "static cost" in n.note
+                and "best case" not in n.note)
     late = sum(1 for n in prof.nodes if not n.trained and n.note and "budget" in n.note)
     console.print(f"nodes trained: {trained} of {len(prof.nodes)}; {cheap} too cheap to win (static cost under "
-                  f"{prof.settings.min_saving:.0%} of the costliest), {late} not reached within the budget", highlight=False)
+                  f"{prof.settings.min_saving:.0%} of the costliest), {pruned} whose best case under the measured "
+                  f"ceiling is below {prof.settings.min_gain:.2f}×, {late} not reached within the budget",
+                  highlight=False)
     console.print(f"runs: {c.get('error_runs_computed', 0)} error and {c.get('timing_runs_computed', 0)} timing runs "
                   f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
                   "runs were stored and skipped", highlight=False)
@@ -178,6 +190,7 @@ def _summary(prof, console: Console) -> None:
     ceiling = prof.measured_ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
+        _ceiling_noise(ceiling, console)
     noise = prof.timing_noise
     if noise is not None and not prof.timing_reliable:
         console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "

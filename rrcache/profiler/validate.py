@@ -4,16 +4,18 @@ never a measured slowdown shipped.
 After training, :func:`validate` takes the labelled selections of the profile
 (:meth:`rrcache.profiles.Profile.threshold_selections`: by default predicted PSNR ≥ 45, 40, 35,
 30 dB) and measures each with :func:`rrcache.harness.cached.compare`, side by side with the
-original at the session's full resolution, alternating frame by frame (main paper §4.4, Fig. 6),
-in the settings' timing format (:mod:`rrcache.gl.formats`). Shaders timed in a window
-(:mod:`rrcache.profiler.plan`) are validated in the same window.
+original at the session's full resolution, alternating frame by frame (main paper §4.4, Fig. 6).
+Shaders timed in a window (:mod:`rrcache.profiler.plan`) are validated in the same window.
 
-**Repeats.** A selection is measured :data:`REPEATS` times: once over ``validation_frames``
-consecutive frames (its error, PSNR, hit rate and a speed-up), then over the first
-:data:`SHORT_FRAMES` of them for each further speed-up (the refresh schedule makes the hit/miss
-mix steady from the second frame on). The measured speed-up is the median of the repeats,
-``speedups`` keeps each, ``measured_noise`` the noisiest run's frame-to-frame noise of the
-original (:func:`rrcache.harness.timing.frame_noise`).
+**Error and repeats.** A selection's error, PSNR and hit rate are measured over
+``validation_frames`` consecutive frames drawn exactly (``rgba32f``, as the error runs the
+models were trained on: an 8-bit target would add its own rounding to the error); its speed-up
+:data:`REPEATS` times in the settings' timing format (:mod:`rrcache.gl.formats`, ``rgba8`` by
+default, as applications draw), each over :data:`SHORT_FRAMES` consecutive frames, the stretches
+spread over the validation frames (the refresh schedule makes the hit/miss mix steady from a
+stretch's second frame on). The measured speed-up is the median of the repeats, ``speedups``
+keeps each, ``measured_noise`` the noisiest run's frame-to-frame noise of the original
+(:func:`rrcache.harness.timing.frame_noise`).
 
 **Never a measured slowdown.** A selection is *slower than the original beyond the noise* when
 every repeat measured it slower (the highest repeat < 1.0). Then the next candidate on the
@@ -35,6 +37,7 @@ from __future__ import annotations
 import statistics
 from typing import Callable, Optional
 
+from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.harness.cached import compare
 from rrcache.harness.timing import frame_noise
 from rrcache.model.psnr import VISIBLE_DB
@@ -79,7 +82,7 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
     # measurements already stored (a resumed run) are reused, keyed by what is cached
     measured = {row.key: row for row in store.validations() if row.parts}
     todo = {c.key for c in choices if c.parts} - set(measured)
-    per = len(frames) + (REPEATS - 1) * len(short)
+    per = len(frames) + REPEATS * len(short)
     state = {"done": 0, "total": 2 * per * len(todo)}
 
     def measure(choice: Selection) -> Selection:
@@ -93,24 +96,32 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
         variant, period = variant_for_selection(work, choice)
         if choice.key not in todo:  # a fallback candidate: more work than planned
             state["total"] += 2 * per
+
+        def step(*_, detail=""):
+            state["done"] += 2
+            if progress is not None:
+                progress(ProgressEvent("validate", state["done"], state["total"], detail))
+
+        common = dict(period=period, window=window, **settings.cache_options())
+        # the error over every validation frame, drawn exactly (rgba32f) as the error runs are
+        exact_run = compare(variant, session, work.prepared, frames, color_format=ERROR_FORMAT,
+                            on_frame=lambda *a: step(detail=f"{choice.label}: {choice.describe()} error"), **common)
+        # the speed-up in the timing format, REPEATS times over stretches spread over the frames
         runs = []
         for repeat in range(REPEATS):
-
-            def step(*_, detail=f"{choice.label}: {choice.describe()} [{repeat + 1}/{REPEATS}]"):
-                state["done"] += 2
-                if progress is not None:
-                    progress(ProgressEvent("validate", state["done"], state["total"], detail))
-
-            runs.append(compare(variant, session, work.prepared, frames if repeat == 0 else short, period=period,
-                                on_frame=step, window=window, color_format=settings.timing_format,
-                                **settings.cache_options()))
-        first = runs[0]
+            start = (len(frames) - len(short)) * repeat // max(1, REPEATS - 1)
+            stretch = frames[start:start + len(short)]
+            runs.append(compare(variant, session, work.prepared, stretch, color_format=settings.timing_format,
+                                on_frame=lambda *a, r=repeat: step(
+                                    detail=f"{choice.label}: {choice.describe()} timing [{r + 1}/{REPEATS}]"),
+                                **common))
         speedups = tuple(r.speedup for r in runs)
-        exact = first.mean_error == 0.0
-        psnr = None if exact else min(first.psnr, PSNR_CAP)  # exact: PSNR ∞, kept as null
-        sel = choice.with_measurement(first.mean_error, psnr, statistics.median(r.ms_per_frame for r in runs),
+        exact = exact_run.mean_error == 0.0
+        psnr = None if exact else min(exact_run.psnr, PSNR_CAP)  # exact: PSNR ∞, kept as null
+        sel = choice.with_measurement(exact_run.mean_error, psnr, statistics.median(r.ms_per_frame for r in runs),
                                       statistics.median(r.original_ms_per_frame for r in runs),
-                                      float(statistics.median(speedups)), first.hit_rate, len(first.frames), speedups)
+                                      float(statistics.median(speedups)), exact_run.hit_rate, len(exact_run.frames),
+                                      speedups)
         sel = sel.replace(measured_noise=max(frame_noise([f.original_ms for f in r.frames[1:]]) for r in runs),
                           exact=exact, visible_artifacts=bool(psnr is not None and psnr < VISIBLE_DB))
         measured[choice.key] = sel
