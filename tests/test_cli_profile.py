@@ -102,6 +102,16 @@ def test_profile_end_to_end(full):
             assert list((out / "optimized" / sel["label"]).glob("*.frag"))
     assert f"nodes trained: {len(data['nodes'])} of {len(data['nodes'])}" in proc.stdout
     assert "selections" in proc.stdout and "μ =" in proc.stdout
+    # every selection is stored as validated (the original ones too), and counted after validation
+    assert data["counts"]["validations"] >= 4
+    # default levels: predicted PSNR >= 45, 40, 35, 30 dB; the original's image is exact, never "100.0"
+    assert [s["min_psnr"] for s in data["selections"]] == [45.0, 40.0, 35.0, 30.0]
+    for sel in data["selections"]:
+        if not sel["parts"]:
+            assert sel["exact"] and sel["measured_psnr"] is None and sel["measured_speedup"] == 1.0
+    if any(not s["parts"] for s in data["selections"]):
+        assert "∞ (exact)" in proc.stdout
+    assert data["ceiling"] is not None and data["verdict"] is None  # --min-gain 0: measured, never stops
 
 
 def test_select_json_and_out(full, tmp_path):
@@ -115,6 +125,11 @@ def test_select_json_and_out(full, tmp_path):
     data = json.loads((out / "profile.json").read_text())
     if choice["node"] is not None:
         assert choice["node"] in {n["id"] for n in data["nodes"]} and 1 <= choice["period"] <= 50
+    by_psnr = json.loads(rrcache("select", out, "--min-psnr", "40", "--json").stdout)
+    assert by_psnr["node"] is None or by_psnr["predicted_psnr"] >= 40 - 1e-9
+    assert by_psnr["exact"] == (by_psnr["node"] is None or by_psnr["predicted_error"] == 0)
+    both = rrcache("select", out, "--min-psnr", "40", "--max-error", "0.1", check=False)
+    assert both.returncode == 2 and "one of --max-error and --min-psnr" in both.stderr
     strict = json.loads(rrcache("select", out / "profile.json", "--max-error", "0", "--json").stdout)
     assert strict["predicted_error"] <= 1e-12 and strict["predicted_ms"] >= choice["predicted_ms"]
     written = rrcache("select", out, "--max-error", "1e9", "--out", tmp_path / "opt")
