@@ -102,9 +102,16 @@ def parts_from_json(data, where: str) -> tuple:
     return tuple(out)
 
 
+def _at_least(default, minimum=0):
+    """A field whose value (when a number) must be >= ``minimum``: the range
+    :mod:`rrcache.profiles.document` checks when it reads the record."""
+    return field(default=default, metadata={"minimum": minimum})
+
+
 @dataclass(frozen=True)
 class Selection:
-    """A choice of what to cache and its figures (see the module docstring).
+    """A choice of what to cache and its figures (see the module docstring). Each field's type
+    and range (its metadata) are the record's declared shape in ``profile.json``.
 
     - ``parts``: what is cached (empty: the original shader).
     - ``predicted_error`` (mean RGB L2), ``predicted_ms`` (per frame), ``predicted_speedup``
@@ -120,31 +127,31 @@ class Selection:
       (see the field comments).
     """
 
-    parts: tuple = ()
-    predicted_error: float = 0.0
-    predicted_ms: float = math.nan
-    predicted_speedup: float = 1.0
+    parts: tuple = field(default=(), metadata={"parts": True})
+    predicted_error: float = _at_least(0.0)
+    predicted_ms: float = _at_least(math.nan)
+    predicted_speedup: float = _at_least(1.0)
     label: Optional[str] = None
-    max_error: Optional[float] = None
+    max_error: Optional[float] = _at_least(None)
     algorithm: Optional[str] = None
-    measured_error: Optional[float] = None
+    measured_error: Optional[float] = _at_least(None)
     measured_psnr: Optional[float] = None
-    measured_ms: Optional[float] = None
-    measured_original_ms: Optional[float] = None
-    measured_speedup: Optional[float] = None
-    hit_rate: Optional[float] = None
-    frames: int = 0
-    speedups: tuple = ()
+    measured_ms: Optional[float] = _at_least(None)
+    measured_original_ms: Optional[float] = _at_least(None)
+    measured_speedup: Optional[float] = _at_least(None)
+    hit_rate: Optional[float] = field(default=None, metadata={"minimum": 0, "maximum": 1})
+    frames: int = _at_least(0)
+    speedups: tuple[float, ...] = field(default=(), metadata={"minimum": 0})
     files: Optional[str] = None
     #: the PSNR level (dB) it was selected at (None: selected at ``max_error``)
     min_psnr: Optional[float] = None
     #: the PSNR predicted from the error (:mod:`rrcache.model.psnr`) and its ± uncertainty (dB)
     predicted_psnr: Optional[float] = None
-    predicted_psnr_uncertainty: Optional[float] = None
+    predicted_psnr_uncertainty: Optional[float] = _at_least(None)
     #: the predicted speed-up's range from the performance fits' residuals (low, high)
-    predicted_speedup_range: tuple = ()
+    predicted_speedup_range: tuple[float, ...] = field(default=(), metadata={"minimum": 0})
     #: the relative noise of the original's frame times while it was measured
-    measured_noise: Optional[float] = None
+    measured_noise: Optional[float] = _at_least(None)
     #: the image is the original's (nothing cached, or every pixel recomputed): PSNR ∞
     exact: bool = False
     #: below 30 dB (measured, else predicted): a choice with visible artifacts

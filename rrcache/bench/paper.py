@@ -393,8 +393,8 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
         originals += [r.original_ms for r in result.equal_time[1:]]
     else:
-        result.notes.append(f"the {medium.label} selection measured {medium.measured_speedup:.2f}×, no faster than the "
-                            "original: no equal-time comparison")
+        result.notes.append(f"the {medium.label} selection measured {medium.measured_speedup:.2f}×, no faster than "
+                            "the original: no equal-time comparison")
     result.original_ms = float(statistics.median(originals)) if originals else _original_ms(work, session, frames)
     result.wall_s = time.time() - started
     return result

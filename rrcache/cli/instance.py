@@ -16,7 +16,8 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 @click.command("instance")
 @click.argument("shader", type=click.Path(dir_okay=False))
 @click.option("--node", required=True, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True,
+              help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)

@@ -37,8 +37,8 @@ from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, render
-from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH,
-                             FILTERS, REFRESH_MODES)
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD,
+                             DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 
 
@@ -54,10 +54,11 @@ from rrcache.session import load_session
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
+@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True,
+              help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
-@click.option("--block", type=click.Choice([str(b) for b in BLOCK_SIZES]), default=str(DEFAULT_BLOCK), show_default=True,
-              help="Refresh block size k (pixels).")
+@click.option("--block", type=click.Choice([str(b) for b in BLOCK_SIZES]), default=str(DEFAULT_BLOCK),
+              show_default=True, help="Refresh block size k (pixels).")
 @click.option("--refresh", type=click.Choice(REFRESH_MODES), default=DEFAULT_REFRESH, show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
               help="Payload reconstruction filter.")

@@ -57,10 +57,10 @@ from rrcache.pipeline import ShaderWork, variant_for
 from rrcache.model.ceiling import Ceiling
 from rrcache.profiler.ceiling import measure_ceiling
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
-                                   shader_inputs, signature)
+                                    shader_inputs, signature)
 from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
-                                  coverage_map,
-                                  fraction_for, place_window)
+                                   coverage_map,
+                                   fraction_for, place_window)
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
 

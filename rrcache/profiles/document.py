@@ -301,10 +301,11 @@ class Profile:
         value, spread = predicted_psnr(self.psnr_fits()[i], choice.predicted_error)
         rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
         ms = float(choice.predicted_ms)
-        lo = self.original_ms / (ms + rms) if ms + rms > 0 else math.inf
-        hi = self.original_ms / (ms - rms) if ms - rms > 0 else math.inf
-        return {"predicted_psnr": value, "predicted_psnr_uncertainty": spread, "exact": False,
-                "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": (lo, hi)}
+        # no range when the residual reaches the predicted time itself (no finite upper bound)
+        span = (self.original_ms / (ms + rms), self.original_ms / (ms - rms)) if ms - rms > 0 else ()
+        return {"predicted_psnr": value if math.isfinite(value) else None,
+                "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
+                "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
 
     def front_candidates(self, choice: Selection) -> list[Selection]:
         """The options that could stand in for ``choice`` at its level when it measures slower
@@ -457,17 +458,16 @@ def _read(value, tp, path: str, file: str, meta):
         if not args:
             return dict(value)
         return {k: _read(v, args[1], f"{path}.{k}", file, meta) for k, v in value.items()}
-    if origin is list:
+    if origin is list or origin is tuple:
         if not isinstance(value, list):
             raise _fail(file, path, "must be a list")
-        return [_read(v, args[0], f"{path}[{i}]", file, meta) for i, v in enumerate(value)]
+        items = [_read(v, args[0], f"{path}[{i}]", file, meta) for i, v in enumerate(value)]
+        return items if origin is list else tuple(items)
     if tp is TrainingSettings:
         try:
             return TrainingSettings.from_json(value, "settings")
         except RRCacheError as err:  # "settings: block: ..." with the file in front
             raise RRCacheError(err.message, f"{file}: {path}", hint=err.hint) from None
-    if tp is Selection:
-        return _read_selection(value, path, file)
     if dataclasses.is_dataclass(tp):
         return _read_dataclass(tp, value, path, file)
     raise TypeError(f"no reader for {tp!r}")  # a shape declared with a type this module cannot check
@@ -493,43 +493,14 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 raise _fail(file, at, "is missing")
             continue
+        if f.metadata.get("parts"):  # the tagged parts of a Selection (rrcache.selection)
+            try:
+                kwargs[name] = parts_from_json(value[name], at)
+            except RRCacheError as err:
+                raise _fail(file, err.where, err.message) from None
+            continue
         kwargs[name] = _read(value[name], hints[name], at, file, f.metadata)
     return cls(**kwargs)
-
-
-_SELECTION_RANGES = {"predicted_error": (0, None), "predicted_ms": (0, None), "predicted_speedup": (0, None),
-                     "max_error": (0, None), "measured_error": (0, None), "measured_ms": (0, None),
-                     "measured_original_ms": (0, None), "measured_speedup": (0, None), "hit_rate": (0, 1),
-                     "frames": (0, None), "predicted_psnr_uncertainty": (0, None), "measured_noise": (0, None)}
-
-
-#: the selection's tuple fields (lists of numbers in the document)
-_TUPLES = ("speedups", "predicted_speedup_range")
-
-
-def _read_selection(value, path: str, file: str) -> Selection:
-    if not isinstance(value, dict):
-        raise _fail(file, path, "must be an object")
-    try:
-        parts = parts_from_json(value.get("parts", []), f"{path}.parts")
-    except RRCacheError as err:
-        raise RRCacheError(err.message, f"{file}: {err.where}", hint=_HINT) from None
-    hints = typing.get_type_hints(Selection)
-    names = {f.name for f in dataclasses.fields(Selection)}
-    unknown = sorted(set(value) - names)
-    if unknown:
-        raise _fail(file, f"{path}.{unknown[0]}", "unknown key")
-    kwargs = {"parts": parts}
-    for name in names - {"parts"}:
-        if name not in value:
-            continue
-        low, high = _SELECTION_RANGES.get(name, (None, None))
-        hint = hints[name]
-        if name in _TUPLES:
-            hint = list[float]
-        read = _read(value[name], hint, f"{path}.{name}", file, {"minimum": low, "maximum": high})
-        kwargs[name] = tuple(read) if name in _TUPLES else read
-    return Selection(**kwargs)
 
 
 # ---------------------------------------------------------------------- reading
