@@ -3,9 +3,11 @@
 The public API; the CLI and the notebooks use nothing else.
 
 >>> import rrcache
->>> shader = rrcache.load_shader("shaders/marble.glsl")          # doctest: +SKIP
->>> session = rrcache.load_session("sessions/marble.json")       # doctest: +SKIP
->>> result = rrcache.render(shader, session, frames=[0, 1])       # doctest: +SKIP
+>>> shader = rrcache.load_shader("shaders/glslviewer_basic.glsl")
+>>> session = rrcache.load_session("sessions/marble.json")
+>>> result = rrcache.render(shader, session, frames=[0, 1], resolution=(64, 48))
+>>> [f.index for f in result.frames], result.frames[1].image.shape
+([0, 1], (48, 64, 4))
 
 Names are imported lazily so that ``import rrcache`` stays cheap.
 """

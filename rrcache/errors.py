@@ -7,7 +7,21 @@ what to do. ``str(err)`` is the one-line message the CLI prints, in the usual
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
+
+
+def printable(text: str) -> str:
+    """``text`` with control characters (NUL, escape, newline...) and lone surrogates escaped as ``\\x00``
+    or ``\\ud800``: an error message never carries raw bytes of a file to the terminal.
+
+    >>> printable("a\\x00b\\udc80")
+    'a\\\\x00b\\\\udc80'
+    """
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}" if ord(m.group()) < 0x100
+                        else f"\\u{ord(m.group()):04x}", text)
 
 
 @dataclass(frozen=True)

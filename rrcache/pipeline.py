@@ -12,11 +12,18 @@ The refresh period is not part of a variant: the same compiled passes run at any
 given to the runtime (:class:`rrcache.runtime.CacheRuntime`, ``period=``) and recorded in the
 manifest when the variant is written (:meth:`rrcache.compiler.Variant.write`, ``period=``).
 
->>> work = load_for_session("shaders/marble.glsl", load_session("sessions/marble.json"))  # doctest: +SKIP
->>> variant = variant_for(work, "n2575", "two-pass")                                     # doctest: +SKIP
+>>> from rrcache.session import load_session
+>>> work = load_for_session("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"))
+>>> work.defines
+{'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TANGENT': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
+>>> node = max(work.table.nodes, key=lambda n: n.cost)
+>>> variant = variant_for(work, node.id, "two-pass")
+>>> variant.algorithm, sorted(variant.passes)
+('two-pass', ['hit', 'miss'])
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Mapping, Optional
@@ -26,8 +33,8 @@ from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 from rrcache.compiler import Variant, instance
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
-from rrcache.harness.prepare import PreparedShader, load_for_meshes, prepare
-from rrcache.selection import CachedNode, Selection
+from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
+from rrcache.selection import AmortizedLoop, CachedNode, Selection
 
 
 @dataclass
@@ -38,10 +45,19 @@ class ShaderWork:
     shader: Shader
     table: object
     defines: dict
+    #: the user's vertex shader (``UserVertex``), or None when the harness generates it
+    vertex: object = None
+    #: the command line's include folders (absolute; the session's own are in the session)
+    include_dirs: tuple = ()
 
     @cached_property
     def prepared(self) -> PreparedShader:
-        return prepare(self.shader, self.defines)
+        return prepare(self.shader, self.defines, self.vertex)
+
+    @property
+    def hash(self) -> str:
+        """The fragment shader's hash, covering the user's vertex shader too when there is one."""
+        return combined_hash(self.shader.hash, self.vertex)
 
     def node(self, node_id: str):
         """The table entry (listed or excluded) with this id; an unknown id raises the analysis'
@@ -56,18 +72,28 @@ class ShaderWork:
 
 
 def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, str]] = None,
-                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS) -> ShaderWork:
+                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None) -> ShaderWork:
     """Load and analyse ``shader_path`` (loops of at most ``max_unroll`` iterations unrolled);
     with a ``session`` its meshes' attributes set the ``MODEL_VERTEX_*`` defines (``defines``
-    win over them)."""
-    shader, all_defines = load_for_meshes(shader_path, session, defines, include_dirs)
-    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines)
+    win over them). Includes are looked up next to the including file, then in ``include_dirs``
+    (``-I``), then in the session's ``"include_dirs"``. ``vertex`` is the path of the user's
+    vertex shader (None: the session's ``"vertex"``, else a generated one)."""
+    dirs = all_include_dirs(include_dirs, session)
+    shader, all_defines = load_for_meshes(shader_path, session, defines, dirs)
+    user = load_user_vertex(vertex, session, all_defines, dirs)
+    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user,
+                      tuple(os.path.abspath(d) for d in include_dirs or ()))
+
+
+def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
+    """The command line's ``-I`` folders, then the session's ``"include_dirs"``."""
+    return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
 def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",
                 payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``)."""
-    return instance(work.table, node_id, algorithm, filter, payload_dtype)
+    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex)
 
 
 def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:
@@ -78,5 +104,15 @@ def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Varia
     if len(selection.parts) == 1 and isinstance(selection.parts[0], CachedNode):
         part = selection.parts[0]
         return variant_for(work, part.node, algorithm), int(part.period)
+    if len(selection.parts) == 1 and isinstance(selection.parts[0], AmortizedLoop):
+        from rrcache.compiler.amortize import instance_amortized
+        from rrcache.runtime.cache import DEFAULT_PERIOD
+
+        part = selection.parts[0]
+        variant = instance_amortized(work.shader, part.estimator, algorithm, samples=part.samples,
+                                     blend=part.blend, phase=part.phase, history=part.history,
+                                     vertex=work.vertex)
+        # an amortized variant does not use the refresh rule: the period is the runtime's default
+        return variant, DEFAULT_PERIOD
     raise RRCacheError(f"no variant for a selection of kind {selection.kind!r}", "selection",
                        hint="the original shader needs none; other kinds are compiled where they are added")

@@ -9,7 +9,8 @@ and the node's expression text, the validation (or the bench) the measured figur
 
 *What* is chosen is a tuple of **parts**, each a small frozen dataclass tagged by its ``KIND``:
 no part is the original shader; one :class:`CachedNode` is today's choice (one node cached,
-refreshed every ``period`` frames). A new kind of choice (an amortized loop with its (m, λ),
+refreshed every ``period`` frames); one :class:`AmortizedLoop` an estimator's samples spread over
+frames (m of N per frame, blend λ). A new kind of choice (an amortized loop with its (m, λ),
 several nodes each with its own period) is a new part class registered in :data:`PART_KINDS`
 (its JSON and its validation come with it); the store, the document, the report and the bench
 carry it without change, and :func:`rrcache.pipeline.variant_for_selection` is where a kind
@@ -70,8 +71,59 @@ class CachedNode:
         return cls(node, period, text)
 
 
+@dataclass(frozen=True)
+class AmortizedLoop:
+    """Part ``amortize``: estimator ``estimator`` (a loop id such as ``e1``, see
+    :mod:`rrcache.analysis.estimators`) evaluated at ``samples`` (m) of its iterations per frame
+    where the cache hits, blended with the reprojected estimate by ``blend`` (λ in [0, 1));
+    ``history`` ``blend`` or ``slots`` and ``phase`` ``frame`` or ``pixel`` as in
+    :func:`rrcache.compiler.amortize.instance_amortized`. ``text`` is the loop, for people.
+
+    >>> AmortizedLoop("e1", 4, 0.6).describe()
+    'e1 m=4 λ=0.6'
+    """
+
+    KIND: ClassVar[str] = "amortize"
+
+    estimator: str
+    samples: int
+    blend: float
+    history: str = "blend"
+    phase: str = "frame"
+    text: Optional[str] = field(default=None, compare=False)
+
+    def key(self) -> tuple:
+        return (self.KIND, self.estimator, int(self.samples), float(self.blend), self.history, self.phase)
+
+    def describe(self) -> str:
+        extra = "" if (self.history, self.phase) == ("blend", "frame") else f" {self.history}/{self.phase}"
+        return f"{self.estimator} m={self.samples} λ={self.blend:g}{extra}"
+
+    @classmethod
+    def from_json(cls, data: dict, where: str) -> "AmortizedLoop":
+        _only(data, ("kind", "estimator", "samples", "blend", "history", "phase", "text"), where)
+        estimator = data.get("estimator")
+        if not isinstance(estimator, str) or not estimator:
+            raise RRCacheError("must be an estimator id (a string such as 'e1')", f"{where}.estimator")
+        samples = data.get("samples")
+        if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+            raise RRCacheError("must be a whole number >= 1", f"{where}.samples")
+        blend = data.get("blend")
+        if isinstance(blend, bool) or not isinstance(blend, (int, float)) or not 0.0 <= blend < 1.0:
+            raise RRCacheError("must be a number in [0, 1)", f"{where}.blend")
+        history, phase = data.get("history", "blend"), data.get("phase", "frame")
+        if history not in ("blend", "slots"):
+            raise RRCacheError("must be 'blend' or 'slots'", f"{where}.history")
+        if phase not in ("frame", "pixel"):
+            raise RRCacheError("must be 'frame' or 'pixel'", f"{where}.phase")
+        text = data.get("text")
+        if text is not None and not isinstance(text, str):
+            raise RRCacheError("must be a string or null", f"{where}.text")
+        return cls(estimator, samples, float(blend), history, phase, text)
+
+
 #: part kind -> part class: the one place a new kind of choice is declared
-PART_KINDS: dict[str, type] = {CachedNode.KIND: CachedNode}
+PART_KINDS: dict[str, type] = {CachedNode.KIND: CachedNode, AmortizedLoop.KIND: AmortizedLoop}
 
 
 def _only(data: dict, keys: tuple, where: str) -> None:

@@ -145,7 +145,7 @@ WIDTH = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
 
 
 def test_a_node_inside_a_replaced_node_is_subsumed(scene):
-    from rrcache.analysis._tree import walk
+    from rrcache.glsl.ast import walk
 
     work, _ = scene
     nodes = [n for n in work.table.nodes if not n.final]

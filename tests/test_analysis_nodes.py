@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -46,15 +45,22 @@ def test_each_reason_on_a_small_shader():
     assert reason_of(t, "int(v_uv.x * 4.0)") == "type"
     assert reason_of(t, "v_uv.y > 0.5") == "type"
     assert reason_of(t, "sin(u_k) * 2.0") == "uniform"
-    assert reason_of(t, "fwidth(v_uv.x * 3.0) + pow(v_uv.y, 3.0)") == "derivative"
+    # a value computed with fwidth() is not excluded: only one-pass cannot cache it
+    assert reason_of(t, "fwidth(v_uv.x * 3.0) + pow(v_uv.y, 3.0)") == "cheap"
     assert reason_of(t, "v_uv.x * 3.0") == "derivative"                  # inside fwidth()
     assert reason_of(t, "exp(v_uv.x * float(i))") == "dynamic"           # run-time loop
     assert reason_of(t, "log(v_uv.y + 2.0) * exp(v_uv.x)") == "dynamic"  # per-pixel branch
     assert reason_of(t, "v_uv.x") == "cheap"
     assert reason_of(t, "a") == "duplicate"            # a read of a single definition
-    # the colour reads d, computed with fwidth(): derivative through a local variable
-    assert not [n for n in t.nodes if n.final]
-    assert reason_of(t, "vec4(a + b * w + vec3(d + s + float(k)), 1.0)") == "derivative"
+    # the colour reads d, computed with fwidth(): through a local variable, it needs
+    # derivatives, so it is listed for three-pass and two-pass only, with the reason
+    final = [n for n in t.nodes if n.final]
+    assert [n.text for n in final] == ["vec4(a + b * w + vec3(d + s + float(k)), 1.0)"]
+    assert final[0].algorithms == ["three-pass", "two-pass"]
+    assert final[0].invalid["one-pass"].startswith("derivative")
+    assert reason_of(t, "a + b * w") == "listed"
+    assert [n.algorithms for n in t.nodes if n.text == "a + b * w"] == [
+        ["three-pass", "two-pass", "one-pass"]]
     assert set(x.reason for x in t.excluded) <= set(REASONS)
 
 
@@ -85,7 +91,8 @@ def test_code_after_discard_and_early_return_is_not_dynamic():
             if (v_uv.y < 0.1) discard;
             fragColor = vec4(f(v_uv) + exp(v_uv.x) * sin(v_uv.y), 0.0, 0.0, 1.0);
         }""", cheap_below=0)
-    after_return = [n for n in t.nodes if re.fullmatch(r"exp\(_rr_p_\d+\.y\) \* sin.*", n.text)]
+    # the node table shows the expression as written in f(), not the inliner's names
+    after_return = [n for n in t.nodes if re.fullmatch(r"exp\(p\.y\) \* sin.*", n.text)]
     assert len(after_return) == 1 and after_return[0].call_chain == ["f (9:30)"]
     assert reason_of(t, "exp(v_uv.x) * sin(v_uv.y)") == "listed"
     assert reason_of(t, "0.0") in ("dynamic", "uniform")   # the early return's value
@@ -111,23 +118,20 @@ def test_ids_are_stable_and_resolve():
 
 @pytest.fixture(scope="module")
 def marble():
-    start = time.perf_counter()
-    shader = load_shader(MARBLE)
-    table = cacheable_nodes(shader)
-    return table, time.perf_counter() - start
+    # (how long this takes is measured by `rrcache bench-frontend`, not asserted here)
+    return cacheable_nodes(load_shader(MARBLE))
 
 
 def test_marble_has_at_least_100_candidates(marble):
-    table, seconds = marble
+    table = marble
     candidates = len(table.nodes) + table.counts()["cheap"]
     assert candidates >= 100
     assert len(table.nodes) >= 20
     assert [n for n in table.nodes if n.final]
-    assert seconds < 5.0         # the benchmark target is 1 s; a loaded CI machine gets slack
 
 
 def test_marble_has_a_node_per_noise_octave(marble):
-    table, _ = marble
+    table = marble
     octaves = {}
     for n in table.nodes:
         chain = n.call_chain
@@ -143,7 +147,7 @@ def test_marble_has_a_node_per_noise_octave(marble):
 
 
 def test_marble_nodes_inside_the_octave_loop_are_listed(marble):
-    table, _ = marble
-    sums = [n for n in table.nodes if n.text.startswith("_rr_sum_")]
+    table = marble
+    sums = [n for n in table.nodes if n.text.startswith("sum + amplitude * abs(noise(")]
     assert len(sums) == 5                     # the partial sums of the turbulence
     assert sorted(n.cost for n in sums) == [n.cost for n in sums]

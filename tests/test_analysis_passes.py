@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rrcache.analysis import analyse, expand_compound_assignments, inline_calls, unroll_loops
-from rrcache.analysis._tree import walk
+from rrcache.glsl.ast import walk
 from rrcache.errors import UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.frontend import parse_shader
@@ -124,6 +124,56 @@ CASES = {
             if (uv.x < 0.1) discard;
             c.rg *= 2.0; c.b /= 4.0; c += vec4(0.1);
             fragColor = c; }""",
+    # the analysis once rejected its own rewrite of each of these (issue 14, item 4)
+    "shadowed_globals": """
+        vec3 pos = vec3(0.25, 0.5, 0.75);
+        vec2 st = vec2(0.3, 0.6);
+        float height() { return pos.y * 2.0 + uv.x; }
+        vec3 tint(float h) { return vec3(st, h); }
+        void main() { float pos = uv.y; vec3 st = vec3(uv, 0.5);
+                      fragColor = vec4(tint(height()) * 0.5 + st * 0.25 + pos * 0.1, 1.0); }""",
+    "local_named_like_a_builtin": """
+        float edge(float x) { return step(0.5, x) * 0.5 + smoothstep(0.2, 0.8, x) * 0.5; }
+        void main() { float step = 0.25; float smoothstep = uv.y;
+                      fragColor = vec4(edge(uv.x) + step, smoothstep, 0.5, 1.0); }""",
+    "globals_after_main": """
+        float wave(float x);
+        void main() { fragColor = vec4(wave(uv.x), wave(uv.y), 0.5, 1.0); }
+        const float FREQ = 7.0;
+        float g_bias = 0.25;
+        float wave(float x) { return g_bias + 0.5 * sin(x * FREQ); }""",
+    "struct_after_main": """
+        float lit(vec2 p);
+        void main() { fragColor = vec4(lit(uv), lit(uv.yx), 0.5, 1.0); }
+        struct Light { vec2 dir; float k; };
+        const Light SUN = Light(vec2(0.6, 0.8), 0.75);
+        float lit(vec2 p) { Light l = SUN; l.k *= 0.5; return max(dot(p, l.dir), 0.0) * l.k + 0.1; }""",
+    "void_ternary": """
+        vec3 g;
+        void a(float k) { g = vec3(k, 0.2, 0.1); }
+        void b(float k) { g = vec3(0.1, k, 0.2); }
+        void none() { }
+        void main() { g = vec3(0.0); none(); uv.x > 0.5 ? a(uv.y) : b(uv.x);
+                      fragColor = vec4(g, 1.0); }""",
+    "unsigned_wrap": """
+        const uint ALL = -1u;
+        void main() {
+            uint m = -1u; uint h = uint(uv.x * 255.0) + 7u;
+            for (uint i = 0u; i < 3u; i++) { h = h * 747796405u + m; h ^= h >> 13u; }
+            uint n = 0u; for (uint k = 3u; k != ALL; k--) n += k;
+            fragColor = vec4(float(h & 255u) / 255.0, float(n) / 6.0, float(ALL >> 31u), 1.0); }""",
+    "offset_indices": """
+        void main() {
+            vec2 a[5];
+            for (int i = 0; i < 5; i++) a[i] = uv * float(i + 1);
+            vec2 s = vec2(0.0);
+            for (int i = 0; i < 5; i++) {
+                s += a[i - 1 + 1];
+                if (i > 0) s += a[i - 1] * 0.5;
+                if (i < 4) s -= a[i + 1] * 0.25; else s += a[0];
+                s += i > 0 ? a[i - 1] * 0.1 : a[0];
+            }
+            fragColor = vec4(s * 0.1, 0.5, 1.0); }""",
 }
 
 
@@ -203,3 +253,28 @@ def test_expand_compound_assignments():
     text = print_glsl(expand_compound_assignments(parse_shader(src, "t.frag")).unit)
     assert "c.xy = c.xy * 2.0;" in text
     assert "c[i++] += 1.0;" in text      # the target has a side effect: left alone
+
+
+def test_unroll_drops_branches_the_loop_index_decides():
+    shader = parse_shader(HEAD + CASES["offset_indices"], "t.frag")
+    text = print_glsl(analyse(shader).unit)
+    assert "for (" not in text and "if (" not in text and "?" not in text
+    assert "0 - 1]" not in text
+
+
+def test_unroll_keeps_a_loop_whose_copy_would_index_out_of_range():
+    # the guard is not an if this pass decides: a copy would hold a[0 - 1], which does not compile
+    shader = parse_shader(HEAD + """void main() { float a[3] = float[3](uv.x, uv.y, 0.5); float s = 0.0;
+        for (int i = 0; i < 3; i++) { if (i > 0 && a[i - 1] > 0.2) s += a[i]; }
+        fragColor = vec4(s); }""", "t.frag")
+    assert _loops(analyse(shader).unit) == 1
+
+
+def test_inlined_body_keeps_reading_the_global_a_local_shadows():
+    text = print_glsl(analyse(parse_shader(HEAD + CASES["shadowed_globals"], "t.frag")).unit)
+    assert "float pos = " not in text and "= pos.y * 2.0" in text and "vec3(st, " in text
+
+
+def test_void_ternary_becomes_an_if():
+    text = print_glsl(analyse(parse_shader(HEAD + CASES["void_ternary"], "t.frag")).unit)
+    assert "_rr_sel" not in text and "if (uv.x > 0.5)" in text

@@ -320,3 +320,76 @@ def test_errors():
     with pytest.raises(UnsupportedShaderError) as err:
         instance(table, node.id)
     assert "reserved" in str(err.value)
+
+
+# ----------------------------------------------------------------------------- tidy output
+
+
+TIDY = """#version 330
+in vec3 v_objectPosition;
+out vec4 fragColor;
+float hash(vec3 p) { p = fract(p * 0.3183 + 0.1); p *= 17.0; return fract(p.x * p.y * p.z * (p.x + p.y + p.z)); }
+float fbm(vec3 p) {
+    float s = 0.0;
+    float a = 0.5;
+    for (int i = 0; i < 3; i++) { float h = hash(p); s += a * h; p = p * 2.0 + 0.1; a *= 0.5; }
+    return s;
+}
+void main() {
+    float w = fbm(v_objectPosition);
+    fragColor = vec4(vec3(w), 1.0);
+}
+"""
+
+
+def _blocks_are_tidy(text: str) -> list[str]:
+    """The runs of nested braces in ``text``: empty blocks in a statement list and blocks
+    whose only statement is a block."""
+    bad = []
+    for n in A.walk(parse_source(text)):
+        if isinstance(n, A.Compound):
+            bad += [f"empty block at {x.loc}" for x in n.stmts if isinstance(x, A.Compound) and not x.stmts]
+            if len(n.stmts) == 1 and isinstance(n.stmts[0], A.Compound):
+                bad.append(f"block holding only a block at {n.loc}")
+    return bad
+
+
+def test_pruned_passes_have_no_runs_of_nested_braces():
+    # a node deep in nested blocks (fbm inlined, then the second unrolled iteration)
+    table = cacheable_nodes(parse_shader(TIDY, "tidy.frag"))
+    node = [n for n in table.nodes if n.call_chain[-1:] == ["for i=1 (8:5)"]][0]
+    variant = instance(table, node.id, "three-pass")
+    for name, p in variant.passes.items():
+        assert not _blocks_are_tidy(p.fragment), (name, p.fragment)
+    # golden: the reprojection pass keeps nothing of the shader's code, and says so plainly
+    assert _main_text(variant.passes["reproject"].fragment) == """{
+    if (!rr_hit() || rr_refreshNow())
+        discard;
+    rr_outPayload = rr_previous();
+    rr_outInvDepth = gl_FragCoord.w;
+}
+"""
+
+
+def test_tidy_keeps_a_block_a_loop_header_needs():
+    src = """#version 330
+uniform int n; out vec4 c;
+void main() { float s = 0.0; for (int i = 0; i < n; i++) { { int i = 2; s += float(i); } } c = vec4(s); }
+"""
+    text = _pruned(src)
+    assert "for (int i = 0; i < n; i++)\n    {\n        {\n            int i = 2;" in text
+    check(parse_source(text))
+
+
+def test_prune_drops_case_labels_left_at_the_end_of_a_switch():
+    src = """#version 330
+uniform int k; uniform float a; out vec4 c;
+void main() { float x = 0.0; float dead = 0.0;
+    switch (k) { case 0: x = a; break; case 1: dead = 2.0; break; default: dead = 3.0; }
+    c = vec4(x); }
+"""
+    text = _pruned(src)
+    body = text.split("switch (k)", 1)[1]
+    # the driver refuses a label followed by '}' (GLSL: a label precedes a statement)
+    assert "case 0:" in body and "default:" not in body
+    assert not body.split("}")[0].rstrip().endswith(":")

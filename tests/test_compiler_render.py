@@ -135,7 +135,7 @@ def test_discard_before_and_after_the_node(gl_ctx):
         prog.release()
         holes = ((ref[0][..., 3] == 0)).sum()
         assert holes > 48 * 48 // 2
-        t_node = [n for n in table.nodes if n.text.startswith("_rr_valueNoise") and "0.5 *" in n.text]
+        t_node = [n for n in table.nodes if n.text.startswith("valueNoise(") and "0.5 *" in n.text]
         assert t_node, [n.text for n in table.nodes]
         for algorithm in ALGORITHMS:
             variant = instance(table, t_node[0].id, algorithm)

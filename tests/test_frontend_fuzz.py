@@ -6,13 +6,13 @@ Two hypothesis tests, 200 examples each (about a second or two in all):
   junk characters;
 * corpus shaders mutated by deleting, duplicating and swapping tokens.
 
-Nothing but :class:`rrcache.errors.GLSLError` may escape, no example may take more than
-``TIME_BOUND`` seconds, and whatever parses must also survive print → parse unchanged.
+Nothing but :class:`rrcache.errors.GLSLError` may escape, and whatever parses must also survive
+print → parse unchanged. (No example's duration is asserted: the parser's speed is measured by
+``rrcache bench-frontend``.)
 """
 from __future__ import annotations
 
 import re
-import time
 from pathlib import Path
 
 from hypothesis import HealthCheck, given, settings
@@ -22,7 +22,6 @@ from rrcache.errors import GLSLError
 from rrcache.glsl.parser import parse_source
 from rrcache.glsl.printer import print_glsl
 
-TIME_BOUND = 2.0
 CORPUS = sorted((Path(__file__).parent / "glsl" / "corpus").glob("*.frag"))
 SOURCES = [p.read_text() for p in CORPUS]
 
@@ -41,14 +40,11 @@ _TOKEN_RE = re.compile(r"[A-Za-z_][A-Za-z_0-9]*|[0-9.][0-9A-Za-z_.]*|\S")
 
 
 def _check(source: str) -> None:
-    start = time.perf_counter()
     try:
         unit = parse_source(source, "fuzz.frag")
     except GLSLError as err:
         assert err.loc is None or err.loc.line >= 1
         unit = None
-    elapsed = time.perf_counter() - start
-    assert elapsed < TIME_BOUND, f"parse took {elapsed:.2f}s"
     if unit is not None:
         text = print_glsl(unit)
         assert parse_source(text, "printed.frag") == unit, text

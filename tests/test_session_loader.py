@@ -129,7 +129,8 @@ def test_mesh_and_texture_assets_and_hash(tmp_path):
     assert s.objects[0].name == "ball" and s.objects[0].mesh.face_count == 80
     t = s.textures
     assert t["u_albedo"].kind == "2d" and t["u_albedo"].data.shape == (3, 2, 3)
-    assert (t["u_albedo"].filter, t["u_albedo"].wrap) == ("linear", "repeat")
+    # no filter given: mipmapped, as an application sets up a texture sampled with implicit LOD
+    assert (t["u_albedo"].filter, t["u_albedo"].wrap) == ("mipmap", "repeat")
     assert (t["u_data"].filter, t["u_data"].wrap) == ("nearest", "clamp")
     env = t["u_env"]
     assert env.kind == "cube" and env.data.shape == (6, 2, 2, 3) and env.wrap == "clamp"

@@ -79,3 +79,108 @@ def test_failures(tmp_path):
     empty.write_text("v 0 0 0\nv 1 0 0\n")
     with pytest.raises(MeshLoadError, match="no triangles"):
         load_mesh_file(str(empty))
+
+
+# --- the mesh loader's own output never reaches the user unfiltered (issue 14) ------------------
+
+TEXTURED_PLY = """ply
+format ascii 1.0
+comment TextureFile missing_texture.png
+element vertex 3
+property float x
+property float y
+property float z
+property float texture_u
+property float texture_v
+element face 1
+property list uchar int vertex_indices
+end_header
+0 0 0 0 0
+1 0 0 1 0
+0 1 0 0 1
+3 0 1 2
+"""
+
+
+def _garbage_stl(path):
+    # 'solid' then bytes that are neither a binary STL of this size nor UTF-8 text
+    path.write_bytes(b"solid x\n" + bytes(range(128, 256)) * 4)
+    return path
+
+
+def _session(tmp_path, mesh):
+    import json
+
+    doc = {"rrcache_session": 1, "resolution": [8, 8], "frames": 1,
+           "camera": {"keyframes": [{"frame": 0, "eye": [0, 0, 3], "target": [0, 0, 0]}]},
+           "objects": [{"mesh": mesh}]}
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_missing_texture_is_a_note_not_a_traceback(tmp_path, capfd):
+    from rrcache.session import load_session
+
+    (tmp_path / "tri.ply").write_text(TEXTURED_PLY)
+    m = load_mesh_file(str(tmp_path / "tri.ply"))
+    assert m.face_count == 1 and m.texcoords is not None
+    assert len(m.notes) == 1 and "missing_texture.png" in m.notes[0] and "\n" not in m.notes[0]
+    session = load_session(_session(tmp_path, "tri.ply"))
+    assert session.notes == [f"{tmp_path / 'tri.ply'}: {m.notes[0]}"]
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_render_prints_the_note_once(tmp_path):
+    import subprocess
+    import sys
+
+    (tmp_path / "tri.ply").write_text(TEXTURED_PLY)
+    session = _session(tmp_path, "tri.ply")
+    (tmp_path / "s.frag").write_text("#version 330\nout vec4 c;\nvoid main() { c = vec4(1.0); }\n")
+    proc = subprocess.run([sys.executable, "-m", "rrcache", "render", str(tmp_path / "s.frag"), str(session),
+                           "--json"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr and "unable to load image" not in proc.stderr
+    notes = [line for line in proc.stderr.splitlines() if "missing_texture.png" in line]
+    assert len(notes) == 1 and notes[0].startswith("note: ")
+
+
+def test_garbage_stl_is_one_line(tmp_path, capfd):
+    path = _garbage_stl(tmp_path / "bad.stl")
+    with pytest.raises(MeshLoadError) as info:
+        load_mesh_file(str(path))
+    assert "\n" not in str(info.value)
+    out, err = capfd.readouterr()
+    assert "Traceback" not in out + err
+
+
+def test_missing_optional_package_is_named(tmp_path, monkeypatch, capfd):
+    """Without charset-normalizer (an optional dependency of trimesh), a non-UTF-8 STL says which
+    package to install, as an AssetError at the session's mesh."""
+    import sys
+
+    from rrcache.errors import AssetError
+    from rrcache.session import load_session
+
+    monkeypatch.setitem(sys.modules, "charset_normalizer", None)
+    _garbage_stl(tmp_path / "bad.stl")
+    with pytest.raises(AssetError) as info:
+        load_session(_session(tmp_path, "bad.stl"))
+    msg = str(info.value)
+    assert "objects[0].mesh" in msg and "bad.stl" in msg and "pip install charset-normalizer" in msg
+    assert "ModuleNotFoundError" not in msg and "\n" not in msg
+    out, err = capfd.readouterr()
+    assert "Traceback" not in out + err
+
+
+def test_optional_dependencies_are_declared():
+    import pathlib
+    import re
+
+    text = (pathlib.Path(__file__).resolve().parents[1] / "pyproject.toml").read_text()
+    deps = text.split("dependencies = [", 1)[1].split("]", 1)[0]
+    names = {re.split(r"[<>=\[ ;]", line.strip().strip('",'))[0].lower()
+             for line in deps.splitlines() if line.strip().startswith('"')}
+    assert {"trimesh", "charset-normalizer", "pillow"} <= names

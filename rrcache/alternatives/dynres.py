@@ -11,9 +11,13 @@ covers both: clear, scene draws, upsample draw and ``ctx.finish()``.
 measured side by side with the original (:func:`rrcache.alternatives.measure.compare_renderers`)
 and searched by :func:`rrcache.alternatives.search.match_scale`.
 
->>> with DynresRenderer(work.prepared, session, (640, 480), scale=0.5) as r:   # doctest: +SKIP
+>>> from rrcache.pipeline import load_for_session
+>>> from rrcache.session import load_session
+>>> session = load_session("sessions/marble.json")
+>>> work = load_for_session("shaders/glslviewer_basic.glsl", session)
+>>> with DynresRenderer(work.prepared, session, (64, 48), scale=0.5) as r:
 ...     r.low_size, r.render_frame(0).image.shape
-((320, 240), (480, 640, 4))
+((32, 24), (48, 64, 4))
 """
 from __future__ import annotations
 
@@ -29,7 +33,7 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import FrameResult, Renderer, check_frame_index, session_background
-from rrcache.harness.vertex import vertex_source
+from rrcache.harness.vertex import vertex_for
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, match_scale
 
@@ -88,7 +92,7 @@ class DynresRenderer:
         ctx, scope = self.ctx, self._scope
         inputs = {name: d.type for name, d in prepared.inputs.items()}
         locs = {name: d.loc for name, d in prepared.inputs.items()}
-        self.program = scope.own(build_program(ctx, vertex_source(inputs, locs), prepared.source, prepared.line_map,
+        self.program = scope.own(build_program(ctx, vertex_for(inputs, locs, getattr(prepared, "vertex", None)), prepared.source, prepared.line_map,
                                                fragment_name=prepared.path))
         self.drawer = SceneDrawer(ctx, self.session, prepared, self.low_size, scope)
         self.drawer.add_program(self.program)
@@ -111,6 +115,7 @@ class DynresRenderer:
         self.drawer.set_frame(index)
         ctx.finish()
         start = time.perf_counter()
+        self.drawer.render_shadow_map()  # the light's depth pass is part of the frame
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         self._low_fbo.use()

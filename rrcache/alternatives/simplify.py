@@ -27,8 +27,12 @@ The ranking is computed once from single-node replacements, not re-evaluated aft
 step as a full greedy search would: each evaluation compiles and renders a shader, and this
 keeps the cost linear in the candidates. The means are those of the original shader.
 
->>> s = simplified_shader(work, {"n12": (0.5, 0.5, 0.5)})     # doctest: +SKIP
->>> s.prepared.source.count("vec3(0.5, 0.5, 0.5)")              # doctest: +SKIP
+>>> from rrcache.pipeline import load_for_session
+>>> from rrcache.session import load_session
+>>> work = load_for_session("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"))
+>>> node = [n for n in work.table.nodes if n.type == "vec3"][0]
+>>> s = simplified_shader(work, {node.id: (0.5, 0.25, 0.125)})
+>>> s.prepared.source.count("vec3(0.5, 0.25, 0.125)")
 1
 """
 from __future__ import annotations
@@ -41,10 +45,9 @@ from typing import Callable, Mapping, Optional, Sequence
 
 import numpy as np
 
-from rrcache.analysis._tree import walk
 from rrcache.analysis.cacheable import find_node
 from rrcache.analysis.cost import op_cost
-from rrcache.compiler._ast import main_function, substitute
+from rrcache.glsl.ast import main_function, substitute, walk
 from rrcache.compiler.locate import NODE_TYPES
 from rrcache.compiler.prune import prune
 from rrcache.errors import GLSLError, RRCacheError, UnsupportedShaderError
@@ -97,7 +100,7 @@ def static_cost(unit: A.TranslationUnit) -> int:
     main = main_function(unit)
     if main is None:
         return 0
-    return int(sum(op_cost(n) for n in walk(main.body) if isinstance(n, A.Expr)))
+    return int(sum(op_cost(n) for n in walk(main.body, decl_types=False) if isinstance(n, A.Expr)))
 
 
 def simplified_shader(work, constants: Mapping[str, Sequence[float]]) -> Simplified:

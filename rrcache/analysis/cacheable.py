@@ -17,9 +17,19 @@ Every expression in a value position of ``main`` is either listed or left out wi
                functions) are not pure values and get this reason too. Code after a per-pixel
                ``discard``/``return`` (and under the inliner's early-return guards
                ``_rr_live_<n>``) is *not* dynamic: it runs exactly where the original does.
-``derivative`` its value needs screen-space derivatives: the expression, or a value it reads
-               through local variables, calls ``dFdx``/``dFdy``/``fwidth`` or an implicit-LOD
-               texture lookup; or it is inside the argument of such a call.
+``screen``     it depends on the pixel's screen position (``gl_FragCoord``, and so on
+               ``gl_FragCoord.xy / u_resolution``). Such a value is attached to the screen, not
+               to the surface: reprojection fetches it from where the surface was last frame,
+               a different pixel as soon as anything moves. A value of ``gl_FragCoord`` and
+               constants alone is the same at a pixel every frame, but it is not the same at
+               the *surface point*, and the cache is indexed by surface point; so it is
+               excluded too (such values are cheap to recompute or belong in a screen-space
+               texture, not in a reprojection cache).
+``derivative`` caching it would change a screen-space derivative: it is inside the
+               coordinate of an implicit-LOD texture lookup or the operand of
+               ``dFdx``/``dFdy``/``fwidth``, or it is written into a variable that such an
+               argument reads (the pass that uses a cached value reads it at helper pixels
+               too, where the cache holds another surface's value).
 ``uniform``    the same for every pixel: it depends only on literals, constants and uniforms.
 ``duplicate``  the same value as a node listed earlier on every path to it: an identical
                expression reading the same definitions of the same variables, or a read of a
@@ -30,9 +40,22 @@ Every expression in a value position of ``main`` is either listed or left out wi
 
 The *cost* of a node is the work a cache hit saves: the static cost
 (:mod:`rrcache.analysis.cost`) of its expression tree plus that of every definition of a local
-variable it depends on, transitively, each counted once. The *final colour* (the last
-assignment of the whole colour output at the top level of ``main``) is always listed unless it
-is ``type``/``dynamic``/``derivative``/``uniform``, and is flagged ``final``.
+variable it depends on, transitively, each counted once. Every write makes a definition: a
+whole assignment, and also a partial one (a component ``c.rgb += ...``, a member
+``m.albedo.rgb = ...``, an element ``a[i] = ...``, ``++``/``--``, an ``out``/``inout`` argument;
+the inliner turns calls into such assignments), whose definition reads the variable's previous
+definitions besides the value written; so a variable partly written from a varying is not
+``uniform`` and costs everything written into it. The *final colour* (the last assignment of
+the whole colour output at the top level of ``main``) is always listed unless it is
+``type``/``dynamic``/``screen``/``derivative``/``uniform``, and is flagged ``final``.
+
+A listed node is valid for every cache algorithm unless its value needs screen-space
+derivatives (an implicit-LOD lookup or ``dFdx``/``dFdy``/``fwidth`` among what it is computed
+from): three-pass and two-pass compute it in a pass that draws whole primitives (pixels not
+computed are culled by the depth test, so the 2x2 quads keep their helper pixels), but one-pass
+computes it inside a per-pixel branch, where derivatives are undefined. Such a node's
+``invalid`` maps ``one-pass`` to the reason, :attr:`CacheableNode.algorithms` lists the valid
+ones, and :func:`rrcache.compiler.instance` refuses the others.
 
 L-values (assignment targets, ``out`` arguments) and expression statements that only assign are
 not values and appear in neither list. Expressions outside ``main`` (in functions the inliner
@@ -50,19 +73,34 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Optional, Union
 
+import numpy as np
+
+from rrcache.deep import deep
 from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
 
-from rrcache.analysis._tree import chain_of, is_live_flag, iter_exprs, paused_gc, written_roots
+from rrcache.glsl.ast import iter_exprs
+from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
+from rrcache.glsl.writes import out_qualifiers, written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
 from rrcache.analysis.pipeline import analyse
+from rrcache.analysis.source_text import attach_source_text
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
 __all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "cacheable_nodes",
            "find_node", "node_ids"]
 
-REASONS = ("type", "dynamic", "derivative", "uniform", "duplicate", "cheap")
+REASONS = ("type", "dynamic", "screen", "derivative", "uniform", "duplicate", "cheap")
+
+#: every cache algorithm, in the order the node table lists them
+ALGORITHMS = ("three-pass", "two-pass", "one-pass")
+
+#: why a node that needs screen-space derivatives cannot be cached by the one-pass algorithm
+ONE_PASS_DERIVATIVE = (
+    "derivative: the value needs screen-space derivatives (an implicit-LOD texture lookup or "
+    "dFdx/dFdy/fwidth), and one-pass computes it inside a per-pixel branch, where they are "
+    "undefined; three-pass and two-pass compute it over whole primitives")
 
 
 @dataclass
@@ -78,11 +116,24 @@ class CacheableNode:
     call_chain: list[str]
     node: A.Expr = field(repr=False, compare=False)
     final: bool = False
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
+    #: the algorithms that cannot cache this node, each with the reason
+    invalid: dict = field(default_factory=dict)
+
+    @property
+    def algorithms(self) -> list[str]:
+        """The cache algorithms whose variants of this node are valid."""
+        return [a for a in ALGORITHMS if a not in self.invalid]
+
+    def valid_for(self, algorithm: str) -> bool:
+        """Whether ``algorithm`` can cache this node (see :attr:`invalid` for why not)."""
+        return algorithm not in self.invalid
 
     def to_json(self) -> dict:
         return {"id": self.id, "type": self.type, "line": self.line, "column": self.column,
                 "text": self.text, "cost": self.cost, "call_chain": list(self.call_chain),
-                "final": self.final}
+                "final": self.final, "algorithms": self.algorithms,
+                "not_valid": dict(self.invalid), "file": self.file}
 
 
 @dataclass
@@ -98,11 +149,16 @@ class ExcludedNode:
     type: str = ""
     cost: int = 0
     call_chain: list[str] = field(default_factory=list)
+    file: Optional[str] = None  # the included file the node was written in (None: the main file)
+
+    #: a node left out is valid for no algorithm
+    algorithms = property(lambda self: [])
+    invalid = property(lambda self: {a: self.reason for a in ALGORITHMS})
 
     def to_json(self) -> dict:
         return {"id": self.id, "reason": self.reason, "line": self.line, "column": self.column,
                 "text": self.text, "type": self.type, "cost": self.cost,
-                "call_chain": list(self.call_chain)}
+                "call_chain": list(self.call_chain), "algorithms": [], "file": self.file}
 
 
 @dataclass
@@ -160,6 +216,7 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
                        hint="node ids look like 'n42'; list them with 'rrcache nodes SHADER'")
 
 
+@deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
                     cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
@@ -176,42 +233,90 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     """
     with paused_gc():
         target = shader if analysed else analyse(shader, max_iterations)
-        return _Classifier(target, cheap_below).run()
+        table = _Classifier(target, cheap_below).run()
+        if not analysed:  # the text as written, and the file, of nodes from inlined code
+            attach_source_text(table, shader.unit)
+        return table
 
 
 # ----------------------------------------------------------------------------- classification
+#
+# Data flow. Every write of a variable (whole, component, member, element, ``++``/``--``, an
+# ``out``/``inout`` argument) makes a *definition* (:class:`_Def`); a partial write's definition
+# reads the variable's previous definitions besides the value written. The definitions form a
+# DAG; a node's cost is the own cost of its expression tree plus the own costs of every
+# definition reachable from the definitions it reads, each counted once. Reachable sets are
+# bitsets (Python ints, bit k = definition k): a union is an ``|`` and the cost of what a union
+# adds is summed over the bits it adds, so nothing is ever copied element by element. Only the
+# definitions still visible (in scope, reaching) keep their bitset; variables are forgotten at
+# the end of their block.
+
+_DERIV = 1    # the value needs screen-space derivatives (invalid under one-pass)
+_SCREEN = 2   # the value depends on the pixel's screen position
+
+#: a node's text is printed whole up to this many syntax nodes; a larger one (a generated chain of
+#: thousands of terms) is abbreviated, so that listing every node of a chain stays linear
+_TEXT_NODES = 400
+
+
+def _bounded_texts(exprs):
+    """``text(e)`` for the expressions ``exprs``: the printed expression, abbreviated to its last
+    operand when its subtree is over ``_TEXT_NODES`` nodes (sizes counted once, without recursion)."""
+    size: dict[int, int] = {}
+    for root in exprs:
+        if id(root) in size:
+            continue
+        stack = [(root, False)]
+        while stack:
+            node, done = stack.pop()
+            if done:
+                size[id(node)] = 1 + sum(size[id(c)] for c in node.children())
+                continue
+            if id(node) in size:
+                continue
+            stack.append((node, True))
+            stack.extend((c, False) for c in node.children() if id(c) not in size)
+
+    def text(e) -> str:
+        n = size.get(id(e), 0)
+        if n <= _TEXT_NODES:
+            return print_expr(e)
+        if isinstance(e, A.Binary) and size.get(id(e.right), _TEXT_NODES + 1) <= _TEXT_NODES:
+            return f"(... {n:,} nodes ...) {e.op} {print_expr(e.right)}"
+        return f"(expression of {n:,} nodes)"
+
+    return text
+
 
 
 class _Def:
-    """One definition of a variable: the value expression (None when unknown)."""
+    """One definition of a variable: ``expr`` the value expression (None when the write is
+    partial or its value unknown), ``mask`` the definitions it depends on (itself included),
+    ``cost`` their own costs summed."""
 
-    __slots__ = ("expr", "uniform", "deriv", "own", "closure", "closure_cost")
+    __slots__ = ("expr", "uniform", "flags", "idx", "mask", "cost")
 
-    def __init__(self, expr, uniform: bool, deriv: bool, own: int, reads: frozenset):
+    def __init__(self, expr, uniform: bool, flags: int, idx: int, mask: int, cost: int):
         self.expr = expr
         self.uniform = uniform
-        self.deriv = deriv
-        self.own = own
-        if len(reads) == 1:        # the common chain: no Python-level sum over the closure
-            (r,) = reads
-            self.closure = r.closure | {self}
-            self.closure_cost = own + r.closure_cost
-        else:
-            closure = {self}
-            for d in reads:
-                closure |= d.closure
-            self.closure = frozenset(closure)
-            self.closure_cost = sum(d.own for d in closure)
+        self.flags = flags
+        self.idx = idx
+        self.mask = mask
+        self.cost = cost
 
 
 class _Info:
-    __slots__ = ("uniform", "deriv", "effects", "reads", "own", "key")
+    """What an expression is: ``mask``/``rcost`` the definitions it reads (transitively) and
+    their cost, ``own`` the cost of its own tree."""
 
-    def __init__(self, uniform, deriv, effects, reads, own, key):
+    __slots__ = ("uniform", "flags", "effects", "mask", "rcost", "own", "key")
+
+    def __init__(self, uniform, flags, effects, mask, rcost, own, key):
         self.uniform = uniform
-        self.deriv = deriv
+        self.flags = flags
         self.effects = effects
-        self.reads = reads
+        self.mask = mask
+        self.rcost = rcost
         self.own = own
         self.key = key
 
@@ -232,7 +337,19 @@ class _Ctx:
         return c
 
 
-_EMPTY: frozenset = frozenset()
+class _Record:
+    __slots__ = ("expr", "reason", "cost", "flags", "dup", "sink", "key", "region", "dup_of")
+
+    def __init__(self, expr, reason, cost, flags, dup=False, key=-1, region=(), dup_of=None):
+        self.expr = expr
+        self.reason = reason
+        self.cost = cost
+        self.flags = flags
+        self.dup = dup          # a read of a variable whose one definition is ``dup_of``
+        self.sink = None        # the definition this value is written into (its index)
+        self.key = key          # structural key (same key, same value)
+        self.region = region    # the branches it is in
+        self.dup_of = dup_of
 
 
 def _is_cacheable_type(t) -> bool:
@@ -244,6 +361,20 @@ def _var_key(sym) -> tuple:
     return (id(sym.decl), sym.name)
 
 
+def _differentiated_args(call) -> tuple:
+    """The argument positions whose screen-space derivatives ``call`` takes (the coordinate of
+    an implicit-LOD lookup, the operand of ``dFdx``...), or () for other calls."""
+    target = call.target
+    if not getattr(target, "derivative", False):
+        return ()
+    if getattr(target, "category", "") == "derivative":
+        return (0,)
+    return (1,)
+
+
+_SCREEN_BUILTINS = frozenset({"gl_FragCoord"})
+
+
 class _Classifier:
     def __init__(self, shader, cheap_below: int):
         self.shader = shader
@@ -251,11 +382,12 @@ class _Classifier:
         # id(expr) -> k of its id "n<k>" (pre-order index)
         self.order = {id(e): k for k, e in enumerate(iter_exprs(shader.unit))}
         self.state: dict[tuple, tuple] = {}    # var key -> reaching defs
-        self.records: list[tuple] = []        # (expr, reason or None, info, ctx, dup_of_def)
+        self.records: list[_Record] = []
         self.intern: dict[tuple, int] = {}
-        self.seen: dict[int, tuple] = {}       # structural key -> region of first listing
-        self.cost_memo: dict[frozenset, int] = {}
         self.final: Optional[A.Expr] = None
+        self.own: list[int] = []                  # own cost of definition k
+        self.own_np = np.zeros(1024, dtype=np.int64)
+        self.deriv_mask = 0                       # definitions read by differentiated arguments
         info = shader.info
         outs = list(info.outputs)
         self.output = outs[0] if outs else ("gl_FragData" if "gl_FragData" in info.used_globals
@@ -270,30 +402,50 @@ class _Classifier:
                     self.block(d.body.stmts, _Ctx())
                 else:
                     for e in iter_exprs(d.body):
-                        self.records.append((e, "type" if not _is_cacheable_type(e.type)
-                                             else "dynamic", None, None, None))
+                        self.records.append(_Record(e, "type" if not _is_cacheable_type(e.type)
+                                                    else "dynamic", 0, 0))
             elif isinstance(d, A.VariableDecl):
                 for decl in d.declarators:
                     if decl.init is not None:
                         for e in iter_exprs(decl.init):
-                            self.records.append((e, "type" if not _is_cacheable_type(e.type)
-                                                 else "uniform", None, None, None))
-                        self.state[(id(d), decl.name)] = (
-                            _Def(decl.init, True, False, 0, _EMPTY),)
+                            self.records.append(_Record(e, "type" if not _is_cacheable_type(e.type)
+                                                        else "uniform", 0, 0))
+                        self.state[(id(d), decl.name)] = (self.new_def(decl.init, True, 0, 0, 0, 0),)
         return self.finish()
 
     def finish(self) -> NodeTable:
         nodes: list[CacheableNode] = []
         excluded: list[ExcludedNode] = []
         order = self.order
-        self.records.sort(key=lambda r: order[id(r[0])])
+        deriv_mask = self.deriv_mask
+        # in evaluation order: values written into a definition that a differentiated argument
+        # reads are excluded (caching them would change the derivative), then duplicates of
+        # the first listed occurrence
+        seen: dict[int, tuple] = {}
+        feeds: set = set()
+        for r in self.records:
+            if r.reason is not None:
+                continue
+            if r.sink is not None and (deriv_mask >> r.sink) & 1:
+                r.reason = "derivative"
+                feeds.add(id(r.expr))
+                continue
+            if r.dup and id(r.dup_of) in feeds:
+                r.dup = False
+            first = seen.get(r.key)
+            if first is not None and r.region[:len(first)] == first:
+                r.dup = True
+            elif first is None:
+                seen[r.key] = r.region
+        self.records.sort(key=lambda r: order[id(r.expr)])
         final, cheap_below = self.final, self.cheap_below
         type_names: dict = {}
-        for e, reason, info, ctx, dup in self.records:
-            cost = self.cost(info) if info is not None else 0
+        text = _bounded_texts([r.expr for r in self.records])
+        for r in self.records:
+            e, reason, cost = r.expr, r.reason, r.cost
             is_final = e is final
             if reason is None and not is_final:
-                if dup:
+                if r.dup:
                     reason = "duplicate"
                 elif cost < cheap_below:
                     reason = "cheap"
@@ -309,44 +461,79 @@ class _Classifier:
             line, column = (loc.line, loc.col) if loc else (0, 0)
             chain = list(chain_of(loc))
             if reason is None:
-                nodes.append(CacheableNode(node_id, tname, line, column, print_expr(e), cost,
-                                           chain, e, is_final))
+                invalid = {"one-pass": ONE_PASS_DERIVATIVE} if r.flags & _DERIV else {}
+                nodes.append(CacheableNode(node_id, tname, line, column, text(e), cost,
+                                           chain, e, is_final, invalid=invalid))
             else:
-                excluded.append(ExcludedNode(node_id, reason, line, column, print_expr(e), e,
+                excluded.append(ExcludedNode(node_id, reason, line, column, text(e), e,
                                              tname, cost, chain))
         return NodeTable(self.shader, nodes, excluded)
 
-    def cost(self, info: _Info) -> int:
-        reads = info.reads
-        if len(reads) == 1:
-            (r,) = reads
-            return info.own + r.closure_cost
-        extra = self.cost_memo.get(reads)
-        if extra is None:
-            closure: set = set()
-            for d in reads:
-                closure |= d.closure
-            extra = sum(d.own for d in closure)
-            self.cost_memo[reads] = extra
-        return info.own + extra
+    # ------------------------------------------------------------------ definitions and costs
+    def new_def(self, expr, uniform: bool, flags: int, own: int, mask: int, cost: int) -> _Def:
+        """A new definition of own cost ``own`` reading ``mask`` (of cost ``cost``)."""
+        idx = len(self.own)
+        self.own.append(own)
+        if idx >= self.own_np.size - 64:
+            grown = np.zeros(self.own_np.size * 2, dtype=np.int64)
+            grown[:self.own_np.size] = self.own_np
+            self.own_np = grown
+        self.own_np[idx] = own
+        return _Def(expr, uniform, flags, idx, mask | (1 << idx), cost + own)
+
+    def weight(self, mask: int) -> int:
+        """The own costs of the definitions in ``mask``, summed."""
+        if mask.bit_count() <= 24:
+            own, w = self.own, 0
+            while mask:
+                low = mask & -mask
+                w += own[low.bit_length() - 1]
+                mask ^= low
+            return w
+        raw = mask.to_bytes((mask.bit_length() + 7) // 8, "little")
+        bits = np.unpackbits(np.frombuffer(raw, dtype=np.uint8), bitorder="little")
+        return int(self.own_np[:bits.size][bits.view(bool)].sum())
+
+    def join(self, m1: int, c1: int, m2: int, c2: int) -> tuple[int, int]:
+        """The union of two dependency sets and its cost (each definition counted once)."""
+        if not m2 or m1 == m2:
+            return m1, c1
+        if not m1:
+            return m2, c2
+        u = m1 | m2
+        if u == m1:
+            return m1, c1
+        if u == m2:
+            return m2, c2
+        if c1 >= c2:
+            return u, c1 + self.weight(m2 & ~m1)
+        return u, c2 + self.weight(m1 & ~m2)
+
+    def defs_mask(self, defs) -> tuple[int, int]:
+        m, c = 0, 0
+        for d in defs:
+            m, c = self.join(m, c, d.mask, d.cost)
+        return m, c
 
     # ------------------------------------------------------------------ variables
     def read_defs(self, sym) -> tuple:
         return self.state.get(_var_key(sym), ())
 
-    def define(self, sym_key: tuple, expr, info: Optional[_Info], ctx: _Ctx) -> None:
-        if info is None:
-            d = _Def(None, False, False, 0, _EMPTY)
+    def define(self, sym_key: tuple, expr, info: Optional[_Info], ctx: _Ctx) -> _Def:
+        if info is None:   # declared without a value: undefined, contributes nothing
+            d = self.new_def(None, not ctx.varying, 0, 0, 0, 0)
         else:
-            d = _Def(expr, info.uniform and not ctx.varying, info.deriv, info.own, info.reads)
+            d = self.new_def(expr, info.uniform and not ctx.varying, info.flags, info.own,
+                             info.mask, info.rcost)
         self.state[sym_key] = (d,)
+        return d
 
     def clobber(self, node, ctx: _Ctx) -> None:
         """Variables written somewhere under ``node`` (a loop) get an unknown definition too."""
         for root in written_roots(node):
             if root.symbol is not None:
                 key = _var_key(root.symbol)
-                self.state[key] = self.state.get(key, ()) + (_Def(None, False, False, 0, _EMPTY),)
+                self.state[key] = self.state.get(key, ()) + (self.new_def(None, False, 0, 0, 0, 0),)
 
     def merge(self, a: dict, b: dict) -> dict:
         out = dict(a)
@@ -360,8 +547,13 @@ class _Classifier:
 
     # ------------------------------------------------------------------ statements
     def block(self, stmts: list, ctx: _Ctx) -> None:
+        declared = []
         for s in stmts:
             self.stmt(s, ctx)
+            if isinstance(s, A.DeclStmt) and isinstance(s.decl, A.VariableDecl):
+                declared.extend((id(s.decl), d.name) for d in s.decl.declarators)
+        for key in declared:     # out of scope: their definitions can no longer be read
+            self.state.pop(key, None)
 
     def stmt(self, s, ctx: _Ctx) -> None:
         if isinstance(s, A.Compound):
@@ -373,8 +565,10 @@ class _Classifier:
                         for x in d.array_dims:
                             if x is not None:
                                 self.expr(x, ctx)
+                    start = len(self.records)
                     info = self.expr(d.init, ctx) if d.init is not None else None
-                    self.define((id(s.decl), d.name), d.init, info, ctx)
+                    made = self.define((id(s.decl), d.name), d.init, info, ctx)
+                    self.sink(start, made)
         elif isinstance(s, A.ExprStmt):
             if s.expr is not None:
                 self.top_expr(s.expr, ctx)
@@ -393,6 +587,15 @@ class _Classifier:
             self.state = self.merge(before, self.state)
         elif isinstance(s, A.Return) and s.expr is not None:
             self.expr(s.expr, ctx)
+
+    def sink(self, start: int, made: Optional[_Def]) -> None:
+        """The values recorded since ``start`` are written into definition ``made``."""
+        if made is None:
+            return
+        records = self.records
+        for k in range(start, len(records)):
+            if records[k].sink is None:
+                records[k].sink = made.idx
 
     def branch(self, s: A.If, ctx: _Ctx) -> None:
         info = self.expr(s.cond, ctx)
@@ -435,19 +638,37 @@ class _Classifier:
         if isinstance(e, A.Assign):
             self.assign(e, ctx, top=True)
         elif isinstance(e, A.Unary) and e.op in ("++", "--"):
-            self.lvalue(e.operand, ctx)
-            self.write(e.operand, None, None, ctx)
+            index = self.lvalue(e.operand, ctx)
+            self.write(e.operand, None, self.step_info(index), ctx)
         elif isinstance(e, A.Sequence):
             for x in e.exprs:
                 self.top_expr(x, ctx)
         else:
             self.expr(e, ctx)
 
+    def step_info(self, index: Optional[_Info]) -> _Info:
+        """The value an increment adds (one ALU operation), with its l-value's indices."""
+        info = _Info(True, 0, False, 0, 0, 1, -1)
+        return self.combine(info, index) if index is not None else info
+
+    def combine(self, a: _Info, b: _Info) -> _Info:
+        m, c = self.join(a.mask, a.rcost, b.mask, b.rcost)
+        return _Info(a.uniform and b.uniform, a.flags | b.flags, a.effects or b.effects, m, c,
+                     a.own + b.own, -1)
+
     def assign(self, e: A.Assign, ctx: _Ctx, top: bool = False) -> None:
+        start = len(self.records)
         info = self.expr(e.value, ctx)
-        self.lvalue(e.target, ctx)
+        index = self.lvalue(e.target, ctx)
         whole = e.op == "=" and isinstance(e.target, A.Ident)
-        self.write(e.target, e.value if whole else None, info if whole else None, ctx)
+        if whole:
+            made = self.write(e.target, e.value, info, ctx)
+        else:      # a component, member or element, or an operator not expanded: partial
+            if e.op != "=":
+                info = self.combine(info, _Info(True, 0, False, 0, 0, op_cost(
+                    A.Binary(e.op[:-1], e.target, e.value, loc=e.loc, type=e.target.type)), -1))
+            made = self.write(e.target, None, self.combine(info, index) if index else info, ctx)
+        self.sink(start, made)
         if top and e.op == "=" and not ctx.dynamic and not ctx.region and self.is_output(e.target):
             self.final = e.value
 
@@ -458,30 +679,44 @@ class _Classifier:
                 and target.obj.name == "gl_FragData" == self.output
                 and isinstance(target.index, A.IntLit) and target.index.value == 0)
 
-    def write(self, target, value, info, ctx: _Ctx) -> None:
+    def write(self, target, value, info: Optional[_Info], ctx: _Ctx,
+              whole: bool = False) -> Optional[_Def]:
+        """Write ``info`` into the variable under ``target``. ``value`` given (``x = value``)
+        or ``whole`` (an ``out`` argument) replaces the variable's value; otherwise the write is
+        partial and the new definition also reads the previous ones."""
         root = target
         while isinstance(root, (A.Field, A.Index)):
             root = root.obj
         if not isinstance(root, A.Ident) or root.symbol is None:
-            return
+            return None
         key = _var_key(root.symbol)
         if value is not None:
-            self.define(key, value, info, ctx)
-            return
-        # a partial write (swizzle, element, ++): a new unknown-valued definition that still
-        # depends on the old value
+            return self.define(key, value, info, ctx)
+        if whole and root is target:
+            d = self.new_def(None, info.uniform and not ctx.varying, info.flags, info.own,
+                             info.mask, info.rcost)
+            self.state[key] = (d,)
+            return d
         old = self.state.get(key, ())
-        d = _Def(None, all(x.uniform for x in old) and bool(old) and not ctx.varying
-                 and (info is None or info.uniform), any(x.deriv for x in old),
-                 0, frozenset(old))
+        m, c = self.defs_mask(old)
+        m, c = self.join(m, c, info.mask, info.rcost)
+        flags = info.flags
+        for x in old:
+            flags |= x.flags
+        d = self.new_def(None, all(x.uniform for x in old) and info.uniform and not ctx.varying,
+                         flags, info.own, m, c)
         self.state[key] = (d,)
+        return d
 
-    def lvalue(self, e, ctx: _Ctx) -> None:
-        """Visit the index expressions of an l-value (they are values)."""
+    def lvalue(self, e, ctx: _Ctx) -> Optional[_Info]:
+        """Visit the index expressions of an l-value (they are values); what they read."""
+        got = None
         while isinstance(e, (A.Field, A.Index)):
             if isinstance(e, A.Index):
-                self.expr(e.index, ctx)
+                info = self.expr(e.index, ctx)
+                got = info if got is None else self.combine(got, info)
             e = e.obj
+        return got
 
     def intern_key(self, key: tuple) -> int:
         got = self.intern.get(key)
@@ -495,21 +730,21 @@ class _Classifier:
         if isinstance(e, A.Ident):
             info, dup = self.ident(e)
         elif isinstance(e, (A.IntLit, A.FloatLit, A.BoolLit)):
-            info = _Info(True, False, False, _EMPTY, 0,
+            info = _Info(True, 0, False, 0, 0, 0,
                          self.intern_key(("lit", type(e).__name__, e.value)))
-            dup = False
+            dup = None
         elif isinstance(e, A.Assign):
             self.assign(e, ctx)
-            info = _Info(False, False, True, _EMPTY, 0, self.intern_key(("fx", id(e))))
-            dup = False
+            info = _Info(False, 0, True, 0, 0, 0, self.intern_key(("fx", id(e))))
+            dup = None
         elif isinstance(e, A.Unary) and e.op in ("++", "--"):
-            self.lvalue(e.operand, ctx)
-            self.write(e.operand, None, None, ctx)
-            info = _Info(False, False, True, _EMPTY, 1, self.intern_key(("fx", id(e))))
-            dup = False
+            index = self.lvalue(e.operand, ctx)
+            self.write(e.operand, None, self.step_info(index), ctx)
+            info = _Info(False, 0, True, 0, 0, 1, self.intern_key(("fx", id(e))))
+            dup = None
         else:
             info = self.compound_expr(e, ctx)
-            dup = False
+            dup = None
         self.record(e, info, ctx, dup)
         return info
 
@@ -518,32 +753,40 @@ class _Classifier:
         kind = sym.kind if sym is not None else "in"
         if kind == "builtin":
             kind = sym.qualifiers[0] if sym.qualifiers else "in"
+            if e.name in _SCREEN_BUILTINS:
+                return _Info(False, _SCREEN, False, 0, 0, 0,
+                             self.intern_key(("id", e.name))), None
         if kind in ("uniform", "const"):
-            return _Info(True, False, False, _EMPTY, 0, self.intern_key(("id", e.name))), False
+            return _Info(True, 0, False, 0, 0, 0, self.intern_key(("id", e.name))), None
         if kind == "in":
-            return _Info(False, False, False, _EMPTY, 0, self.intern_key(("id", e.name))), False
+            return _Info(False, 0, False, 0, 0, 0, self.intern_key(("id", e.name))), None
         defs = self.read_defs(sym)
         uniform = bool(defs) and all(d.uniform for d in defs)
-        deriv = any(d.deriv for d in defs)
-        reads = frozenset(defs)
-        key = self.intern_key(("var", e.name, tuple(id(d) for d in defs)))
-        dup = len(defs) == 1 and defs[0].expr is not None
-        return _Info(uniform, deriv, False, reads, 0, key), dup
+        flags = 0
+        for d in defs:
+            flags |= d.flags
+        if len(defs) == 1:
+            mask, cost = defs[0].mask, defs[0].cost
+        else:
+            mask, cost = self.defs_mask(defs)
+        key = self.intern_key(("var", e.name, tuple(d.idx for d in defs)))
+        dup_of = defs[0].expr if len(defs) == 1 else None
+        return _Info(uniform, flags, False, mask, cost, 0, key), dup_of
 
     def compound_expr(self, e, ctx: _Ctx) -> _Info:
-        uniform, deriv, effects = True, False, False
-        reads: set = set()
+        uniform, flags, effects = True, 0, False
         own = op_cost(e)
         keys: list = [type(e).__name__, getattr(e, "op", None), getattr(e, "name", None)]
-        call_deriv = isinstance(e, A.Call) and bool(getattr(e.target, "derivative", False))
-        out_pos = set()
+        out_pos: dict = {}
+        diff_pos: tuple = ()
         if isinstance(e, A.Call):
             if e.kind == "function":
                 uniform, effects = False, True
             if getattr(e.target, "side_effects", False):
                 effects = True
-            quals = getattr(e.target, "qualifiers", ())
-            out_pos = {i for i, q in enumerate(quals) if q != "in"}
+            out_pos = {i: q for i, q in enumerate(out_qualifiers(e)) if q != "in"}
+            diff_pos = _differentiated_args(e)
+        outs = []
         if isinstance(e, A.Ternary) or (isinstance(e, A.Binary) and e.op in ("&&", "||")):
             first = e.cond if isinstance(e, A.Ternary) else e.left
             infos = [self.expr(first, ctx)]
@@ -552,46 +795,53 @@ class _Classifier:
                             varying=ctx.varying or not infos[0].uniform)
             infos += [self.expr(x, inner) for x in rest]
         else:
-            sub = ctx.but(in_deriv=True) if call_deriv else ctx
             infos = []
             for i, c in enumerate(_value_children(e)):
                 if i in out_pos:
-                    self.lvalue(c, ctx)
-                    self.write(c, None, None, ctx)
+                    index = self.lvalue(c, ctx)
+                    outs.append((c, out_pos[i], index))
                     effects = True
                     continue
-                infos.append(self.expr(c, sub))
+                if i in diff_pos:
+                    info = self.expr(c, ctx.but(in_deriv=True))
+                    self.deriv_mask |= info.mask
+                else:
+                    info = self.expr(c, ctx)
+                infos.append(info)
+        mask, rcost = 0, 0
         for inf in infos:
             uniform = uniform and inf.uniform
-            deriv = deriv or inf.deriv
+            flags |= inf.flags
             effects = effects or inf.effects
-            reads |= inf.reads
+            mask, rcost = self.join(mask, rcost, inf.mask, inf.rcost)
             own += inf.own
             keys.append(inf.key)
-        if call_deriv:
-            deriv = True
+        if diff_pos:
+            flags |= _DERIV
         if isinstance(e, A.Call) and e.kind == "function":
             keys.append(id(e))
-        return _Info(uniform, deriv, effects, frozenset(reads), own,
-                     self.intern_key(tuple(keys)))
+        info = _Info(uniform, flags, effects, mask, rcost, own, self.intern_key(tuple(keys)))
+        for target, qual, index in outs:      # out/inout arguments: written by the call
+            value = _Info(uniform and e.kind != "function", flags, False, mask, rcost, own, -1)
+            if index is not None:
+                value = self.combine(value, index)
+            self.write(target, None, value, ctx, whole=qual == "out")
+        return info
 
-    def record(self, e, info: _Info, ctx: _Ctx, dup: bool) -> None:
+    def record(self, e, info: _Info, ctx: _Ctx, dup_of) -> None:
         reason = None
         if not _is_cacheable_type(e.type):
             reason = "type"
         elif ctx.dynamic or info.effects:
             reason = "dynamic"
-        elif info.deriv or ctx.in_deriv:
+        elif info.flags & _SCREEN:
+            reason = "screen"
+        elif ctx.in_deriv:
             reason = "derivative"
         elif info.uniform:
             reason = "uniform"
-        else:
-            first = self.seen.get(info.key)
-            if first is not None and ctx.region[:len(first)] == first:
-                dup = True
-            elif first is None:
-                self.seen[info.key] = ctx.region
-        self.records.append((e, reason, info, ctx, dup))
+        self.records.append(_Record(e, reason, info.own + info.rcost, info.flags,
+                                    dup_of is not None, info.key, ctx.region, dup_of))
 
 
 def _value_children(e) -> list:

@@ -20,7 +20,9 @@ import dataclasses
 from rrcache.glsl import ast as A
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import clone, walk, written_roots
+from rrcache.glsl.ast import walk
+from rrcache.glsl.rewrite import clone
+from rrcache.glsl.writes import written_roots
 
 __all__ = ["expand_compound_assignments", "expand_unit"]
 
@@ -44,7 +46,7 @@ def expand_compound_assignments(shader):
 
 def expand_unit(unit: A.TranslationUnit) -> A.TranslationUnit:
     """The pass, in place on ``unit`` (a copy the caller owns)."""
-    for node in walk(unit):
+    for node in walk(unit, decl_types=False):
         if isinstance(node, A.Assign) and node.op in _OPS and _simple_target(node.target) \
                 and _pure(node.value):
             node.value = A.Binary(node.op[:-1], clone(node.target), node.value, loc=node.loc)
@@ -65,7 +67,7 @@ def _simple_target(e: A.Expr) -> bool:
 def _pure(e: A.Expr) -> bool:
     if next(written_roots(e), None) is not None:
         return False
-    for n in walk(e):
+    for n in walk(e, decl_types=False):
         if isinstance(n, A.Assign) or (isinstance(n, A.Unary) and n.op in ("++", "--")):
             return False
         if isinstance(n, A.Call) and (n.kind == "function"

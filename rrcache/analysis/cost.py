@@ -45,7 +45,7 @@ from __future__ import annotations
 
 from rrcache.glsl import ast as A
 
-from rrcache.analysis._tree import walk
+from rrcache.glsl.ast import walk
 
 __all__ = ["ADD", "MUL", "DIV", "SQRT", "TRANSCENDENTAL", "TEXTURE", "USER_CALL",
            "CACHE_LOOKUP_COST", "op_cost", "subtree_cost"]
@@ -171,4 +171,4 @@ def subtree_cost(e: A.Expr) -> int:
     >>> subtree_cost(A.Binary("+", A.Ident("a"), A.Call("sqrt", [A.Ident("b")])))
     5
     """
-    return sum(op_cost(n) for n in walk(e) if isinstance(n, A.Expr))
+    return sum(op_cost(n) for n in walk(e, decl_types=False) if isinstance(n, A.Expr))

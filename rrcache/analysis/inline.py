@@ -32,6 +32,13 @@ input, built as follows.
   A function with a ``return`` inside a loop or ``switch`` is *not inlined*: it stays a function,
   and the cacheable-node analysis marks the nodes in its body ``dynamic``.
 - Functions no longer called are removed. Names starting with ``_rr`` are reserved.
+- A body inlined into another function keeps meaning what it meant: a local or parameter of
+  the caller named like a global or a function the body uses (``float pos`` where the body
+  reads the global ``vec3 pos``; ``float step`` where it calls ``step()``) is renamed first,
+  and a definition that now uses a global or struct type declared after it (``main`` written
+  before the helpers and their globals) moves after that declaration, its prototype left in
+  place.
+- A ``?:`` of ``void`` calls used as a statement becomes an ``if``.
 
 >>> from rrcache.glsl.frontend import parse_shader
 >>> s = parse_shader("float sq(float x) { return x * x; }\\n"
@@ -48,10 +55,12 @@ from typing import Optional
 from rrcache.glsl import ast as A
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import (
-    NameAllocator, assign, check_reserved_names, children, clone, declare, declare_typed,
-    is_literal, out_qualifiers, param_qualifier, rewrite_scoped, walk, with_chain,
+from rrcache.glsl.ast import children, is_literal, walk
+from rrcache.glsl.rewrite import (
+    NameAllocator, assign, check_reserved_names, clone, declare, declare_typed, rewrite_scoped,
+    with_chain,
 )
+from rrcache.glsl.writes import out_qualifiers, param_qualifier
 
 __all__ = ["inline_calls", "inline_unit"]
 
@@ -100,7 +109,7 @@ class _Template:
         if self.uses > 0:
             return clone(self.body, lambda loc: with_chain(loc, site))
         body, self.body = self.body, None
-        for n in walk(body):
+        for n in walk(body, decl_types=False):
             if n.loc is not None:
                 n.loc = with_chain(n.loc, site)
         return body
@@ -118,13 +127,7 @@ def _returns_in_loops(s: A.Node, inside: bool = False) -> bool:
 def _stmt_children(s: A.Node):
     if isinstance(s, A.Compound):
         return s.stmts
-    if isinstance(s, A.If):
-        return [x for x in (s.then, s.else_) if x is not None]
-    if isinstance(s, (A.For, A.While, A.DoWhile)):
-        return [s.body]
-    if isinstance(s, A.Switch):
-        return [s.body]
-    return []
+    return [sub for _, sub in A.branches(s)]
 
 
 def _has_return(s: A.Node) -> bool:
@@ -189,6 +192,9 @@ class _Inliner:
         # original FunctionDecl (call targets) -> its copy in self.unit
         self.copy_of = {id(o): c for o, c in zip(unit.decls, self.unit.decls)
                         if isinstance(o, A.FunctionDecl)}
+        # original global declaration (what a global Symbol's ``decl`` is) -> its copy
+        self.global_copy = {id(o): c for o, c in zip(unit.decls, self.unit.decls)
+                            if not isinstance(o, A.FunctionDecl)}
         self.defs = [d for d in self.unit.decls if isinstance(d, A.FunctionDecl) and d.body]
         self.templates: dict[int, _Template] = {}
         self.inlinable: dict[int, bool] = {}
@@ -200,17 +206,96 @@ class _Inliner:
     def run(self) -> A.TranslationUnit:
         self.call_sites: dict[int, int] = {}
         for d in self.defs:
-            for n in walk(d.body):
+            for n in walk(d.body, decl_types=False):
                 if isinstance(n, A.Call):
                     t = self._target(n)
                     if t is not None:
                         self.call_sites[id(t)] = self.call_sites.get(id(t), 0) + 1
         for d in self.defs:
             self.inlinable[id(d)] = d.name != "main" and not _returns_in_loops(d.body)
+        self._unshadow_globals()
         done: set[int] = set()
         for d in self.defs:
             self._process(d, done)
-        return self._prune()
+        self._prune()
+        self._define_after_globals()
+        return self.unit
+
+    def _global_names_read(self, d: A.FunctionDecl) -> set[str]:
+        """The global names the body of ``d`` uses: globals (by their semantic symbols) and the
+        functions it calls (built-in or not)."""
+        names = set()
+        for n in walk(d.body, decl_types=False):
+            if isinstance(n, A.Ident):
+                if n.symbol is not None and id(getattr(n.symbol, "decl", None)) in self.global_copy:
+                    names.add(n.name)
+            elif isinstance(n, A.Call) and n.kind in ("builtin", "function"):
+                names.add(n.name)
+        return names
+
+    def _unshadow_globals(self) -> None:
+        """Rename the locals and parameters that have the name of a global or a function some
+        inlinable function uses: once that function's body is inlined into their scope, the
+        name would mean the local (``vec3 pos; float f() { return pos.y; }`` inlined where
+        ``float pos`` is declared; ``step(a, b)`` inlined where ``float step`` is). Each gets
+        a fresh ``_rr_<name>_<n>``; other names are left as written."""
+        shadowed = set()
+        for d in self.defs:
+            if self.inlinable[id(d)]:
+                shadowed |= self._global_names_read(d)
+        if not shadowed:
+            return
+        for d in self.defs:
+            params = [p for p in d.params if p.name in shadowed]
+            if not params and not any(isinstance(n, A.Declarator) and n.name in shadowed
+                                      for n in walk(d.body, decl_types=False)):
+                continue
+            initial = {}
+            for p in params:
+                initial[p.name] = p.name = self.names.fresh(p.name)
+            rewrite_scoped(d.body, initial,
+                           lambda name: self.names.fresh(name) if name in shadowed else None)
+
+    def _define_after_globals(self) -> None:
+        """Move a function definition that now uses a global declared after it (a body
+        inlined from a function defined later: ``float f(); void main() { ... f() ... }
+        float k; float f() { return k; }``; a variable, or a struct type) to right after the
+        last such declaration, leaving a prototype in its place (none for ``main``)."""
+        decls = self.unit.decls
+        defs = [i for i, x in enumerate(decls) if isinstance(x, A.FunctionDecl) and x.body is not None]
+        if not defs or not any(not isinstance(x, A.FunctionDecl) for x in decls[defs[0] + 1:]):
+            return   # every global is declared before the first definition (the usual layout)
+        pos = {id(x): i for i, x in enumerate(decls)}
+        struct_pos = {x.type.spec.struct.name: i for i, x in enumerate(decls)
+                      if isinstance(x, A.VariableDecl) and x.type.spec.struct is not None
+                      and x.type.spec.struct.name}
+        after: dict[int, list] = {}
+        moved: dict[int, A.FunctionDecl] = {}
+        for i, d in enumerate(decls):
+            if not isinstance(d, A.FunctionDecl) or d.body is None:
+                continue
+            last = -1
+            for n in walk(d.body):
+                if isinstance(n, A.Ident) and n.symbol is not None \
+                        and id(getattr(n.symbol, "decl", None)) in self.global_copy:
+                    last = max(last, pos.get(id(self.global_copy[id(n.symbol.decl)]), -1))
+                elif isinstance(n, (A.TypeSpecifier, A.Call)) and n.name in struct_pos:
+                    last = max(last, struct_pos[n.name])
+            if last > i:
+                after.setdefault(id(decls[last]), []).append(d)
+                moved[id(d)] = d
+        if not moved:
+            return
+        out = []
+        for x in decls:
+            if id(x) in moved:
+                if x.name != "main":
+                    out.append(A.FunctionDecl(x.return_type, x.name, clone(x.params), None,
+                                              loc=x.loc))
+            else:
+                out.append(x)
+            out.extend(after.get(id(x), ()))
+        self.unit.decls = out
 
     def _target(self, call: A.Call) -> Optional[A.FunctionDecl]:
         if call.kind != "function" or not isinstance(call.target, A.FunctionDecl):
@@ -221,7 +306,7 @@ class _Inliner:
         if id(d) in done:
             return
         done.add(id(d))
-        for n in walk(d.body):
+        for n in walk(d.body, decl_types=False):
             if isinstance(n, A.Call):
                 t = self._target(n)
                 if t is not None:
@@ -241,7 +326,7 @@ class _Inliner:
         if any(param_qualifier(p) != "in" for p in d.params):
             return True
         local = {p.name for p in d.params if p.name}
-        for n in walk(d.body):
+        for n in walk(d.body, decl_types=False):
             if isinstance(n, A.Declarator):
                 local.add(n.name)
             elif isinstance(n, A.Call):
@@ -261,7 +346,7 @@ class _Inliner:
                         return True
         return False
 
-    def _prune(self) -> A.TranslationUnit:
+    def _prune(self) -> None:
         """Drop functions (and prototypes) no longer called from main or a kept function."""
         by_name: dict[str, list[A.FunctionDecl]] = {}
         for d in self.defs:
@@ -270,7 +355,7 @@ class _Inliner:
         stack = [d for d in self.defs if d.name == "main"]
         roots = [x for x in self.unit.decls if not isinstance(x, A.FunctionDecl)]
         for r in roots:
-            for n in walk(r):
+            for n in walk(r, decl_types=False):
                 if isinstance(n, A.Call) and n.name in by_name:
                     stack.extend(by_name[n.name])
         while stack:
@@ -278,7 +363,7 @@ class _Inliner:
             if id(d) in keep:
                 continue
             keep.add(id(d))
-            for n in walk(d.body):
+            for n in walk(d.body, decl_types=False):
                 if isinstance(n, A.Call) and n.name in by_name:
                     stack.extend(by_name[n.name])
         kept_names = {d.name for d in self.defs if id(d) in keep}
@@ -291,7 +376,6 @@ class _Inliner:
                     continue
             decls.append(x)
         self.unit.decls = decls
-        return self.unit
 
     # ------------------------------------------------------------------ predicates
     def has_call(self, e) -> bool:
@@ -306,7 +390,7 @@ class _Inliner:
                 t = self._target(e)
                 got = t is not None and self.inlinable.get(id(t), False)
             if not got:
-                got = any(self.has_call(c) for c in children(e))
+                got = any(self.has_call(c) for c in children(e, decl_types=False))
             self._calls_memo[key] = (e, got)
         return got
 
@@ -324,7 +408,7 @@ class _Inliner:
                     or getattr(e.target, "side_effects", False)):
                 got = True
             else:
-                got = any(self.has_effects(c) for c in children(e))
+                got = any(self.has_effects(c) for c in children(e, decl_types=False))
             self._effects_memo[key] = (e, got)
         return got
 
@@ -464,6 +548,16 @@ class _Inliner:
             if not (self.has_call(e.then) or self.has_call(e.else_)):
                 e.cond = cond
                 return e
+            if e.type is not None and e.type.is_void:   # ``c ? f() : g();`` as a statement
+                arms = []
+                for branch in (e.then, e.else_):
+                    inner: list = []
+                    v = self.expr(branch, inner, value_used=False)
+                    if v is not None:
+                        inner.append(A.ExprStmt(v, loc=branch.loc))
+                    arms.append(A.Compound(inner, loc=e.loc))
+                pre.append(A.If(cond, arms[0], arms[1], loc=e.loc))
+                return None
             name = self.names.fresh("sel")
             pre.append(declare_typed(name, e.type, None, e.loc))
             branches = []
@@ -515,7 +609,7 @@ class _Inliner:
         return out
 
     def _effects_call(self, e) -> bool:
-        for n in walk(e):
+        for n in walk(e, decl_types=False):
             if isinstance(n, A.Call):
                 t = self._target(n)
                 if t is not None and self.effectful.get(id(t), True):

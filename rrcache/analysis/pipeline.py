@@ -15,24 +15,27 @@ import dataclasses
 
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import paused_gc
+from rrcache.glsl.rewrite import paused_gc
 from rrcache.analysis.compound import expand_unit
 from rrcache.analysis.inline import inline_unit
-from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL, unroll_unit
+from rrcache.analysis.unroll import (
+    DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_SIZE, DEFAULT_MAX_TOTAL, unroll_unit,
+)
 
 __all__ = ["analyse"]
 
 
 def analyse(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-            max_total: int = DEFAULT_MAX_TOTAL):
+            max_total: int = DEFAULT_MAX_TOTAL, max_size: int = DEFAULT_MAX_SIZE):
     """The analysed copy of ``shader``: every call inlined, constant loops unrolled (at most
-    ``max_iterations`` per loop, ``max_total`` body copies in all), compound assignments
-    expanded, type-checked again. A valid program equivalent to the input; node ids
+    ``max_iterations`` per loop, ``max_total`` body copies and ``max_size`` syntax nodes of
+    copies in all; see :mod:`rrcache.analysis.unroll`), compound assignments expanded,
+    type-checked again. A valid program equivalent to the input; node ids
     (:func:`rrcache.analysis.find_node`) refer to it. The input is not modified.
     """
     with paused_gc():
         unit = inline_unit(shader.unit)
-        unit = unroll_unit(unit, shader.info, max_iterations, max_total)
+        unit = unroll_unit(unit, shader.info, max_iterations, max_total, max_size)
         unit = expand_unit(unit)
         info = check(unit, shader.path or "<string>")
     return dataclasses.replace(shader, unit=unit, info=info)

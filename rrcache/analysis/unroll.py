@@ -10,8 +10,11 @@ cacheable (the paper lists this as future work). A ``for`` loop is unrolled when
   ``i = i - c``;
 - the body does not write the variable and has no ``break``/``continue`` of this loop;
 - the trip count, simulated in the variable's own precision (``float`` loops in single
-  precision), is at most ``max_iterations``, and the total number of body copies made in the
-  shader stays within ``max_total``.
+  precision), is at most ``max_iterations``, the total number of body copies made in the
+  shader stays within ``max_total``, and the syntax nodes of all the copies stay within
+  ``max_size`` (a total-size budget: a shader of many loops, or of loops whose bodies inline
+  large functions, stops unrolling when the analysed program would outgrow it; loops are
+  unrolled in program order while the budget lasts and the remaining ones are left rolled).
 
 "Constant" means literals, ``const`` globals, and locals initialised with a constant and not
 written before the loop (so ``int n = 5; for (int i = 0; i < n; i++)`` and an inlined parameter
@@ -20,6 +23,14 @@ variable is replaced by its value as a literal and the body's locals get fresh n
 (``_rr_<name>_<n>``); an assigned (not declared) loop variable gets its exit value after the
 copies. Nested loops unroll inside out once the outer variable is a literal. Other loops are
 left as they are (the cacheable-node analysis treats what is inside them as ``dynamic``).
+
+Constants are evaluated as GLSL does: ``int``/``uint`` wrap to 32 bits (``-1u`` is
+``0xFFFFFFFF``; a ``uint`` loop may count down through zero), ``float`` in single precision,
+comparisons and ``&&``/``||``/``^^``/``!`` to ``bool``. An ``if`` or ``?:`` whose condition
+became constant in a copy (``if (i > 0)`` with ``i`` = 0) keeps only the branch taken, since the
+other may index an array out of range (``a[i - 1]``), which is a compile error once the index
+is constant. A loop with a copy that still holds such an index (under a guard this pass does
+not decide, ``i > 0 && a[i - 1] > x``) is left rolled.
 
 >>> from rrcache.glsl.frontend import parse_shader
 >>> from rrcache.glsl.printer import print_glsl
@@ -39,14 +50,18 @@ import numpy as np
 from rrcache.glsl import ast as A
 from rrcache.glsl.semantic import check
 
-from rrcache.analysis._tree import (
-    InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped, walk, written_roots,
-)
+from rrcache.glsl.ast import walk
+from rrcache.glsl.rewrite import InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped
+from rrcache.glsl.writes import written_roots
 
-__all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL"]
+__all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL",
+           "DEFAULT_MAX_SIZE"]
 
 DEFAULT_MAX_ITERATIONS = 64
 DEFAULT_MAX_TOTAL = 4096
+#: the syntax nodes all unrolled copies may add (the paper scenes add under 3,000; node analysis
+#: runs at roughly 10-30k expression nodes per second, see docs/bench_frontend.md)
+DEFAULT_MAX_SIZE = 60_000
 _COMPARE = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
             "!=": np.not_equal, "==": np.equal}
 _FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!=", "==": "=="}
@@ -54,7 +69,7 @@ _DTYPE = {"int": np.int32, "uint": np.uint32, "float": np.float32}
 
 
 def unroll_loops(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                 max_total: int = DEFAULT_MAX_TOTAL):
+                 max_total: int = DEFAULT_MAX_TOTAL, max_size: int = DEFAULT_MAX_SIZE):
     """Return a copy of ``shader`` with its constant-trip-count ``for`` loops unrolled (see the
     module docstring). The input is not modified; the result is type-checked again.
 
@@ -65,19 +80,21 @@ def unroll_loops(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     >>> "for" in print_glsl(unroll_loops(s, max_iterations=10).unit)
     True
     """
-    unit = unroll_unit(clone(shader.unit), shader.info, max_iterations, max_total)
+    unit = unroll_unit(clone(shader.unit), shader.info, max_iterations, max_total, max_size)
     info = check(unit, shader.path or "<string>")
     return dataclasses.replace(shader, unit=unit, info=info)
 
 
 def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                max_total: int = DEFAULT_MAX_TOTAL) -> A.TranslationUnit:
+                max_total: int = DEFAULT_MAX_TOTAL,
+                max_size: int = DEFAULT_MAX_SIZE) -> A.TranslationUnit:
     """The unrolling pass, in place on ``unit`` (a copy the caller owns). ``info`` is the
     :class:`SemanticInfo` of the input (for the values of ``const`` globals)."""
     consts = {name: sym.const_value for name, sym in info.globals.items()
               if sym.kind == "const" and isinstance(sym.const_value, (int, float, bool))
               and not sym.type.dims}
-    u = _Unroller(unit, consts, max_iterations, max_total)
+    u = _Unroller(unit, consts, max_iterations, max_total, max_size)
+    u.const_bases = {name: info.globals[name].type.base for name in consts}
     for d in unit.decls:
         if isinstance(d, A.FunctionDecl) and d.body is not None:
             u.scopes = [{}]
@@ -88,13 +105,26 @@ def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX
     return unit
 
 
+def fold_copy(body: A.Compound, unit: A.TranslationUnit) -> list:
+    """Fold what one copy of a loop body made constant once its index is a literal (an ``if`` or
+    ``?:`` on the index keeps the branch taken, inner constant loops unroll), as this pass does to
+    each iteration's copy; returns the copy's statements. Used by
+    :mod:`rrcache.compiler.amortize` for the subsets it unrolls."""
+    u = _Unroller(unit, {}, DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL)
+    while A.substitute(body, u.constant_choice, u.chosen_arm):
+        pass
+    return u.stmt(body)
+
+
 class _Unroller:
-    def __init__(self, unit, consts, max_iterations, max_total):
+    def __init__(self, unit, consts, max_iterations, max_total, max_size=DEFAULT_MAX_SIZE):
         self.consts = consts
         self.max_iterations = max_iterations
         self.budget = max_total
+        self.size_budget = max_size
         self.names = NameAllocator(unit)
         self.scopes: list[dict[str, Optional[tuple[str, object]]]] = [{}]
+        self.const_bases: dict[str, str] = {}
 
     # ------------------------------------------------------------------ constants
     def lookup(self, name: str):
@@ -104,7 +134,9 @@ class _Unroller:
         v = self.consts.get(name)
         if v is None:
             return None
-        return ("float" if isinstance(v, float) else "bool" if isinstance(v, bool) else "int", v)
+        if isinstance(v, bool):
+            return ("bool", v)
+        return _scalar("float" if isinstance(v, float) else self.const_bases.get(name, "int"), v)
 
     def invalidate(self, name: str) -> None:
         for scope in reversed(self.scopes):
@@ -113,18 +145,25 @@ class _Unroller:
                 return
 
     def const(self, e) -> Optional[tuple[str, object]]:
-        """``(base, value)`` of a constant scalar expression, or None."""
+        """``(base, value)`` of a constant scalar expression (``int``/``uint`` wrapped to 32
+        bits, ``float`` in single precision, ``bool`` from comparisons and logic), or None."""
         if isinstance(e, A.IntLit):
-            return ("uint" if e.unsigned else "int", e.value)
+            return _scalar("uint" if e.unsigned else "int", e.value)
         if isinstance(e, A.FloatLit) and not e.double:
-            return ("float", float(np.float32(e.value)))
+            return _scalar("float", e.value)
+        if isinstance(e, A.BoolLit):
+            return ("bool", bool(e.value))
         if isinstance(e, A.Ident):
             return self.lookup(e.name)
-        if isinstance(e, A.Unary) and e.op in ("-", "+"):
+        if isinstance(e, A.Unary) and e.op in ("-", "+", "!"):
             v = self.const(e.operand)
-            if v is None or v[0] not in _DTYPE:
+            if v is None:
                 return None
-            return (v[0], -v[1] if e.op == "-" else v[1])
+            if e.op == "!":
+                return ("bool", not v[1]) if v[0] == "bool" else None
+            if v[0] not in _DTYPE:
+                return None
+            return _scalar(v[0], -v[1] if e.op == "-" else v[1])
         if isinstance(e, A.Binary) and e.op in ("+", "-", "*"):
             a, b = self.const(e.left), self.const(e.right)
             if a is None or b is None or a[0] != b[0] or a[0] not in _DTYPE:
@@ -133,11 +172,22 @@ class _Unroller:
             with np.errstate(all="ignore"):
                 r = x + y if e.op == "+" else x - y if e.op == "-" else x * y
             return (a[0], r.item())
+        if isinstance(e, A.Binary) and e.op in _COMPARE:
+            a, b = self.const(e.left), self.const(e.right)
+            if a is None or b is None or a[0] != b[0] or a[0] not in _DTYPE:
+                return None
+            return ("bool", bool(_COMPARE[e.op](a[1], b[1])))
+        if isinstance(e, A.Binary) and e.op in ("&&", "||", "^^"):
+            a, b = self.const(e.left), self.const(e.right)
+            if a is None or b is None or a[0] != "bool" or b[0] != "bool":
+                return None
+            return ("bool", a[1] and b[1] if e.op == "&&" else a[1] or b[1] if e.op == "||"
+                    else a[1] != b[1])
         if isinstance(e, A.Call) and e.name in ("int", "float", "uint") and len(e.args) == 1:
             v = self.const(e.args[0])
             if v is None or v[0] not in _DTYPE:
                 return None
-            return (e.name, _DTYPE[e.name](v[1]).item())
+            return _scalar(e.name, v[1])
         return None
 
     # ------------------------------------------------------------------ statements
@@ -170,7 +220,7 @@ class _Unroller:
                 v = self.const(d.init)
                 base = decl.type.spec.name
                 if v is not None and base in _DTYPE and v[0] in _DTYPE:
-                    value = (base, _DTYPE[base](v[1]).item())
+                    value = _scalar(base, v[1])
                 elif v is not None and base == v[0]:
                     value = v
             self.scopes[-1][d.name] = value
@@ -189,6 +239,15 @@ class _Unroller:
                 self.writes(s.expr)
             return [s]
         if isinstance(s, A.If):
+            cond = self.const(s.cond)
+            if cond is not None and cond[0] == "bool":
+                # a condition made constant by unrolling (``if (i > 0)`` with i = 0): keep the
+                # branch taken only; the other may index out of range (``a[i - 1]``)
+                taken = s.then if cond[1] else s.else_
+                if taken is None:
+                    return []
+                got = self.sub(taken)
+                return [got if isinstance(got, A.Compound) else A.Compound([got], loc=got.loc)]
             self.writes(s.cond)
             s.then = self.sub(s.then)
             s.else_ = self.sub(s.else_)
@@ -256,30 +315,67 @@ class _Unroller:
             return None
         dtype = _DTYPE[base]
         values = []
-        try:
-            v, b, dv = dtype(start), dtype(bound[1]), dtype(delta[1])
-        except (OverflowError, ValueError):
+        # the three in the loop variable's type (``k--`` on a uint steps by 0xFFFFFFFF)
+        start, stop, step_by = (_scalar(base, x) for x in (start, bound[1], delta[1]))
+        if start is None or stop is None or step_by is None:
             return None
+        v, b, dv = dtype(start[1]), dtype(stop[1]), dtype(step_by[1])
         with np.errstate(all="ignore"):
             while bool(_COMPARE[op](v, b)):
                 values.append(v.item())
                 if len(values) > min(self.max_iterations, self.budget):
                     return None
                 v = dtype(v + dv)
+        budget = self.budget
+        size = sum(1 for _ in walk(s.body)) * len(values)
+        if size > self.size_budget:
+            return None       # over the total-size budget: left rolled (its nodes are dynamic)
         self.budget -= len(values)
+        self.size_budget -= size
         loc = s.loc
         copies: list = []
         for value in values:
             body = clone(s.body, _iteration_loc(f"for {_display(name)}={value}", loc))
             body = body if isinstance(body, A.Compound) else A.Compound([body], loc=body.loc)
             rewrite_scoped(body, {name: _literal(base, value)}, self.names.fresh)
+            while A.substitute(body, self.constant_choice, self.chosen_arm):
+                pass
             copies.extend(self.stmt(body))
+        if any(self.out_of_range(n) for c in copies for n in walk(c, decl_types=False)):
+            # a constant index out of range left in a copy (``a[i - 1]`` under a guard this
+            # pass does not decide): the unrolled program would not compile; keep the loop
+            self.budget = budget
+            self.size_budget += size
+            return None
         if not declared:
             exit_value = _literal(base, v.item())(A.Ident(name, loc=loc))
             copies.append(A.ExprStmt(A.Assign("=", A.Ident(name, loc=loc), exit_value, loc=loc),
                                      loc=loc))
             self.invalidate(name)
         return [A.Compound(copies, loc=loc)] if declared else copies
+
+    def constant_choice(self, n) -> bool:
+        """``c ? a : b`` with ``c`` constant (after the loop variable became a literal)."""
+        if not isinstance(n, A.Ternary):
+            return False
+        c = self.const(n.cond)
+        return c is not None and c[0] == "bool"
+
+    def chosen_arm(self, n: A.Ternary) -> A.Expr:
+        return n.then if self.const(n.cond)[1] else n.else_
+
+    def out_of_range(self, n) -> bool:
+        """An index this pass knows to be constant and outside its array, vector or matrix."""
+        if not isinstance(n, A.Index):
+            return False
+        t = getattr(n.obj, "type", None)
+        if t is None:
+            return False
+        bound = t.dims[0] if t.dims else t.cols if t.is_matrix else t.size if t.is_vector else None
+        v = self.const(n.index)
+        if v is None or v[0] not in ("int", "uint") or bound is None:
+            return False
+        return v[1] < 0 or v[1] >= bound
 
     def loop_header(self, s: A.For):
         """``(name, base, start, declared)`` of a loop variable with a constant start."""
@@ -305,6 +401,22 @@ class _Unroller:
                 return None
             return t.name, base, v[1], False
         return None
+
+
+def _scalar(base: str, value) -> Optional[tuple[str, object]]:
+    """``(base, value)`` with ``value`` converted as GLSL does: ``int``/``uint`` wrap to 32 bits
+    (``-1u`` is 4294967295), ``float`` is rounded to single precision; a ``float`` too large
+    for an integer type (undefined in GLSL) gives None."""
+    if base == "float":
+        return ("float", float(np.float32(value)))
+    if isinstance(value, float):
+        if not np.isfinite(value) or not -2.0 ** 31 <= value < 2.0 ** 32:
+            return None
+        value = int(value)   # towards zero, as GLSL converts
+    value = int(value)
+    if base == "uint":
+        return ("uint", value & 0xFFFFFFFF)
+    return ("int", (value + 2 ** 31) % 2 ** 32 - 2 ** 31)
 
 
 def _literal(base: str, value):
@@ -363,7 +475,7 @@ def _breaks(s, depth: int = 0) -> bool:
     if isinstance(s, (A.For, A.While, A.DoWhile)):
         return False
     if isinstance(s, A.Switch):
-        return any(isinstance(n, A.Continue) for n in walk(s.body)
+        return any(isinstance(n, A.Continue) for n in walk(s.body, decl_types=False)
                    if not isinstance(n, (A.For, A.While, A.DoWhile)))
     if isinstance(s, A.Compound):
         return any(_breaks(x) for x in s.stmts)

@@ -123,14 +123,16 @@ class CacheBench:
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
         progress: Optional[Callable[[str, int, int], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
-        limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT) -> CacheBench:
+        limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT, vertex: Optional[str] = None,
+        include_dirs=()) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
     ``limit_algorithm``; every render draws into a ``color_format`` colour target (the errors
-    are then those of that format). ``progress(message, done, total)`` before each step."""
+    are then those of that format). ``progress(message, done, total)`` after each step.
+    ``vertex``: the user's vertex shader (None: the session's, else generated)."""
     step = {"done": 0}
     session = load_session(session_path)
-    work = load_for_session(shader_path, session)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
@@ -138,8 +140,11 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
                        compare_period=compare_period, color_format=color_format)
 
     plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
+    # only the algorithms the node table allows for this node (one-pass cannot cache a value
+    # that needs screen-space derivatives)
     plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period)
-             for algorithm in ("three-pass", "two-pass", "one-pass")]
+             for algorithm in ("three-pass", "two-pass", "one-pass")
+             if algorithm in getattr(entry, "algorithms", ("three-pass", "two-pass", "one-pass"))]
     plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period) for block in blocks]
     if periods:
         plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH))
@@ -234,14 +239,15 @@ class Breakdown:
 def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("three-pass", "two-pass"),
               formats=("rgba32f", "rgba8"), frames: int = 60, resolution: Optional[tuple[int, int]] = None,
               period: int = 16, repeats: int = 3, payloads=("f4",),
-              progress: Optional[Callable[[str, int, int], None]] = None) -> Breakdown:
+              progress: Optional[Callable[[str, int, int], None]] = None, vertex: Optional[str] = None,
+              include_dirs=()) -> Breakdown:
     """Measure the all-hit frame stage by stage for every algorithm, colour format and payload
     precision (see :class:`Breakdown`); the configurations take turns within each repeat. (A
     16-bit payload is used as asked: its range is not checked here.)"""
     from rrcache.harness.limit import all_hit_breakdown
 
     session = load_session(session_path)
-    work = load_for_session(shader_path, session)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
     work.node(node_id)
     indices = probe_frames(range(min(frames, session.frames)), 3)
     size = tuple(resolution or session.resolution)

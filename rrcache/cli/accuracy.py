@@ -19,6 +19,7 @@ from rich.table import Table
 
 from rrcache.jsonable import finite_json
 from rrcache.profiler.accuracy import DEFAULT_PERIODS, held_out
+from rrcache.cli.options import include_dirs_option
 from rrcache.profiles.document import load_profile
 from rrcache.profiles.settings import parse_periods
 
@@ -29,9 +30,11 @@ from rrcache.profiles.settings import parse_periods
               help="Held-out refresh periods, comma-separated.")
 @click.option("--nodes", default=None, help="Node ids to measure (default: the Pareto front and the selections).")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-def command(profile_path, periods, nodes, as_json):
+@include_dirs_option
+def command(profile_path, periods, nodes, as_json, include_dirs):
     """Check the profile's models at refresh periods they were not trained on."""
     prof = load_profile(profile_path)
+    prof.include_dirs = list(include_dirs) + prof.include_dirs
     chosen = [n.strip() for n in nodes.split(",") if n.strip()] if nodes else None
     err_console = Console(stderr=True)
     with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),

@@ -14,7 +14,7 @@ import json
 import click
 from rich.console import Console
 
-from rrcache.cli.options import resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 
@@ -41,8 +41,10 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
 @quiet_option
+@vert_option
+@include_dirs_option
 def command(shader, session, node, periods, compare_period, frames, repeats, resolution, timing_format, breakdown,
-            formats, payloads, algorithms, as_json, markdown, quiet):
+            formats, payloads, algorithms, as_json, markdown, quiet, vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import breakdown as run_breakdown, run
 
@@ -67,10 +69,11 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
             bench = run_breakdown(shader, session, node, algorithms=tuple(algorithm_list), formats=tuple(format_list),
                                   payloads=tuple(payload_list), frames=frames,
                                   resolution=resolution, period=compare_period, repeats=repeats,
-                                  progress=reporter.update)
+                                  progress=reporter.update, vertex=vert, include_dirs=include_dirs)
         else:
             bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution,
-                        repeats=repeats, progress=reporter.update, color_format=timing_format)
+                        repeats=repeats, progress=reporter.update, color_format=timing_format, vertex=vert,
+                        include_dirs=include_dirs)
     if as_json:
         click.echo(json.dumps(bench.to_json()))
     else:

@@ -13,11 +13,30 @@ from rich.table import Table
 @click.option("--lines", default=3000, show_default=True, help="Size of the synthetic large shader.")
 @click.option("--repeat", default=3, show_default=True, help="Runs per shader (the median is reported).")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of a table.")
-def command(shader, lines, repeat, as_json):
+@click.option("--generated", "generated", multiple=True, type=click.IntRange(min=50), metavar="LINES",
+              help="Also time node analysis, with its peak memory, of generated large shaders of this "
+                   "many lines (a library-shaped and an ES-sketch-shaped one; repeatable), each in a "
+                   "fresh process.")
+def command(shader, lines, repeat, as_json, generated):
     """Time preprocessing+parsing+type checking and analysis of SHADER and of a large shader made
     from it."""
-    from rrcache.bench.frontend import run
+    from rrcache.bench.frontend import run, run_generated
 
+    if generated:
+        rows = run_generated(generated, repeat=repeat)
+        if as_json:
+            click.echo(json.dumps(rows))
+            return
+        table = Table(title="node analysis of generated shaders (fresh process each; median of %d)" % repeat)
+        for col in ("shader", "lines", "AST exprs", "parse s", "analyse s", "CPU s", "µs/expr", "peak MB"):
+            table.add_column(col, justify="right" if col != "shader" else "left")
+        for r in rows:
+            table.add_row(r["shader"], str(r["lines"]), str(r["exprs"]), f"{r['parse_s']:.2f}",
+                          f"{r['analyse_s']:.2f}", f"{r['analyse_cpu_s']:.2f}",
+                          f"{1e6 * r['analyse_cpu_s'] / max(1, r['exprs']):.0f}",
+                          str(r["rss_peak_mb"]))
+        Console().print(table)
+        return
     timings = run(shader, lines, repeat)
     if as_json:
         click.echo(json.dumps([dict(name=t.name, lines=t.lines, parse_s=t.parse_s, analyse_s=t.analyse_s,

@@ -1,5 +1,10 @@
 """``rrcache instance SHADER --node ID --period N --out DIR``: write a cached variant's shaders.
 
+``rrcache instance SHADER --estimator e1 --samples 4 --lambda 0.6 --out DIR`` writes an
+amortized variant instead (:mod:`rrcache.compiler.amortize`; the manifest's ``amortized`` entry
+gives m, N, λ and the phase cycle: run pass ``<pass>@<k>`` at frames ``k`` mod cycle, set
+``rr_lambda`` to λ).
+
 Writes ``<pass>.vert`` and ``<pass>.frag`` for every pass of the algorithm and ``manifest.json``
 (node, period, algorithm, filter, payload precision, the uniforms and textures each pass expects
 and the ``rr_`` uniforms the runtime sets). Load them in an application with
@@ -9,29 +14,53 @@ from __future__ import annotations
 
 import click
 
-from rrcache.cli.options import parse_defines
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
 
 @click.command("instance")
 @click.argument("shader", type=click.Path(dir_okay=False))
-@click.option("--node", required=True, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True,
-              help="Refresh period Δn.")
+@click.option("--node", default=None, metavar="ID", help="The node to cache (an id from `rrcache nodes`).")
+@click.option("--estimator", default=None, metavar="ID",
+              help="Amortize this estimator instead (an id from `rrcache nodes --json`).")
+@click.option("--samples", type=click.IntRange(min=1), default=4, show_default=True,
+              help="With --estimator: samples evaluated per frame at hits (m).")
+@click.option("--lambda", "blend", type=click.FloatRange(0.0, 1.0, max_open=True), default=0.6, show_default=True,
+              help="With --estimator: weight of the reprojected estimate (λ).")
+@click.option("--history", type=click.Choice(["blend", "slots"]), default="blend", show_default=True)
+@click.option("--period", type=PERIOD, default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Take the MODEL_VERTEX_* defines from this session's meshes.")
+@include_dirs_option
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
-def command(shader, node, period, algorithm, filter_, payload, session, defines, out_dir):
-    """Write the shaders of the variant of SHADER that caches --node, and a manifest."""
+@vert_option
+def command(shader, node, estimator, samples, blend, history, period, algorithm, filter_, payload, session, defines,
+            include_dirs, out_dir, vert):
+    """Write the shaders of the variant of SHADER that caches --node (or amortizes --estimator),
+    and a manifest."""
     from rrcache.pipeline import load_for_session, variant_for
     from rrcache.session import load_session
 
+    if (node is None) == (estimator is None):
+        raise click.UsageError("give either --node or --estimator")
     loaded = load_session(session) if session else None
-    work = load_for_session(shader, loaded, parse_defines(defines))
+    work = load_for_session(shader, loaded, parse_defines(defines), include_dirs, vertex=vert)
+    if estimator is not None:
+        from rrcache.compiler.amortize import instance_amortized
+
+        variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend,
+                                     filter=filter_, payload_dtype=payload, history=history, vertex=work.vertex)
+        written = variant.write(out_dir)
+        a = variant.amortized
+        click.echo(f"{estimator} ({variant.node_text}, {variant.node_loc}) amortized with {algorithm}: "
+                   f"{a['samples']} of {a['of']} samples per frame, λ = {a['lambda']:g}, {a['history']}:")
+        for path in written:
+            click.echo(f"  {path}")
+        return
     entry = work.node(node)
     variant = variant_for(work, node, algorithm, filter_, payload)
     written = variant.write(out_dir, period=period)

@@ -3,7 +3,12 @@ from __future__ import annotations
 
 import click
 
+from rrcache.budgets import MAX_PERIOD
 from rrcache.harness.renderer import parse_resolution
+
+
+#: the ``--period`` type of every command: Δn from 1 to :data:`rrcache.budgets.MAX_PERIOD`
+PERIOD = click.IntRange(min=1, max=MAX_PERIOD)
 
 
 def parse_defines(items) -> dict[str, str]:
@@ -22,6 +27,14 @@ def parse_defines(items) -> dict[str, str]:
     return defines
 
 
+def include_dirs_option(fn):
+    """``-I DIR`` (repeatable): folders where ``#include`` files are looked up after the including
+    file's own folder, as compilers do (a session's ``"include_dirs"`` come after these)."""
+    return click.option("-I", "include_dirs", multiple=True, type=click.Path(file_okay=False), metavar="DIR",
+                        help="Look for #include files in DIR too (repeatable); includes are read only from "
+                             "the shader's folder tree and these folders.")(fn)
+
+
 def resolution_option(ctx, param, value):
     """click callback: ``WxH`` → ``(w, h)`` (None stays None)."""
     if value is None:
@@ -30,3 +43,11 @@ def resolution_option(ctx, param, value):
         return parse_resolution(value)
     except ValueError as err:
         raise click.BadParameter(str(err)) from None
+
+
+#: ``--vert FILE``: the user's vertex shader (glslViewer's .vert), on every command that renders or
+#: compiles; it wins over a session's ``"vertex"``.
+vert_option = click.option(
+    "--vert", "vert", type=click.Path(dir_okay=False), default=None, metavar="FILE",
+    help="The vertex shader paired with SHADER (a glslViewer .vert); default: the session's "
+         "\"vertex\", else a generated one.")

@@ -23,11 +23,11 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.harness.timing import UNRELIABLE_NOISE
 from rrcache.model.psnr import VISIBLE_DB, psnr_text
-from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
 from rrcache.profiles.document import algorithm_line
@@ -38,7 +38,13 @@ from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_
 def _periods(ctx, param, value):
     if value is None:
         return None
-    return parse_periods(value, "--periods")
+    return parse_periods(value, param.opts[0])  # the option given: --periods or --timing-periods
+
+
+def _seconds(ctx, param, value):
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter(f"{value} is not a finite number of seconds (e.g. 480)")
+    return value
 
 
 def _fmt(value, spec=".3g", none="–"):
@@ -71,7 +77,7 @@ def _fmt(value, spec=".3g", none="–"):
               help="Refresh periods at which each node is timed (default: 2,8,50).")
 @click.option("--algorithm", type=click.Choice(ALGORITHM_CHOICES), default="auto", show_default=True,
               help="auto: time three-pass and two-pass on the first node and keep the faster.")
-@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
               help=f"Skip nodes whose static cost is below this share of the costliest node's "
@@ -90,11 +96,15 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--levels", type=click.Choice(LEVEL_KINDS), default="psnr", show_default=True,
               help="The four selection levels e1..e4: psnr = predicted PSNR against the original >= 45, 40, 35, "
                    "30 dB; relative = the paper's error thresholds (fractions of the largest error seen).")
+@click.option("--wait", is_flag=True,
+              help="If another rrcache process is profiling into the same --out, wait for it (default: exit 2).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @quiet_option
+@vert_option
+@include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
             algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            defines, quiet):
+            wait, defines, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -115,7 +125,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         with Reporter(err_console, quiet=quiet) as reporter, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh)
+                prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
+                               vertex=vert, include_dirs=include_dirs, wait=wait)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

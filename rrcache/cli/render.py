@@ -28,11 +28,12 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from rrcache.cli.options import parse_defines, resolution_option
+from rrcache.cli.options import PERIOD, include_dirs_option, parse_defines, resolution_option, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT, ERROR_FORMAT
 from rrcache.harness.timing import frame_noise, load_warning
 from rrcache.jsonable import finite_json
+from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
@@ -53,9 +54,9 @@ from rrcache.session import load_session
               help="Render at this size instead of the session's.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@include_dirs_option
 @click.option("--node", default=None, metavar="ID", help="Cache this node (an id from `rrcache nodes`).")
-@click.option("--period", type=click.IntRange(min=1), default=DEFAULT_PERIOD, show_default=True,
-              help="Refresh period Δn.")
+@click.option("--period", type=PERIOD, default=DEFAULT_PERIOD, show_default=True, help="Refresh period Δn.")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--block", type=click.Choice([str(b) for b in BLOCK_SIZES]), default=str(DEFAULT_BLOCK),
               show_default=True, help="Refresh block size k (pixels).")
@@ -74,8 +75,9 @@ from rrcache.session import load_session
               help="With --node: run the side-by-side comparison this many times (the speed-up is the "
                    "median repeat, with the range).")
 @quiet_option
-def command(shader, session, out_dir, frame_count, resolution, as_json, defines, node, period, algorithm,
-            block, refresh, filter_, payload, depth_epsilon, color_format, repeats, quiet):
+@vert_option
+def command(shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, node, period, algorithm,
+            block, refresh, filter_, payload, depth_epsilon, color_format, repeats, quiet, vert):
     """Render SESSION through the fragment shader SHADER and report time and coverage per frame;
     with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
@@ -83,12 +85,12 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
     if color_format == "auto":
         color_format = ERROR_FORMAT if out_dir else DEFAULT_TIMING_FORMAT
     if node is not None:
-        _render_cached(shader, loaded, parse_defines(defines), node, out_dir, frame_count, resolution, as_json,
+        _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
                             filter=filter_, payload=payload, depth_epsilon=depth_epsilon,
-                            color_format=color_format, repeats=repeats), err_console, quiet)
+                            color_format=color_format, repeats=repeats), err_console, vert, quiet)
         return
-    prepared = prepare_file(shader, loaded, parse_defines(defines))
+    prepared = prepare_file(shader, loaded, parse_defines(defines), all_include_dirs(include_dirs, loaded), vertex=vert)
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:
@@ -105,14 +107,16 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                 write_image(stem.with_suffix(".png"), frame.image)
             reporter.update("rendering", len(nonfinite), len(indices))
 
-        result = render(prepared, loaded, indices, resolution=resolution, progress=done, color_format=color_format)
+        # streamed: each frame's figures are taken (and its images written) as it is done
+        result = render(prepared, loaded, indices, resolution=resolution, progress=done, keep_images=False,
+                        color_format=color_format)
 
     noise = frame_noise([f.ms for f in result.frames])
     warning = load_warning(noise)
     if warning:
         err_console.print(f"warning: {warning}", highlight=False, markup=False)
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     if as_json:
         click.echo(json.dumps({
             "frames": len(result.frames),
@@ -141,12 +145,12 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
                   + (f"; images in {out}" if out is not None else ""), highlight=False)
 
 
-def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resolution, as_json, opts, err_console,
-                   quiet=False):
+def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_count, resolution, as_json, opts,
+                   err_console, vert=None, quiet=False):
     from rrcache.harness.cached import compare
     from rrcache.pipeline import load_for_session, variant_for
 
-    work = load_for_session(shader, loaded, defines)
+    work = load_for_session(shader, loaded, defines, include_dirs, vertex=vert)
     entry = work.node(node)
     variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"])
     indices = frame_indices(loaded, frame_count)
@@ -176,7 +180,7 @@ def _render_cached(shader, loaded, defines, node, out_dir, frame_count, resoluti
     speedups = sorted(r.speedup for r in runs)
     result = sorted(runs, key=lambda r: r.speedup)[len(runs) // 2]
     for note in result.notes:
-        err_console.print(f"note: {note}", highlight=False, markup=False)
+        click.echo(f"note: {note}", err=True)  # one line each, never wrapped
     summary = result.summary()
     summary.update(repeats=repeats, speedup_repeats=[r.speedup for r in runs],
                    speedup_range=[speedups[0], speedups[-1]])

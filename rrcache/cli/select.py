@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import click
 
+from rrcache.cli.options import include_dirs_option
 from rrcache.jsonable import finite_json
 from rrcache.model.psnr import VISIBLE_DB, psnr_text
 from rrcache.profiles.document import load_profile
@@ -29,13 +30,15 @@ from rrcache.profiles.document import load_profile
 @click.option("--json", "as_json", is_flag=True, help="Print the choice as JSON.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default=None,
               help="Write the chosen shader files here.")
-def command(profile_path, max_error, min_psnr, as_json, out_dir):
+@include_dirs_option
+def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
     """Select the node and refresh period predicted fastest within --max-error or --min-psnr."""
     import json
 
     if (max_error is None) == (min_psnr is None):
         raise click.UsageError("give one of --max-error and --min-psnr")
     prof = load_profile(profile_path)
+    prof.include_dirs = list(include_dirs) + prof.include_dirs
     choice = prof.select(max_error) if max_error is not None else prof.select_psnr(min_psnr)
     written = prof.write_variant(choice, out_dir) if out_dir else []
     level = f"error {max_error:g}" if max_error is not None else f"PSNR ≥ {min_psnr:g} dB"

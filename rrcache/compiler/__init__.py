@@ -2,7 +2,7 @@
 
 Given the analysed shader (every call inlined into ``main``, constant loops unrolled; see
 :mod:`rrcache.analysis`) and the id of a cacheable node E, :func:`instance` emits the passes of
-the chosen algorithm (Sitthi-amorn et al. 2008a §3, DESIGN.md §3) as ``#version 330 core``
+the chosen algorithm (Sitthi-amorn et al. 2008a §3, docs/design.md §3) as ``#version 330 core``
 fragment shaders with the runtime's GLSL (:mod:`rrcache.runtime.glsl`), each pruned to what the
 pass needs, and their generated vertex shaders:
 
@@ -31,6 +31,8 @@ from __future__ import annotations
 
 from typing import Any, Union
 
+from rrcache.errors import UnsupportedShaderError
+from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.compiler.emit import (
     fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
@@ -41,19 +43,35 @@ from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS
 
-__all__ = ["instance", "Variant", "PassSource"]
+__all__ = ["instance", "check_algorithm", "Variant", "PassSource"]
 
 
+def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: str) -> None:
+    """Raise :class:`UnsupportedShaderError` when ``analysed`` is a node table whose entry for
+    ``node_id`` is not valid for ``algorithm`` (a node that needs screen-space derivatives
+    cannot be cached by one-pass), naming the reason and the algorithms that can."""
+    for n in getattr(analysed, "nodes", None) or ():
+        if (n.id == node_id or n.node is node_id) and algorithm in getattr(n, "invalid", {}):
+            valid = getattr(n, "algorithms", [])
+            raise UnsupportedShaderError(
+                f"node {n.id} '{n.text}' cannot be cached with {algorithm}: "
+                f"{n.invalid[algorithm]}", n.node.loc,
+                f"use --algorithm {' or '.join(valid)}" if valid else "pick another node")
+
+
+@deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4") -> Variant:
+             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 
     ``analysed`` is what the analysis returns (a checked, inlined and unrolled shader);
     ``node_id`` an id of its node table (or the expression node itself). ``filter`` is the
     payload reconstruction filter (``nearest``, ``bilinear``, ``catmull-rom``) and
     ``payload_dtype`` the cache precision (``f4``, or ``f2`` for half floats), recorded for the
-    runtime. Raises :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a
-    node that cannot be cached.
+    runtime. ``vertex`` is the user's vertex shader (a
+    :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
+    :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
+    be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -61,19 +79,23 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
     if payload_dtype not in PAYLOAD_DTYPES:
         raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    check_algorithm(analysed, node_id, algorithm)
     loc = prepare(analysed, node_id)
     passes: dict[str, PassSource] = {}
     uniforms: dict[str, list[str]] = {}
     samplers: dict[str, list[str]] = {}
     runtime: dict[str, list[str]] = {}
     forms: dict[str, str] = {}
+    user_vertex = vertex
     for name in ALGORITHMS[algorithm]:
         built = build_pass(loc, name, filter)
         iface = interface(built.unit)
-        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit))
+        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), user_vertex)
         fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
         passes[name] = PassSource(vertex, fragment, line_map)
-        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_uniforms(vertex)))
+        vertex_names = (user_vertex.uniform_names(built.spec.lookup) if user_vertex is not None
+                        else vertex_uniforms(vertex))
+        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_names))
         samplers[name] = list(iface["sampler"])
         runtime[name] = runtime_uniforms(built.runtime_glsl)
         forms[name] = built.form
@@ -81,4 +103,5 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         algorithm=algorithm, node_id=node_id if not isinstance(node_id, A.Node) else None,
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
-        runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path)
+        runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
+        vertex_path=getattr(user_vertex, "path", None))

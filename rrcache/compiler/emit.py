@@ -5,7 +5,9 @@ core version when higher) with the runtime's GLSL inserted verbatim after the ``
 ``#extension`` lines; its line map (printed line → original place, None for generated lines)
 maps driver errors back to the user's file.
 
-The vertex shader comes from the harness generator (:func:`rrcache.harness.vertex.
+The vertex shader is the user's own when one was given (:mod:`rrcache.harness.user_vertex`:
+``rr_prevClip`` and ``invariant gl_Position`` added, the user's varyings passed through every
+pass), else it comes from the harness generator (:func:`rrcache.harness.vertex.
 vertex_source`), asked for exactly the varyings the fragment shader declares (plus
 ``rr_prevClip`` when the pass reads the previous frame's cache), with ``gl_Position`` declared
 ``invariant``: every pass must produce bit-identical depths, or the depth tests between passes
@@ -79,9 +81,13 @@ def input_locations(unit: A.TranslationUnit) -> dict[str, Optional[SourceLoc]]:
 
 
 def vertex_shader(inputs: dict[str, str], prev_clip: bool,
-                  locs: Optional[dict[str, Optional[SourceLoc]]] = None) -> str:
-    """The generated vertex shader writing ``inputs`` (and ``rr_prevClip``), with an invariant
-    ``gl_Position``."""
+                  locs: Optional[dict[str, Optional[SourceLoc]]] = None, user=None) -> str:
+    """The vertex shader writing ``inputs`` (and ``rr_prevClip``), with an invariant
+    ``gl_Position``: generated, or the user's own (``user``, a
+    :class:`rrcache.harness.user_vertex.UserVertex`) with the cache's additions."""
+    if user is not None:
+        user.check_inputs(inputs, locs)
+        return user.source(prev_clip=prev_clip)
     wanted = dict(inputs)
     if prev_clip:
         wanted[G.PREV_CLIP] = "vec4"

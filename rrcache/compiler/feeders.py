@@ -38,8 +38,8 @@ from collections import Counter
 from typing import Optional
 
 from rrcache.glsl import ast as A
-from rrcache.analysis._tree import written_roots
-from rrcache.compiler._ast import main_function, walk
+from rrcache.glsl.ast import main_function, walk
+from rrcache.glsl.writes import written_roots
 from rrcache.compiler.locate import Site
 
 

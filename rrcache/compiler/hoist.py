@@ -25,25 +25,9 @@ from __future__ import annotations
 from typing import Optional
 
 from rrcache.glsl import ast as A
-from rrcache.compiler._ast import post_order
+from rrcache.glsl.ast import own_parts, post_order
 from rrcache.compiler.locate import PLACEHOLDER, Site
 from rrcache.compiler.replace import NODE_VAR, node_variable, replace_node
-
-
-def _own_roots(s: A.Stmt) -> list[A.Node]:
-    if isinstance(s, A.ExprStmt):
-        return [s.expr] if s.expr is not None else []
-    if isinstance(s, A.DeclStmt):
-        return [s.decl]
-    if isinstance(s, A.If):
-        return [s.cond]
-    if isinstance(s, A.For):
-        return [x for x in (s.init,) if x is not None]
-    if isinstance(s, A.Switch):
-        return [s.expr]
-    if isinstance(s, A.Return):
-        return [s.expr] if s.expr is not None else []
-    return []
 
 
 def _has_effect(n: A.Node) -> bool:
@@ -65,8 +49,11 @@ def _has_effect(n: A.Node) -> bool:
 
 def side_effect_before(stmt: A.Stmt) -> bool:
     """Whether something with a side effect is evaluated before the placeholder in ``stmt``'s
-    own expressions (evaluation order: operands left to right, then the operator)."""
-    for root in _own_roots(stmt):
+    own expressions (:func:`rrcache.glsl.ast.own_parts`, in evaluation order: operands left to
+    right, then the operator). S holds the placeholder in its own parts, and in a ``for`` only in
+    the init (:func:`rrcache.compiler.locate.find_site` refuses a condition or step), so the
+    search stops there before a condition or step is looked at."""
+    for root in own_parts(stmt):
         for n in post_order(root):
             if isinstance(n, A.Ident) and n.name == PLACEHOLDER:
                 return False

@@ -28,7 +28,7 @@ from rrcache.errors import SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.legacy import to_core
 from rrcache.glsl.printer import print_expr
-from rrcache.compiler._ast import contains, is_ident, main_function, substitute, walk
+from rrcache.glsl.ast import branches, contains, is_ident, main_function, own_parts, substitute, walk
 
 #: The identifier standing for E in the prepared unit (never printed).
 PLACEHOLDER = "rr_cachedNodePlaceholder"
@@ -140,35 +140,6 @@ def prepare(analysed: Any, node_id: Union[int, A.Expr]) -> Located:
     return Located(core, expr, name, NODE_TYPES[name], print_expr(node), node.loc, path)
 
 
-def _own_parts(s: A.Stmt) -> list[A.Node]:
-    """The parts of a statement evaluated by the statement itself (not its sub-statements)."""
-    if isinstance(s, A.ExprStmt):
-        return [s.expr] if s.expr is not None else []
-    if isinstance(s, A.DeclStmt):
-        return [s.decl]
-    if isinstance(s, A.If):
-        return [s.cond]
-    if isinstance(s, A.For):
-        return [x for x in (s.init, s.cond, s.step) if x is not None]
-    if isinstance(s, (A.While, A.DoWhile)):
-        return [s.cond]
-    if isinstance(s, A.Switch):
-        return [s.expr]
-    if isinstance(s, A.Return):
-        return [s.expr] if s.expr is not None else []
-    return []
-
-
-def _sub_statements(s: A.Stmt) -> list[tuple[str, A.Stmt]]:
-    if isinstance(s, A.If):
-        return [(f, getattr(s, f)) for f in ("then", "else_") if getattr(s, f) is not None]
-    if isinstance(s, (A.For, A.While, A.DoWhile)):
-        return [("body", s.body)]
-    if isinstance(s, A.Switch):
-        return [("body", s.body)]
-    return []
-
-
 def find_site(unit: A.TranslationUnit, name: str = PLACEHOLDER) -> Site:
     """Find S, the statement of main holding the identifier ``name`` in its own expressions.
 
@@ -185,14 +156,14 @@ def find_site(unit: A.TranslationUnit, name: str = PLACEHOLDER) -> Site:
                 if found:
                     return found
                 continue
-            if any(contains(p, pred) for p in _own_parts(s)):
+            if any(contains(p, pred) for p in own_parts(s)):
                 if (isinstance(s, (A.For, A.While, A.DoWhile))
                         and not (isinstance(s, A.For) and contains(s.init, pred))):
                     raise UnsupportedShaderError(
                         "the cached node is in a loop condition or step", s.loc,
                         "nodes evaluated once per loop iteration are dynamic; pick another")
                 return Site(block, i, s)
-            for field_name, sub in _sub_statements(s):
+            for field_name, sub in branches(s):
                 if not contains(sub, pred):
                     continue
                 if not isinstance(sub, A.Compound):

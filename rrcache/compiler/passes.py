@@ -2,7 +2,7 @@
 
 Each pass starts from a copy of the prepared unit (:func:`rrcache.compiler.locate.prepare`: core
 profile, E replaced by a placeholder inside S) and is transformed as follows (Sitthi-amorn et
-al. 2008a §3; DESIGN.md §3):
+al. 2008a §3; docs/design.md §3):
 
 =============  ==========================================================================
 ``reproject``  three-pass 1: before S, ``if (!rr_hit() || rr_refreshNow()) discard;
@@ -50,8 +50,8 @@ from rrcache.errors import GLSLError, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.parser import parse_source
 from rrcache.glsl.semantic import check
-from rrcache.analysis._tree import clone
-from rrcache.compiler._ast import main_function
+from rrcache.glsl.ast import main_function
+from rrcache.glsl.rewrite import clone
 from rrcache.compiler.feeders import move_feeders
 from rrcache.compiler.hoist import declare, hoist, insert_before
 from rrcache.compiler.locate import Located, find_site

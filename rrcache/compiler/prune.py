@@ -16,7 +16,12 @@ told apart by their declaration, so shadowing is handled):
 - loops that remain after unrolling are solved to a fixed point; ``break``/``continue`` are kept
   when their loop or ``switch`` is, without keeping it alive by themselves;
 - a declaration whose variable is dead right after it loses its initialiser, and disappears
-  when nothing references the variable any more.
+  when nothing references the variable any more;
+- what is left is tidied (:func:`tidy_blocks`): blocks left empty are removed, and a block
+  whose only statement is a block (inlined calls and unrolled iterations whose other statements
+  went) becomes that block, so no pass shows runs of nested braces; ``case`` labels left at the
+  end of a ``switch`` with no statement after them are removed (a label must precede a
+  statement).
 
 Globals — from ``main`` and the declarations in ``keep`` (the runtime's snippets), everything
 referenced by name is kept, transitively: functions (and prototypes), uniforms, samplers,
@@ -44,8 +49,8 @@ from __future__ import annotations
 from typing import Iterable, Optional
 
 from rrcache.glsl import ast as A
-from rrcache.analysis._tree import written_roots
-from rrcache.compiler._ast import main_function, walk
+from rrcache.glsl.ast import main_function, walk
+from rrcache.glsl.writes import written_roots
 
 DEAD, CONTROL, ESSENTIAL = 0, 1, 2
 
@@ -426,6 +431,65 @@ def prune_main(unit: A.TranslationUnit) -> None:
     rb = _Rebuild(lv)
     rb.stmt(main.body, None)
     rb.restore(main)
+    tidy_blocks(main.body)
+
+
+def _header_names(s: A.Stmt) -> set[str]:
+    """The names a loop's header declares (``for (int i = ...``, ``while (bool b = ...)``)."""
+    decls = [s.init.decl] if isinstance(s, A.For) and isinstance(s.init, A.DeclStmt) else []
+    cond = getattr(s, "cond", None)
+    if isinstance(cond, A.VariableDecl):
+        decls.append(cond)
+    return {d.name for v in decls if isinstance(v, A.VariableDecl) for d in v.declarators}
+
+
+def tidy_blocks(s: Optional[A.Stmt], keep_names: frozenset = frozenset()) -> None:
+    """In place: drop the empty blocks ``{ }`` inside statement lists, and let a block whose
+    only statement is a block hold that block's statements instead (``{ { x; } }`` becomes
+    ``{ x; }``), unless the inner block declares a name in ``keep_names`` (a loop body shares
+    its scope with the loop header's declarations, so ``for (int i...) { { int i; } }`` must
+    keep its inner block).
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> from rrcache.glsl.printer import print_glsl
+    >>> unit = parse_source("void main() { { { { x = 1.0; } { } } } if (c) { { { } } y = 2.0; } }")
+    >>> tidy_blocks(unit.decls[0].body)
+    >>> print(print_glsl(unit), end="")
+    void main()
+    {
+        {
+            x = 1.0;
+        }
+        if (c)
+        {
+            y = 2.0;
+        }
+    }
+    """
+    if isinstance(s, A.Compound):
+        out = []
+        for x in s.stmts:
+            tidy_blocks(x)
+            if not (isinstance(x, A.Compound) and not x.stmts):
+                out.append(x)
+        while len(out) == 1 and isinstance(out[0], A.Compound) and not (
+                keep_names and keep_names & {d.name for x in out[0].stmts if isinstance(x, A.DeclStmt)
+                                             and isinstance(x.decl, A.VariableDecl)
+                                             for d in x.decl.declarators}):
+            out = out[0].stmts
+        s.stmts = out
+    elif isinstance(s, A.If):
+        tidy_blocks(s.then)
+        tidy_blocks(s.else_)
+    elif isinstance(s, (A.For, A.While, A.DoWhile)):
+        tidy_blocks(s.body, frozenset(_header_names(s)))
+    elif isinstance(s, A.Switch):
+        for x in s.body.stmts:
+            tidy_blocks(x)
+        # labels left with no statement after them (their code was pruned) end the body: a
+        # label must precede a statement, and nothing would run there anyway
+        while s.body.stmts and isinstance(s.body.stmts[-1], A.Case):
+            s.body.stmts.pop()
 
 
 def _names(node: A.Node) -> set[str]:

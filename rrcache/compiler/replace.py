@@ -17,7 +17,7 @@ from typing import Callable
 
 from rrcache.errors import UnsupportedShaderError
 from rrcache.glsl import ast as A
-from rrcache.compiler._ast import is_ident, substitute
+from rrcache.glsl.ast import is_ident, substitute
 from rrcache.compiler.locate import PLACEHOLDER
 from rrcache.compiler.outputs import unpack
 

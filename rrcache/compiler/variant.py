@@ -25,6 +25,7 @@ from typing import Any, Optional
 
 import moderngl
 
+from rrcache import atomic
 from rrcache.errors import GLError, SourceLoc
 from rrcache.gl.program import build_program
 from rrcache.runtime.cache import ALGORITHMS, DEFAULT_PERIOD
@@ -64,6 +65,10 @@ class Variant:
     forms: dict[str, str] = field(default_factory=dict)
     node_loc: Optional[SourceLoc] = None
     shader_path: Optional[str] = None
+    vertex_path: Optional[str] = None  # the user's vertex shader (None: generated)
+    # an amortized estimator (rrcache.compiler.amortize): {"estimator", "samples" (m), "of" (N),
+    # "lambda", "phase", "cycle", "history", "accumulators"}; None for a cached node
+    amortized: Optional[dict] = None
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -92,6 +97,7 @@ class Variant:
                 "location": str(self.node_loc) if self.node_loc else None,
             },
             "shader": self.shader_path,
+            "vertex": self.vertex_path,  # the user's vertex shader the passes' .vert derive from (None: generated)
             "algorithm": self.algorithm,
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
@@ -109,6 +115,7 @@ class Variant:
             "uniforms": sorted({u for names in self.uniforms.values() for u in names}),
             "textures": sorted({s for names in self.samplers.values() for s in names}),
             **({"runtime": dict(runtime)} if runtime else {}),
+            **({"amortized": dict(self.amortized)} if self.amortized else {}),
         }
 
     def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,
@@ -119,16 +126,14 @@ class Variant:
         out_dir = os.fspath(out_dir)
         os.makedirs(out_dir, exist_ok=True)
         written = []
+        # each file whole or not at all (a full disk leaves no truncated shader or manifest)
         for name, src in self.passes.items():
             for ext, text in (("vert", src.vertex), ("frag", src.fragment)):
                 path = os.path.join(out_dir, f"{name}.{ext}")
-                with open(path, "w", encoding="utf-8") as f:
-                    f.write(text if text.endswith("\n") else text + "\n")
+                atomic.write_text(path, text if text.endswith("\n") else text + "\n")
                 written.append(path)
         path = os.path.join(out_dir, "manifest.json")
-        with open(path, "w", encoding="utf-8") as f:
-            json.dump(self.manifest(period, runtime), f, indent=2)
-            f.write("\n")
+        atomic.write_text(path, json.dumps(self.manifest(period, runtime), indent=2) + "\n")
         written.append(path)
         return written
 
@@ -143,7 +148,8 @@ class Variant:
                 programs[name] = build_program(
                     ctx, src.vertex, src.fragment, src.fragment_line_map,
                     fragment_name=f"{shader} ({name} pass)",
-                    vertex_name=f"<generated vertex shader of the {name} pass>")
+                    vertex_name=(f"{self.vertex_path} ({name} pass)" if self.vertex_path
+                                 else f"<generated vertex shader of the {name} pass>"))
             except GLError as err:
                 for prog in programs.values():
                     prog.release()

@@ -17,6 +17,7 @@ rrcache.errors.GLError: resolution: 100000x100000 would need 570,000,000,000 byt
 """
 from __future__ import annotations
 
+import contextlib
 import os
 from typing import Optional
 
@@ -49,6 +50,20 @@ def max_target_size(ctx) -> int:
     if viewport:
         limits.extend(int(v) for v in viewport)
     return min(limits)
+
+
+@contextlib.contextmanager
+def target_guard(size, where: str = "resolution"):
+    """Turn the driver's refusal to make a render target inside the block (moderngl's
+    ``framebuffer is not complete``: llvmpipe accepts 16384x16384 in its limits but cannot make a
+    4 GiB float target) into a :class:`GLError` naming ``where`` and the size."""
+    import moderngl
+
+    try:
+        yield
+    except moderngl.Error as err:
+        w, h = int(size[0]), int(size[1])
+        raise GLError(f"the driver could not make the {w}x{h} render targets ({err})", where, _HINT) from None
 
 
 def _gib(n: int) -> str:

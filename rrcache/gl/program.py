@@ -131,8 +131,11 @@ def _to_gl_error(text: str, line_map, fragment_name: str, vertex_name: str) -> G
     loc = map_location(first, lmap, name)
     more = f" (and {len(diags) - 1} more)" if len(diags) > 1 else ""
     hint = None
-    if stage == "vertex_shader":
+    if stage == "vertex_shader" and vertex_name.startswith("<"):
         hint = "the generated vertex shader failed: this is a bug in rrcache, please report it"
+    elif stage == "vertex_shader":  # the user's own (--vert): rewritten to core GLSL, lines kept
+        hint = ("fix the vertex shader (rrcache compiles it as #version 330 core: attribute/varying "
+                "become in/out)")
     err = GLError(f"driver error: {first.message}{more}", where=str(loc) if loc.line else name, hint=hint)
     err.loc = loc if loc.line else None
     err.diagnostics = diags

@@ -146,7 +146,7 @@ def texture_from_asset(ctx: moderngl.Context, asset):
         ctx,
         asset.data,
         kind=getattr(asset, "kind", "2d"),
-        filter=getattr(asset, "filter", None) or "linear",
+        filter=getattr(asset, "filter", None) or "mipmap",
         wrap=getattr(asset, "wrap", None) or "repeat",
         name=getattr(asset, "name", "<texture>"),
     )

@@ -9,42 +9,58 @@ equality.
 Qualifiers are kept as an ordered list of words (``"const"``, ``"uniform"``, ``"highp"``,
 ``"flat"``, ``"centroid"``, ...) and :class:`Layout` objects, exactly as written, so the printer
 reproduces them in their source order.
+
+The tree's shape is declared once, by these classes: a field is a *syntax child field* when it
+takes part in equality (``compare``; the annotations ``loc``, ``Expr.type``, ``Ident.symbol``,
+``Call.target``, ``Call.kind`` and literal spellings do not) and its annotation can hold a node.
+:func:`children`, :func:`walk`, :func:`post_order`, :func:`substitute` and :func:`clone
+<rrcache.glsl.rewrite.clone>` all follow that one spec, so a walk never wanders from a call into
+the body of the function it calls. The ``type`` of a declaration (a :class:`FullType`, marked
+:data:`DECL_TYPE`: struct names and array sizes live there) is followed unless
+``decl_types=False``: the analysis shares it between the copies it makes and does not number the
+expressions inside it.
+
+>>> from rrcache.glsl.parser import parse_source
+>>> unit = parse_source("float[2] a; void main() { float x = 1.0; x = x + a[1]; }")
+>>> child_fields(VariableDecl), child_fields(VariableDecl, decl_types=False)
+(('type', 'declarators'), ('declarators',))
+>>> [type(e).__name__ for e in iter_exprs(unit.decls[1])]
+['FloatLit', 'Assign', 'Ident', 'Binary', 'Ident', 'Index', 'Ident', 'IntLit']
+>>> sum(isinstance(n, IntLit) for n in walk(unit)), sum(isinstance(n, IntLit) for n in walk(unit, decl_types=False))
+(2, 1)
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import Any, Iterator, Optional, Union
+from typing import Any, Callable, Iterator, Optional, Union
 
 from rrcache.errors import SourceLoc
+
+
+#: Metadata of the fields that hold a declaration's type (``VariableDecl.type``, ``Param.type``,
+#: ``StructMember.type``): followed by a traversal unless ``decl_types=False``.
+DECL_TYPE = {"decl_type": True}
 
 
 @dataclass
 class Node:
     loc: Optional[SourceLoc] = field(default=None, compare=False, repr=False, kw_only=True)
 
-    def children(self) -> Iterator["Node"]:
-        """Direct child nodes, in source order."""
-        skip = ("loc", "type") if isinstance(self, Expr) else ("loc",)
-        for f in fields(self):
-            if f.name in skip or not f.compare:
-                continue
-            value = getattr(self, f.name)
-            if isinstance(value, Node):
-                yield value
-            elif isinstance(value, list):
-                for item in value:
-                    if isinstance(item, Node):
-                        yield item
-                    elif isinstance(item, tuple):
-                        for sub in item:
-                            if isinstance(sub, Node):
-                                yield sub
+    def children(self) -> list["Node"]:
+        """Direct child nodes, in source order (:func:`children`)."""
+        return children(self)
 
     def walk(self) -> Iterator["Node"]:
-        """This node and all its descendants, pre-order."""
-        yield self
-        for child in self.children():
-            yield from child.walk()
+        """This node and all its descendants, pre-order (iterative: a chain of 100,000 binary
+        operators walks without recursion)."""
+        stack = [self]
+        pop, extend = stack.pop, stack.extend
+        while stack:
+            node = pop()
+            yield node
+            kids = list(node.children())
+            kids.reverse()
+            extend(kids)
 
 
 # ----------------------------------------------------------------------------- types, qualifiers
@@ -85,7 +101,7 @@ class FullType(Node):
 
 @dataclass
 class StructMember(Node):
-    type: FullType
+    type: FullType = field(metadata=DECL_TYPE)
     declarators: list["Declarator"]
 
 
@@ -106,13 +122,13 @@ class VariableDecl(Node):
     """``const highp vec3 a = ..., b[2];`` (also a bare struct declaration ``struct S {...};``
     with no declarators)."""
 
-    type: FullType
+    type: FullType = field(metadata=DECL_TYPE)
     declarators: list[Declarator]
 
 
 @dataclass
 class Param(Node):
-    type: FullType
+    type: FullType = field(metadata=DECL_TYPE)
     name: Optional[str] = None
     array_dims: Optional[list[Optional["Expr"]]] = None
 
@@ -384,3 +400,184 @@ class InitList(Expr):
     """``{a, b, c}`` initializer list (GLSL 4.20+)."""
 
     items: list[Expr]
+
+
+# ----------------------------------------------------------------------------- traversal
+
+#: Field annotations that can never hold a node (names, operators, literal values, spellings).
+_SCALAR_ANNOTATIONS = frozenset({"str", "bool", "int", "float", "Optional[str]", "Optional[int]",
+                                 "list[str]", "list[tuple[str, str]]", "list[SourceLoc]"})
+
+
+class _FieldTable(dict):
+    """``class -> names of its syntax child fields``, filled on first use of a class."""
+
+    def __init__(self, decl_types: bool):
+        super().__init__()
+        self.decl_types = decl_types
+
+    def __missing__(self, cls: type) -> tuple[str, ...]:
+        names = tuple(f.name for f in fields(cls)
+                      if f.compare and f.type not in _SCALAR_ANNOTATIONS
+                      and (self.decl_types or not f.metadata.get("decl_type")))
+        self[cls] = names
+        return names
+
+
+_WITH_TYPES = _FieldTable(True)
+_WITHOUT_TYPES = _FieldTable(False)
+
+
+def child_fields(cls: type, decl_types: bool = True) -> tuple[str, ...]:
+    """The names of the fields of node class ``cls`` that hold syntax children, in source order
+    (declaration types left out with ``decl_types=False``; see the module docstring)."""
+    return (_WITH_TYPES if decl_types else _WITHOUT_TYPES)[cls]
+
+
+def children(node: Node, decl_types: bool = True) -> list[Node]:
+    """The direct syntax children of ``node`` in source order (items of list fields, and nodes
+    inside the tuples of ``Layout.items``, included)."""
+    out = []
+    node_cls = Node
+    d = node.__dict__
+    for name in (_WITH_TYPES if decl_types else _WITHOUT_TYPES)[node.__class__]:
+        value = d[name]
+        if value is None:
+            continue
+        if isinstance(value, node_cls):
+            out.append(value)
+        elif value.__class__ is list:
+            for item in value:
+                if isinstance(item, node_cls):
+                    out.append(item)
+                elif item.__class__ is tuple:
+                    out.extend(sub for sub in item if isinstance(sub, node_cls))
+    return out
+
+
+def walk(node: Node, decl_types: bool = True) -> Iterator[Node]:
+    """``node`` and its syntax descendants, pre-order (iterative: deep trees are fine)."""
+    stack = [node]
+    pop, extend = stack.pop, stack.extend
+    while stack:
+        n = pop()
+        yield n
+        kids = children(n, decl_types)
+        if kids:
+            kids.reverse()
+            extend(kids)
+
+
+def post_order(node: Node, decl_types: bool = True) -> Iterator[Node]:
+    """``node`` and its descendants, children (left to right) before their parent: the order in
+    which an expression's operands are evaluated."""
+    for child in children(node, decl_types):
+        yield from post_order(child, decl_types)
+    yield node
+
+
+def iter_exprs(node: Node) -> Iterator["Expr"]:
+    """Every expression under ``node`` in pre-order, declaration types left out: the order that
+    numbers the analysis' node ids."""
+    expr_cls = Expr
+    for n in walk(node, decl_types=False):
+        if isinstance(n, expr_cls):
+            yield n
+
+
+def substitute(node: Node, pred: Callable[[Node], bool], make: Callable[[Node], Node]) -> int:
+    """Replace, in place, every descendant ``n`` of ``node`` with ``pred(n)`` true by
+    ``make(n)`` (the replacement is not searched again). Returns the number replaced."""
+    count = 0
+    for name in _WITH_TYPES[node.__class__]:
+        value = getattr(node, name)
+        if isinstance(value, Node):
+            if pred(value):
+                setattr(node, name, make(value))
+                count += 1
+            else:
+                count += substitute(value, pred, make)
+        elif isinstance(value, list):
+            for i, item in enumerate(value):
+                if isinstance(item, Node):
+                    if pred(item):
+                        value[i] = make(item)
+                        count += 1
+                    else:
+                        count += substitute(item, pred, make)
+                elif isinstance(item, tuple):
+                    new = []
+                    for sub in item:
+                        if isinstance(sub, Node) and pred(sub):
+                            new.append(make(sub))
+                            count += 1
+                        else:
+                            if isinstance(sub, Node):
+                                count += substitute(sub, pred, make)
+                            new.append(sub)
+                    value[i] = tuple(new)
+    return count
+
+
+def contains(node: Optional[Node], pred: Callable[[Node], bool]) -> bool:
+    """Whether ``node`` or a descendant satisfies ``pred``."""
+    return node is not None and any(pred(n) for n in walk(node))
+
+
+def is_ident(name: str) -> Callable[[Node], bool]:
+    """A predicate: the node is the identifier ``name``."""
+    return lambda n: isinstance(n, Ident) and n.name == name
+
+
+def is_literal(e: Node) -> bool:
+    """Whether ``e`` is an ``int``/``uint``, float or bool literal."""
+    return isinstance(e, (IntLit, FloatLit, BoolLit))
+
+
+# ----------------------------------------------------------------------------- statements
+
+
+def own_parts(s: Stmt) -> list[Node]:
+    """The parts a statement evaluates itself (not its sub-statements), in evaluation order: an
+    expression statement's expression, a declaration, the condition of ``if``/``while``/
+    ``do``-``while``, ``switch``'s selector, ``return``'s value, and a ``for``'s init, condition
+    and step (the condition and step once per iteration).
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> loop = parse_source("void main() { for (int i = 0; i < 3; i++) {} }").decls[0].body.stmts[0]
+    >>> [type(p).__name__ for p in own_parts(loop)]
+    ['DeclStmt', 'Binary', 'Unary']
+    """
+    if isinstance(s, ExprStmt):
+        return [s.expr] if s.expr is not None else []
+    if isinstance(s, DeclStmt):
+        return [s.decl]
+    if isinstance(s, If):
+        return [s.cond]
+    if isinstance(s, For):
+        return [x for x in (s.init, s.cond, s.step) if x is not None]
+    if isinstance(s, (While, DoWhile)):
+        return [s.cond]
+    if isinstance(s, Switch):
+        return [s.expr]
+    if isinstance(s, (Return, Case)):
+        return [s.expr] if s.expr is not None else []
+    return []
+
+
+def branches(s: Stmt) -> list[tuple[str, Stmt]]:
+    """The sub-statements of ``if``, the loops and ``switch`` as ``(field name, statement)``
+    (a block's statements are ``s.stmts``)."""
+    if isinstance(s, If):
+        return [(f, getattr(s, f)) for f in ("then", "else_") if getattr(s, f) is not None]
+    if isinstance(s, (For, While, DoWhile, Switch)):
+        return [("body", s.body)]
+    return []
+
+
+def main_function(unit: TranslationUnit) -> Optional[FunctionDecl]:
+    """The definition of ``void main()``, or None."""
+    for d in unit.decls:
+        if isinstance(d, FunctionDecl) and d.name == "main" and d.body is not None:
+            return d
+    return None

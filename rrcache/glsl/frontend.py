@@ -16,6 +16,8 @@ import os
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Optional
 
+from rrcache.budgets import budget
+from rrcache.deep import deep
 from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.builtins import NON_FRAGMENT_VARIABLES
@@ -24,7 +26,7 @@ from rrcache.glsl.preprocessor import preprocess
 from rrcache.glsl.semantic import SemanticInfo, check
 from rrcache.glsl.types import Type
 
-__all__ = ["Shader", "load_shader", "parse_shader"]
+__all__ = ["Shader", "describe_change", "file_records", "load_shader", "parse_shader"]
 
 # Layout qualifiers that belong to compute, geometry and tessellation shaders.
 _OTHER_STAGE_LAYOUTS = {
@@ -47,8 +49,11 @@ class Shader:
     ``unit`` is the type-checked AST, ``info`` its :class:`SemanticInfo`; ``uniforms``,
     ``samplers`` and ``inputs`` map names to ``(Type, SourceLoc)`` in declaration order
     (``uniforms`` are the non-opaque plain uniforms, ``samplers`` the opaque ones, ``inputs`` the
-    user-declared inputs the shader reads); ``hash`` is a sha256 over every file read and the
-    defines; ``files`` lists those files (the main one first).
+    user-declared inputs the shader reads); ``hash`` is a sha256 over the *content* of every
+    file read (in the order they were read, never their path strings: the same shader reached
+    through another working directory or path spelling has the same hash) and the defines;
+    ``files`` lists those files (the main one first) and ``file_hashes`` the sha256 of each
+    one's content, in the same order (what :func:`describe_change` compares).
     """
 
     path: Optional[str]
@@ -64,6 +69,25 @@ class Shader:
     outputs: dict[str, tuple[Type, SourceLoc]] = field(default_factory=dict)
     defines: dict[str, object] = field(default_factory=dict)
     files: list[str] = field(default_factory=list)
+    pragmas: list = field(default_factory=list)  # (text after #pragma, SourceLoc) in source order
+    file_hashes: list[str] = field(default_factory=list)
+    #: without ``#version``: the language assumed and why (``Preprocessed.assumed``)
+    assumed: Optional[str] = None
+
+    @property
+    def language(self) -> str:
+        """The GLSL the shader was read as, in words: ``GLSL 330 core``, ``GLSL ES 3.00``, or for
+        a shader without ``#version`` the assumption and its reason.
+
+        >>> parse_shader("#version 300 es\\nprecision highp float; out vec4 c;\\n"
+        ...              "void main() { c = vec4(1.0); }").language
+        'GLSL ES 3.00'
+        """
+        if self.assumed:
+            return self.assumed
+        if self.es:
+            return f"GLSL ES {self.version // 100}.{self.version % 100:02d}"
+        return f"GLSL {self.version}" + (f" {self.profile}" if self.profile else "")
 
     @property
     def varyings(self) -> dict[str, tuple[Type, SourceLoc]]:
@@ -76,6 +100,7 @@ class Shader:
         return self.info.es
 
 
+@deep
 def parse_shader(source: str, filename: str = "<string>",
                  defines: Optional[Mapping[str, object]] = None,
                  include_dirs: Iterable[str] = ()) -> Shader:
@@ -93,22 +118,53 @@ def parse_shader(source: str, filename: str = "<string>",
     defines = dict(defines or {})
     pp = preprocess(source, filename, defines, tuple(include_dirs))
     unit = parse_preprocessed(pp, filename)
+    check_size(unit, filename)
     frag_data = _reject_other_stages(unit, filename)
     info = check(unit, filename)
     _reject_multiple_outputs(frag_data, info)
     path = None if filename.startswith("<") else filename
     files = list(pp.files) or ([filename] if path else [])
+    digests = file_digests(source, files, filename)
     return Shader(
         path=path, source=source, unit=unit, info=info, version=info.version,
         profile=unit.profile or ("es" if info.es else None),
-        hash=_hash(source, files, defines, filename),
+        hash=_hash(digests, defines),
         uniforms={n: (s.type, s.loc) for n, s in info.uniforms.items()
                   if isinstance(s.decl, A.VariableDecl) and not s.type.contains_opaque()},
         samplers={n: (s.type, s.loc) for n, s in info.uniforms.items()
                   if s.type.contains_opaque()},
         inputs={n: (s.type, s.loc) for n, s in info.inputs.items() if n in info.used_globals},
         outputs={n: (s.type, s.loc) for n, s in info.outputs.items()},
-        defines=defines, files=files)
+        defines=defines, files=files, file_hashes=digests, assumed=pp.assumed,
+        pragmas=list(pp.pragmas))
+
+
+def check_size(unit: A.TranslationUnit, filename: str) -> None:
+    """Refuse a program beyond the analysis budgets (:mod:`rrcache.budgets`): more syntax nodes
+    than ``budget.analysis_nodes`` or an expression nested deeper than ``budget.expression_depth``
+    (counted without recursion, before any recursive pass runs)."""
+    count = 0
+    deepest, deepest_node = 0, None
+    stack = [(unit, 0)]
+    pop, push = stack.pop, stack.append
+    while stack:
+        node, depth = pop()
+        count += 1
+        if depth > deepest:
+            deepest, deepest_node = depth, node
+        for child in node.children():
+            push((child, depth + 1))
+    if count > budget.analysis_nodes:
+        raise GLSLError(f"the shader has {count:,} syntax nodes after preprocessing, more than the analysis "
+                        f"budget of {budget.analysis_nodes:,}", SourceLoc(filename, 1, 1),
+                        "raise it with 'rrcache --max-ast-nodes N ...' if the machine has the memory "
+                        "(analysis takes roughly 10 KB per node)")
+    if deepest > budget.expression_depth:
+        loc = getattr(deepest_node, "loc", None) or SourceLoc(filename, 1, 1)
+        raise GLSLError(f"an expression is nested {deepest:,} levels deep, more than the "
+                        f"{budget.expression_depth:,} rrcache analyses", loc,
+                        "split it into several statements, or raise the limit with "
+                        "'rrcache --max-depth N ...'")
 
 
 def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, object]] = None,
@@ -117,17 +173,20 @@ def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
 
     A missing or unreadable file raises :class:`~rrcache.errors.GLSLError` naming the path.
 
-    >>> shader = load_shader("shaders/marble.glsl")  # doctest: +SKIP
-    >>> shader.uniforms["u_camera"][0]  # doctest: +SKIP
+    >>> shader = load_shader("shaders/marble.glsl")
+    >>> shader.uniforms["u_camera"][0]
     Type('vec3')
     """
     path = os.fspath(path)
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            data = f.read(budget.source_bytes + 1)
     except OSError as e:
         raise GLSLError(f"cannot read shader file '{path}': {e.strerror or e}", None,
                         "check the path" if isinstance(e, FileNotFoundError) else None) from None
+    if len(data) > budget.source_bytes:
+        raise GLSLError(f"the shader file is larger than {budget.source_bytes:,} bytes, the analysis budget",
+                        SourceLoc(path, 1, 1), "raise it with 'rrcache --max-source-bytes N ...'")
     try:
         source = data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
@@ -138,21 +197,81 @@ def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
     return parse_shader(source, path, defines, include_dirs)
 
 
-def _hash(source: str, files: list[str], defines: Mapping[str, object], filename: str) -> str:
-    h = hashlib.sha256()
-    h.update(source.encode("utf-8"))
-    for path in files:
-        if path == filename or path.startswith("<"):
+def file_digests(source: str, files: list[str], filename: str) -> list[str]:
+    """The sha256 of each file's content, ``files`` order: the main file's from ``source`` (the
+    text that was parsed), the included ones as read from disk now."""
+    out = []
+    for path in files or [filename]:
+        if path == filename:
+            out.append(hashlib.sha256(source.encode("utf-8")).hexdigest())
             continue
-        h.update(b"\0file\0" + path.encode("utf-8") + b"\0")
         try:
             with open(path, "rb") as f:
-                h.update(f.read())
+                out.append(hashlib.sha256(f.read()).hexdigest())
         except OSError:
-            h.update(b"<unreadable>")
+            out.append("<unreadable>")
+    return out
+
+
+def _hash(digests: list[str], defines: Mapping[str, object]) -> str:
+    # content only: a path spelling (relative, absolute, through a symlink) never changes it
+    h = hashlib.sha256(b"rrcache shader hash 2\0")
+    for digest in digests:
+        h.update(b"\0file\0" + digest.encode("ascii"))
     for name in sorted(defines):
         h.update(f"\0define\0{name}={defines[name]!r}".encode("utf-8"))
     return h.hexdigest()
+
+
+def describe_change(recorded_files: Optional[list], shader: Shader,
+                    recorded_defines: Optional[Mapping[str, object]] = None) -> str:
+    """Why ``shader`` no longer has a recorded hash, in words: which file changed (by content),
+    which include appeared or went, or that no file changed and what else differs.
+    ``recorded_files`` is ``[{"path": ..., "sha256": ...}]`` as :func:`file_records` wrote it
+    (None for a record made before rrcache kept one).
+
+    >>> s = parse_shader("void main() { gl_FragColor = vec4(1.0); }", "a.frag")
+    >>> describe_change(file_records(s), s)
+    'no shader file changed'
+    """
+    if not recorded_files:
+        return ("the record predates per-file hashes, so which file changed cannot be told "
+                "(rrcache then hashed include paths, not only content)")
+    now = {_same_file_key(p): (p, d) for p, d in zip(shader.files, shader.file_hashes)}
+    then = {_same_file_key(r.get("path", "")): (r.get("path", ""), r.get("sha256")) for r in recorded_files}
+    said = []
+    # the main file is compared by position: the profile may have been made with another path
+    if shader.file_hashes and recorded_files[0].get("sha256") != shader.file_hashes[0]:
+        said.append(f"'{shader.files[0] if shader.files else shader.path}' changed")
+    main_keys = {_same_file_key(recorded_files[0].get("path", ""))}
+    if shader.files:
+        main_keys.add(_same_file_key(shader.files[0]))
+    for key, (path, digest) in now.items():
+        if key in main_keys:
+            continue
+        if key not in then:
+            said.append(f"it now includes '{path}'")
+        elif then[key][1] != digest:
+            said.append(f"'{path}' changed")
+    for key, (path, _digest) in then.items():
+        if key not in main_keys and key not in now:
+            said.append(f"it no longer includes '{path}'")
+    if said:
+        return "; ".join(said)
+    if recorded_defines is not None and dict(recorded_defines) != dict(shader.defines):
+        return "no shader file changed, but the defines differ"
+    return "no shader file changed"
+
+
+def file_records(shader: Shader) -> list[dict]:
+    """``[{"path": absolute path, "sha256": content hash}]`` of every file the shader read,
+    for a record (a profile) that :func:`describe_change` later compares against."""
+    return [{"path": p if p.startswith("<") else os.path.abspath(p), "sha256": d}
+            for p, d in zip(shader.files, shader.file_hashes)]
+
+
+def _same_file_key(path: str) -> str:
+    return path if not path or path.startswith("<") else os.path.realpath(path)
 
 
 def _unsupported(what: str, loc: Optional[SourceLoc], filename: str) -> UnsupportedShaderError:

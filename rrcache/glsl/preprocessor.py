@@ -26,7 +26,8 @@ from bisect import bisect_right
 from dataclasses import dataclass, field
 from typing import Iterator, Mapping, Sequence
 
-from rrcache.errors import PreprocessorError, SourceLoc
+from rrcache.errors import PreprocessorError, SourceLoc, printable as _printable
+from rrcache.glsl.extensions import predefined as predefined_extensions
 
 __all__ = ["PPToken", "Preprocessed", "preprocess", "preprocess_file"]
 
@@ -46,7 +47,9 @@ class Preprocessed:
 
     ``version`` is the ``#version`` number (None when absent); ``profile`` the effective
     profile: ``es`` for ES versions, the written one or ``core`` for desktop 150 and later,
-    None below 150. ``files`` lists every file read, the main file first.
+    None below 150. ``files`` lists every file read, the main file first. ``assumed`` says,
+    for a shader without ``#version``, which language it was read as and why (see
+    :func:`_es_sketch_reason`).
     """
 
     tokens: list[PPToken]
@@ -57,6 +60,8 @@ class Preprocessed:
     extension_locs: list[SourceLoc] = field(default_factory=list)  # where each #extension stands
     pragmas: list[tuple[str, SourceLoc]] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    #: without ``#version``: the language the shader was read as, and why (None with one)
+    assumed: str | None = None
 
 
 # --------------------------------------------------------------------------------------------
@@ -395,9 +400,14 @@ class _Preprocessor:
         self.out: list[PPToken] = []
         self.result = Preprocessed(tokens=self.out)
         self.include_dirs = [os.fspath(d) for d in include_dirs]
+        #: the folders includes may come from: the main file's folder tree (added by preprocess)
+        #: and the include directories' trees, as real paths
+        self.roots = [os.path.realpath(d) for d in self.include_dirs]
+        self.source_bytes = 0
         self.cond: list[_Cond] = []
         self.includes: list[tuple[str, str, frozenset]] = []
         self.version_done = False
+        self.main_source = ""  # the main file's text: without #version it decides ES or not
         self.produced = 0
         self.cur: _Source | None = None
         for name, value in (defines or {}).items():
@@ -423,6 +433,13 @@ class _Preprocessor:
         r = self.result
         self.version_done = True
         r.version, r.version_loc = version, loc
+        es_sketch = _es_sketch_reason(self.main_source) if version is None else None
+        if es_sketch:
+            # no #version, but written for GLSL ES 1.00 (see _es_sketch_reason)
+            profile = "es"
+            r.assumed = f"GLSL ES 1.00 (no #version; {es_sketch})"
+        elif version is None:
+            r.assumed = "desktop GLSL 1.10 (no #version, no precision statement, no GL_ES test)"
         if version in _ES_VERSIONS or profile == "es":
             r.profile = "es"
             self._builtin("GL_ES", "1")
@@ -434,6 +451,8 @@ class _Preprocessor:
                 self._builtin("GL_compatibility_profile", "1")
         else:
             r.profile = None
+        for ext in predefined_extensions(r.profile == "es"):
+            self._builtin(ext, "1")
 
     def _mark_content(self) -> None:
         if not self.version_done:
@@ -447,7 +466,9 @@ class _Preprocessor:
         return files.index(label)
 
     def run_file(self, text: str, label: str, key: str, include_loc: SourceLoc | None) -> None:
-        state = frozenset((n, m.key) for n, m in self.macros.items())
+        # the user's macros only: the built-in ones appear when the version is settled, which
+        # must not make a file's second entry look like a different state
+        state = frozenset((n, m.key) for n, m in self.macros.items() if not m.builtin)
         for i, (k, _, s) in enumerate(self.includes):
             if k == key and s == state:
                 chain = " -> ".join([lab for _, lab, _ in self.includes[i:]] + [label])
@@ -786,10 +807,31 @@ class _Preprocessor:
                 found = cand
                 break
         if found is None:
-            raise _err(f"cannot find include file '{path}' (tried: {', '.join(tried) or 'none'})",
-                       first.loc, "add its directory to the include directories")
-        text = _read_text(found, first.loc)
-        self.run_file(text, found, os.path.realpath(found), first.loc)
+            raise _err(f"cannot find include file '{_printable(path)}' (tried: "
+                       f"{', '.join(map(_printable, tried)) or 'none'})",
+                       first.loc, "add its directory to the include directories (-I DIR, or the "
+                       "session's \"include_dirs\")")
+        real = self._confined(path, found, first.loc)
+        text = _read_text(found, first.loc, self)
+        self.run_file(text, found, real, first.loc)
+
+    def _confined(self, path: str, found: str, loc: SourceLoc) -> str:
+        """The real path of the include file ``found``, which must be a shader file inside the
+        main file's folder tree or an include directory's; anything else is refused without
+        reading it (a shader from the web must not read, nor leak, the machine's other files)."""
+        real = os.path.realpath(found)
+        if not any(real == r or real.startswith(r.rstrip(os.sep) + os.sep) for r in self.roots):
+            where = " and ".join(_printable(r) for r in self.roots) or "no folder (no include directory given)"
+            raise _err(f"#include '{_printable(path)}' resolves to {_printable(real)}, outside the folders "
+                       f"includes are read from ({where})", loc,
+                       "includes come from the shader's own folder tree and the include directories; "
+                       "add a folder with -I DIR (or the session's \"include_dirs\") if you trust it")
+        ext = os.path.splitext(real)[1].lower()
+        if ext not in SHADER_EXTENSIONS:
+            raise _err(f"#include '{_printable(path)}' is not a shader file (its name ends in "
+                       f"'{_printable(ext) or 'no extension'}')", loc,
+                       f"includes must be shader sources: {' '.join(sorted(SHADER_EXTENSIONS))}")
+        return real
 
     # -- macro expansion -----------------------------------------------------------------------
     def _expand(self, toks: list[_Tok], depth: int = 0) -> list[_Tok]:
@@ -834,7 +876,7 @@ class _Preprocessor:
         elif t.text == "__FILE__":
             value = self.cur.number if self.cur is not None else 0
         else:
-            value = self.result.version or 110
+            value = self.result.version or (100 if self.result.profile == "es" else 110)
         return _Tok("number", str(value), t.loc, t.space, t.hide)
 
     @staticmethod
@@ -932,12 +974,31 @@ class _Preprocessor:
         return _Tok(kind, text, use.loc, a.space)
 
 
-def _read_text(path: str, loc: SourceLoc | None) -> str:
+#: the file name endings an ``#include`` may read (GLSL sources and their usual headers)
+SHADER_EXTENSIONS = frozenset({".glsl", ".frag", ".vert", ".fs", ".vs", ".fsh", ".vsh", ".fp", ".vp",
+                               ".h", ".inc", ".glslinc", ".hlsl", ".comp", ".geom", ".tesc", ".tese",
+                               ".shader", ".fx", ".cginc"})
+
+def _read_text(path: str, loc: SourceLoc | None, pp: "_Preprocessor | None" = None) -> str:
+    from rrcache.budgets import budget
+
+    limit = budget.source_bytes - (pp.source_bytes if pp is not None else 0)
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            data = f.read(limit + 1)
     except OSError as e:
-        raise _err(f"cannot read '{path}': {e.strerror or e}", loc) from None
+        raise _err(f"cannot read '{_printable(path)}': {e.strerror or e}", loc) from None
+    if len(data) > limit:
+        raise _err(f"'{_printable(path)}' takes the shader's sources past {budget.source_bytes:,} bytes, the "
+                   "analysis budget", loc, "raise it with 'rrcache --max-source-bytes N ...'")
+    if pp is not None:
+        pp.source_bytes += len(data)
+    nul = data.find(b"\0")
+    if nul >= 0:
+        line = data.count(b"\n", 0, nul) + 1
+        col = nul - (data.rfind(b"\n", 0, nul) + 1) + 1
+        raise _err("the file contains a NUL byte: it is not GLSL source text", SourceLoc(path, line, col),
+                   "pass a shader source file")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as e:
@@ -945,6 +1006,35 @@ def _read_text(path: str, loc: SourceLoc | None) -> str:
         col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
         raise _err("the file is not valid UTF-8", SourceLoc(path, line, col),
                    "save the shader as UTF-8") from None
+
+
+_COMMENT_RE = re.compile(r"//[^\n]*|/\*.*?(?:\*/|\Z)", re.S)
+_PRECISION_RE = re.compile(r"(?m)^[ \t]*precision[ \t]+(?:lowp|mediump|highp)[ \t]+\w+[ \t]*;")
+_GL_ES_TEST_RE = re.compile(r"(?m)^[ \t]*#[ \t]*(?:(?:ifdef|ifndef)[ \t]+GL_ES\b|(?:el)?if\b[^\n]*\bGL_ES\b)")
+
+
+def _es_sketch_reason(source: str) -> str | None:
+    """Why a main file without ``#version`` is GLSL ES 1.00, or None for desktop GLSL 1.10.
+
+    The ES sketch tools (glslViewer, GLSL Sandbox, The Book of Shaders' editor; all WebGL 1 or
+    GLES 2 underneath) run a versionless fragment shader as GLSL ES 1.00, and such sketches
+    say so: a ``precision`` statement (mandatory for floats in an ES 1.00 fragment shader), or a
+    test of ``GL_ES`` (``#ifdef GL_ES precision mediump float; #endif``). A versionless shader
+    with either, in its main file, active or not, is read as ES 1.00 (``GL_ES`` defined, so it
+    takes the branches its author ran); one with neither is desktop GLSL 1.10, as the GLSL
+    specification says. Comments are ignored.
+
+    >>> _es_sketch_reason("#ifdef GL_ES\\nprecision mediump float;\\n#endif\\nvoid main(){}")
+    'it has a precision statement and tests GL_ES, as ES sketches do'
+    >>> _es_sketch_reason("// precision highp float;\\nvoid main(){}") is None
+    True
+    """
+    text = _COMMENT_RE.sub(" ", source)
+    found = [what for what, pattern in (("has a precision statement", _PRECISION_RE),
+                                         ("tests GL_ES", _GL_ES_TEST_RE)) if pattern.search(text)]
+    if not found:
+        return None
+    return f"it {' and '.join(found)}, as ES sketches do"
 
 
 def preprocess(source: str, filename: str | os.PathLike = "<string>",
@@ -961,6 +1051,10 @@ def preprocess(source: str, filename: str | os.PathLike = "<string>",
     """
     filename = os.fspath(filename)
     pp = _Preprocessor(defines, include_dirs)
+    pp.main_source = source
+    if not filename.startswith("<"):
+        pp.roots.insert(0, os.path.dirname(os.path.realpath(filename)))
+    pp.source_bytes = len(source.encode("utf-8", "surrogatepass"))
     key = os.path.realpath(filename) if not filename.startswith("<") else filename
     # Tokens are many small acyclic objects: pausing the cyclic GC halves the run time.
     gc_was_enabled = gc.isenabled()
@@ -979,9 +1073,9 @@ def preprocess_file(path: str | os.PathLike, defines: Mapping[str, object] | Non
                     include_dirs: Sequence[str] = ()) -> Preprocessed:
     """Read and preprocess the shader file ``path`` (see :func:`preprocess`).
 
-    >>> pp = preprocess_file("shaders/fog.frag", defines={"USE_FOG": None})  # doctest: +SKIP
-    >>> pp.files[0]  # doctest: +SKIP
-    'shaders/fog.frag'
+    >>> pp = preprocess_file("shaders/glslviewer_basic.glsl", defines={"MODEL_VERTEX_NORMAL": None})
+    >>> pp.files[0], "v_normal" in [t.text for t in pp.tokens]
+    ('shaders/glslviewer_basic.glsl', True)
     """
     path = os.fspath(path)
     return preprocess(_read_text(path, None), path, defines, include_dirs)

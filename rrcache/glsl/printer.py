@@ -106,8 +106,19 @@ def _expr(e: A.Expr) -> str:
     if isinstance(e, A.BoolLit):
         return "true" if e.value else "false"
     if isinstance(e, A.Binary):
-        p = BINARY_PRECEDENCE[e.op]
-        return f"{print_expr(e.left, p)} {e.op} {print_expr(e.right, p + 1)}"
+        # down the left spine without recursion: `a + 1.0 + 1.0 + ...` (100,000 terms) prints
+        tails = []
+        while True:
+            p = BINARY_PRECEDENCE[e.op]
+            tails.append(f" {e.op} {print_expr(e.right, p + 1)}")
+            left = e.left
+            if isinstance(left, A.Binary) and BINARY_PRECEDENCE[left.op] >= p:
+                e = left
+                continue
+            tails.append(print_expr(left, p))
+            break
+        tails.reverse()
+        return "".join(tails)
     if isinstance(e, A.Unary):
         if e.postfix:
             return print_expr(e.operand, P_POSTFIX) + e.op

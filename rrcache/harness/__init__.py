@@ -1,6 +1,6 @@
 """The rendering harness: replays a session through a fragment shader and measures each frame.
 
->>> from rrcache.harness import render, mean_l2, psnr     # doctest: +SKIP
+>>> from rrcache.harness import render, mean_l2, psnr
 """
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr  # noqa: F401
 from rrcache.harness.prepare import Decl, PreparedShader, prepare, prepare_file  # noqa: F401

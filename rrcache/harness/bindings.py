@@ -2,7 +2,7 @@
 
 :func:`plan_bindings` checks the shader against the session once, before any frame is drawn:
 
-- a uniform or sampler the program uses that neither the harness (DESIGN.md §4 built-ins) nor
+- a uniform or sampler the program uses that neither the harness (docs/design.md §4 built-ins) nor
   the session supplies is an error naming the declaration (``shader.frag:line:col``) and the
   session file, saying what to add;
 - a session uniform or texture the shader does not declare is a *note*, never an error (sessions
@@ -24,8 +24,13 @@ BUILTINS = {
     "u_camera": "vec3", "u_light": "vec3", "u_lightColor": "vec3", "u_resolution": "vec2",
     "u_time": "float", "u_frame": "int", "u_modelMatrix": "mat4", "u_viewMatrix": "mat4",
     "u_projectionMatrix": "mat4", "u_modelViewProjectionMatrix": "mat4", "u_normalMatrix": "mat3",
-    "u_prevModelViewProjectionMatrix": "mat4",
+    "u_prevModelViewProjectionMatrix": "mat4", "u_reprojectionMatrix": "mat4", "u_lightMatrix": "mat4",
 }
+
+#: the sampler of the light's shadow map (a depth texture, sampled ``texture(...).r``)
+SHADOW_SAMPLER = "u_lightShadowMap"
+#: what only a light with a shadow map supplies
+SHADOW_NAMES = (SHADOW_SAMPLER, "u_lightMatrix")
 
 _PATH = re.compile(r"([A-Za-z_]\w*)|\[(\d+)\]")
 
@@ -62,6 +67,7 @@ class BindingPlan:
     session: list = field(default_factory=list)
     samplers: list = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    shadow: object = None  # the u_lightShadowMap uniform when the program samples the shadow map
 
 
 def _example(uniform) -> str:
@@ -99,7 +105,17 @@ def plan_bindings(program: moderngl.Program, prepared: PreparedShader, session,
         where = prepared.where(base)
         decl = prepared.declaration(base)
         loc = decl.loc if decl is not None else None
+        if base in SHADOW_NAMES and getattr(session, "shadow_map", None) is None:
+            raise SessionError(
+                f"the shader uses `{base}` (declared at {where}) but the session's light has no shadow map",
+                session_path, "light", hint='add "shadow_map": {"size": 1024} to "light"')
         kind = sampler_kind(uniform)
+        if kind is not None and base == SHADOW_SAMPLER:
+            if opaque_type_name(uniform) != "sampler2D" or uniform.array_length != 1:
+                raise UnsupportedShaderError(f"`{base}` must be declared sampler2D", loc,
+                                             hint="glslViewer's shadow map is a sampler2D depth texture")
+            plan.shadow = uniform
+            continue
         if kind is not None:
             type_name = opaque_type_name(uniform)
             if kind == "other" or type_name[0] in "iu" or uniform.array_length != 1:

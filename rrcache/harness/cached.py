@@ -24,6 +24,7 @@ from typing import Callable, Optional
 import moderngl
 import numpy as np
 
+from rrcache import watchdog
 from rrcache.gl.context import get_context
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
@@ -57,6 +58,7 @@ class CachedFrame:
     ms: float
     hit_map: Optional[np.ndarray] = None
     payload: Optional[np.ndarray] = None
+    cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
 
 
 class CachedRenderer:
@@ -100,7 +102,9 @@ class CachedRenderer:
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
-                clear_color=session_background(session), color_format=color_format)
+                clear_color=session_background(session), color_format=color_format,
+                blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
+                phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1))
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:
@@ -146,6 +150,7 @@ class CachedRenderer:
         read after the first pass into ``hit_box["map"]``."""
         def read_hits():
             hit_box["map"] = self.runtime.read_inverse_depth(current=True) > 0
+        self.drawer.render_shadow_map()  # the light's depth pass is part of the frame
         return self.runtime.frame(self.drawer.draw, after_first_pass=read_hits if hit_box is not None else None)
 
     def render_frame(self, index: int) -> CachedFrame:
@@ -163,11 +168,14 @@ class CachedRenderer:
             self.runtime.reset()
             self._warm = True
         hit_box = {} if self.hit_maps else None
-        ctx.finish()
-        start = time.perf_counter()
-        stats = self._frame(hit_box)
-        ctx.finish()
-        ms = (time.perf_counter() - start) * 1000.0
+        with watchdog.frame(f"frame {index} of the cached variant"):
+            ctx.finish()
+            cpu_start = time.process_time()
+            start = time.perf_counter()
+            stats = self._frame(hit_box)
+            ctx.finish()
+            ms = (time.perf_counter() - start) * 1000.0
+            cpu_ms = (time.process_time() - cpu_start) * 1000.0
         self._last = index
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0
@@ -182,7 +190,7 @@ class CachedRenderer:
         else:  # one-pass: a dynamic branch, nothing for a query to count
             hits = misses = None
         payload = self.runtime.read_payload() if self.keep_payload else None
-        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload)
+        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload, cpu_ms)
 
     def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None,
                       stages: Optional[dict] = None) -> float:
@@ -219,6 +227,7 @@ class CachedRenderer:
 
                 self.ctx.finish()
                 start = time.perf_counter()
+                self.drawer.render_shadow_map()
                 stats = self.runtime.frame(self.drawer.draw, mark=mark if stages is not None else None)
                 self.ctx.finish()
                 end = time.perf_counter()

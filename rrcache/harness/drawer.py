@@ -3,13 +3,23 @@ renderer and the cached one (one program per pass).
 
 :class:`SceneDrawer` uploads meshes and textures once, checks each program it is given against
 the session (:func:`rrcache.harness.bindings.plan_bindings`), and per frame sets the built-in
-uniforms of DESIGN.md §4 (camera, light, time, matrices, the previous frame's
+uniforms of docs/design.md §4 (camera, light, time, matrices, the previous frame's
 model-view-projection for reprojection), the session's uniforms and samplers, and renders every
 object, culling back faces unless the object is ``double_sided``.
 
->>> drawer = SceneDrawer(ctx, session, prepared, (640, 480), scope)    # doctest: +SKIP
->>> drawer.add_program(program)                                         # doctest: +SKIP
->>> drawer.set_frame(10); drawer.draw(program)                          # doctest: +SKIP
+>>> from rrcache.gl import GLScope, build_program, get_context
+>>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.harness.vertex import vertex_source
+>>> from rrcache.session import load_session
+>>> ctx, scope = get_context(), GLScope()
+>>> session = load_session("sessions/marble.json")
+>>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+>>> program = scope.own(build_program(ctx, vertex_source({n: d.type for n, d in prepared.inputs.items()}),
+...                                   prepared.source))
+>>> drawer = SceneDrawer(ctx, session, prepared, (32, 24), scope)
+>>> _ = drawer.add_program(program)
+>>> drawer.set_frame(10); drawer.draw(program)
+>>> scope.release()
 """
 from __future__ import annotations
 
@@ -19,12 +29,24 @@ import moderngl
 import numpy as np
 
 from rrcache.errors import UnsupportedShaderError
+from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.textures import texture_from_asset
 from rrcache.gl.uniforms import write_uniform
 from rrcache.harness.bindings import BUILTINS, BindingPlan, lookup, plan_bindings
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.vertex import ATTRIBUTES
+from rrcache.session.shadow import BIAS, light_view_projection
+
+#: the texture unit of the shadow map (session textures count up from 0; the cache uses 12-15)
+SHADOW_UNIT = 11
+
+_SHADOW_VERTEX = """#version 330 core
+in vec3 a_position;
+uniform mat4 rr_lightModelViewProjection;
+void main() { gl_Position = rr_lightModelViewProjection * vec4(a_position, 1.0); }
+"""
+_SHADOW_FRAGMENT = "#version 330 core\nvoid main() {}\n"
 
 # value for a vertex attribute the mesh does not have
 _DEFAULTS = {"normal": (0.0, 0.0, 1.0), "texcoord": (0.0, 0.0), "color": (1.0, 1.0, 1.0, 1.0),
@@ -42,6 +64,23 @@ def normal_matrix(model: np.ndarray) -> np.ndarray:
         return m3
 
 
+def reprojection_matrix(mvp: np.ndarray, prev_mvp: np.ndarray) -> np.ndarray:
+    """This frame's clip position → the previous frame's, for one object:
+    ``prev_mvp @ inverse(mvp)`` in double precision (what a user's vertex shader multiplies
+    ``gl_Position`` by to find ``rr_prevClip``; see :mod:`rrcache.harness.user_vertex`).
+
+    >>> m = np.diag([2.0, 2.0, 2.0, 1.0])
+    >>> bool(np.allclose(reprojection_matrix(m, m), np.eye(4)))
+    True
+    """
+    mvp = np.asarray(mvp, dtype=np.float64)
+    try:
+        inv = np.linalg.inv(mvp)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(mvp)
+    return np.asarray(prev_mvp, dtype=np.float64) @ inv
+
+
 class SceneDrawer:
     """Draws the objects of ``session`` at ``size`` with programs registered by
     :meth:`add_program`. GL objects are owned by ``scope``."""
@@ -54,7 +93,7 @@ class SceneDrawer:
         self.size = size
         self.scope = scope
         self.cull_back_faces = cull_back_faces
-        self.notes: list[str] = []
+        self.notes: list[str] = list(getattr(session, "notes", None) or [])
         self._plans: dict[int, BindingPlan] = {}
         self._vaos: dict[int, list] = {}
         self._buffers: dict[tuple[int, str], moderngl.Buffer] = {}
@@ -62,6 +101,10 @@ class SceneDrawer:
         self._textures: dict[str, tuple[int, moderngl.Texture]] = {}
         self._frame: Optional[int] = None
         self._per_object: list = []
+        self.shadow_map = getattr(session, "shadow_map", None)
+        self._shadow = None  # (program, depth texture, framebuffer, vertex arrays), made on first use
+        self._light_matrix = np.eye(4)
+        self._light_mvps: list = []
 
     # ------------------------------------------------------------------ programs
     def add_program(self, program: moderngl.Program) -> BindingPlan:
@@ -70,6 +113,8 @@ class SceneDrawer:
         for name, uniform, _kind in plan.samplers:
             unit, _tex = self._texture(name)
             uniform.value = unit
+        if plan.shadow is not None:
+            plan.shadow.value = SHADOW_UNIT
         self._plans[id(program)] = plan
         self._vaos[id(program)] = [self._object_vao(program, i, obj) for i, obj in enumerate(self.session.objects)]
         for note in plan.notes:
@@ -125,11 +170,64 @@ class SceneDrawer:
         self._values = session.uniform_values(index)
         self._frame = index
         self._per_object = []
+        if self.shadow_map is not None:
+            light_vp = light_view_projection(self._light.position, self.shadow_map, session, index)
+            self._light_matrix = BIAS @ light_vp
+            self._light_mvps = [light_vp @ obj.model_matrix(index) for obj in session.objects]
         for obj in session.objects:
             model = obj.model_matrix(index)
             cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
-            self._per_object.append((model, view_proj @ model, prev_view_proj @ obj.model_matrix(prev),
-                                     normal_matrix(model), cull))
+            mvp, prev_mvp = view_proj @ model, prev_view_proj @ obj.model_matrix(prev)
+            self._per_object.append((model, mvp, prev_mvp, normal_matrix(model), cull,
+                                     reprojection_matrix(mvp, prev_mvp)))
+
+    # ------------------------------------------------------------------ shadow map
+    def _shadow_resources(self):
+        if self._shadow is None:
+            ctx, size = self.ctx, int(self.shadow_map.size)
+            program = self.scope.own(build_program(ctx, _SHADOW_VERTEX, _SHADOW_FRAGMENT,
+                                                   fragment_name="<rrcache shadow-map pass>"))
+            depth = self.scope.own(ctx.depth_texture((size, size)))
+            depth.compare_func = ""  # sampled as a plain texture: texture(u_lightShadowMap, uv).r
+            depth.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            depth.repeat_x = depth.repeat_y = False
+            fbo = self.scope.own(ctx.framebuffer(depth_attachment=depth))
+            vaos = []
+            for i, obj in enumerate(self.session.objects):
+                if i not in self._indices:
+                    indices = np.ascontiguousarray(np.asarray(obj.mesh.indices, np.uint32).reshape(-1))
+                    self._indices[i] = self.scope.own(self.ctx.buffer(indices.tobytes()))
+                vaos.append(self.scope.own(ctx.vertex_array(
+                    program, [(self._buffer(i, obj, "position", 3), "3f", "a_position")], self._indices[i],
+                    index_element_size=4)))
+            self._shadow = (program, depth, fbo, vaos)
+        return self._shadow
+
+    def render_shadow_map(self) -> None:
+        """Render the light's depth map of the current frame (nothing when the session's light has
+        no shadow map). Every renderer calls it inside its timed frame, before its own passes,
+        and binds its own framebuffer afterwards."""
+        if self.shadow_map is None:
+            return
+        if self._frame is None:
+            raise RuntimeError("SceneDrawer.render_shadow_map before set_frame")
+        program, depth, fbo, vaos = self._shadow_resources()
+        ctx = self.ctx
+        fbo.use()
+        fbo.viewport = (0, 0, depth.width, depth.height)
+        fbo.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        ctx.cull_face = "back"
+        mvp_uniform = program["rr_lightModelViewProjection"]
+        for vao, mvp, per_object in zip(vaos, self._light_mvps, self._per_object):
+            cull = per_object[4]
+            if cull:
+                ctx.enable(moderngl.CULL_FACE)
+            else:
+                ctx.disable(moderngl.CULL_FACE)
+            write_uniform(mvp_uniform, mvp)
+            vao.render(moderngl.TRIANGLES)
 
     def _set_builtin(self, plan: BindingPlan, name: str, value) -> None:
         uniform = plan.builtins.get(name)
@@ -142,7 +240,7 @@ class SceneDrawer:
             raise UnsupportedShaderError(
                 f"built-in uniform `{name}` must be declared {BUILTINS[name]}",
                 decl.loc if decl is not None else None,
-                hint=f"declare `uniform {BUILTINS[name]} {name};` (DESIGN.md §4)") from None
+                hint=f"declare `uniform {BUILTINS[name]} {name};` (docs/design.md §4)") from None
 
     def draw(self, program: moderngl.Program, _pass_name: str = "") -> None:
         """Draw every object of the current frame with ``program`` into the bound framebuffer
@@ -167,8 +265,11 @@ class SceneDrawer:
         for name, _uniform, _kind in plan.samplers:
             unit, tex = self._textures[name]
             tex.use(location=unit)
+        if plan.shadow is not None:
+            self._shadow_resources()[1].use(location=SHADOW_UNIT)
+        set_builtin(plan, "u_lightMatrix", self._light_matrix)
         ctx.cull_face = "back"
-        for vao, (model, mvp, prev_mvp, nmat, cull) in zip(self._vaos[id(program)], self._per_object):
+        for vao, (model, mvp, prev_mvp, nmat, cull, reproject) in zip(self._vaos[id(program)], self._per_object):
             if cull:
                 ctx.enable(moderngl.CULL_FACE)
             else:
@@ -177,4 +278,5 @@ class SceneDrawer:
             set_builtin(plan, "u_modelViewProjectionMatrix", mvp)
             set_builtin(plan, "u_normalMatrix", nmat)
             set_builtin(plan, "u_prevModelViewProjectionMatrix", prev_mvp)
+            set_builtin(plan, "u_reprojectionMatrix", reproject)
             vao.render(moderngl.TRIANGLES)

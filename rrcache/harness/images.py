@@ -3,8 +3,12 @@
 EXR keeps the float32 RGBA values bit-exact; PNG (and other 8-bit formats) clamp to [0, 1] and
 quantise, with straight (unassociated) alpha, since shaders write straight colour.
 
+>>> import os, tempfile
 >>> import numpy as np
->>> write_image("frame.exr", np.zeros((4, 4, 4), np.float32))   # doctest: +SKIP
+>>> path = os.path.join(tempfile.mkdtemp(), "frame.exr")
+>>> write_image(path, np.full((4, 4, 4), 0.25, np.float32))
+>>> os.path.getsize(path) > 0
+True
 """
 from __future__ import annotations
 
@@ -12,7 +16,9 @@ import os
 
 import numpy as np
 
-from rrcache.errors import AssetError
+from rrcache import atomic
+from rrcache.errors import AssetError, printable
+from rrcache.stdio import quiet_stderr
 
 _FLOAT_FORMATS = (".exr", ".hdr", ".tif", ".tiff")
 
@@ -40,9 +46,19 @@ def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
     if out is None:
         raise AssetError(f"cannot write an image: {oiio.geterror()}", path,
                          hint="use a .exr or .png file name")
-    ok = out.open(path, spec) and out.write_image(pixels)
-    message = out.geterror()
-    out.close()
-    if not ok:
-        raise AssetError(f"cannot write the image: {message or 'unknown OpenImageIO error'}", path,
-                         hint="check that the directory exists and is writable")
+    # written beside, read back, then renamed: a full disk leaves no empty or truncated image
+    # (OpenImageIO's codecs do not always report a failed write)
+    with atomic.temporary_path(path) as tmp:
+        with quiet_stderr():
+            ok = out.open(tmp, spec) and out.write_image(pixels)
+            message = out.geterror()
+            out.close()
+            check = oiio.ImageInput.open(tmp) if ok else None
+            if check is not None:
+                ok = check.read_image(0, 0, 0, c, oiio.FLOAT) is not None and not check.geterror()
+                check.close()
+            else:
+                ok = False
+        if not ok:
+            raise AssetError(f"cannot write the image: {printable(message) or 'it did not read back whole (is the disk full?)'}",
+                             path, hint="check that the folder is writable and the disk has room")

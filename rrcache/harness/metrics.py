@@ -1,4 +1,4 @@
-"""Image error metrics (DESIGN.md §3, "Models").
+"""Image error metrics (docs/design.md §3, "Models").
 
 - :func:`mean_l2`: the paper's error: mean per-pixel Euclidean distance of RGB between an image
   and the reference, over the covered (shaded) pixels only. Pixels where either image is not

@@ -17,8 +17,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Mapping, Optional, Sequence
 
+from rrcache.deep import deep
 from rrcache.errors import SourceLoc
-from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes
+from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes, shadow_defines
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,8 @@ class PreparedShader:
     uniforms: dict[str, Decl] = field(default_factory=dict)
     inputs: dict[str, Decl] = field(default_factory=dict)
     defines: dict[str, str] = field(default_factory=dict)
+    #: the user's vertex shader (``rrcache.harness.user_vertex.UserVertex``); None: generated
+    vertex: Optional[object] = None
 
     def declaration(self, name: str) -> Optional[Decl]:
         """The declaration of uniform or input ``name`` (None when the shader declares none)."""
@@ -84,15 +87,21 @@ def declarations(unit) -> tuple[dict[str, Decl], dict[str, Decl]]:
     return uniforms, inputs
 
 
-def prepare(shader, defines: Optional[Mapping[str, str]] = None) -> PreparedShader:
+@deep
+def prepare(shader, defines: Optional[Mapping[str, str]] = None, vertex=None) -> PreparedShader:
     """A :class:`PreparedShader` from a front-end ``Shader``: rewritten to ``#version 330 core``
     (``rrcache.glsl.legacy.to_core``) and printed with a line map.
 
-    ``defines`` are recorded (the shader must already have been loaded with them).
+    ``defines`` are recorded (the shader must already have been loaded with them). ``vertex``
+    is the user's vertex shader (a ``UserVertex``; None: the harness generates one); the hash
+    then covers it too.
 
-    >>> from rrcache.glsl.frontend import parse_shader          # doctest: +SKIP
-    >>> prepare(parse_shader(open("marble.frag").read(), "marble.frag")).source[:17]  # doctest: +SKIP
-    '#version 330 core'
+    >>> from rrcache.glsl.frontend import parse_shader
+    >>> shader = parse_shader("varying vec3 v_normal;\\nvoid main() { gl_FragColor = vec4(v_normal, 1.0); }",
+    ...                       "normal.frag")
+    >>> p = prepare(shader)
+    >>> p.source[:17], sorted(p.inputs)
+    ('#version 330 core', ['v_normal'])
     """
     from rrcache.glsl.legacy import to_core
     from rrcache.glsl.printer import print_with_map
@@ -114,26 +123,36 @@ def prepare(shader, defines: Optional[Mapping[str, str]] = None) -> PreparedShad
     return PreparedShader(
         source=text,
         path=str(shader.path) if getattr(shader, "path", None) else "<string>",
-        hash=shader.hash,
+        hash=combined_hash(shader.hash, vertex),
         line_map=list(line_map),
         uniforms=uniforms,
         inputs=inputs,
         defines=dict(defines or {}),
+        vertex=vertex,
     )
+
+
+def combined_hash(fragment_hash: str, vertex=None) -> str:
+    """The fragment shader's hash, or with a user vertex shader a hash over both."""
+    if vertex is None:
+        return fragment_hash
+    import hashlib
+
+    return hashlib.sha256(f"{fragment_hash}\0vertex\0{vertex.hash}".encode()).hexdigest()
 
 
 def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[str, str]] = None,
                     include_dirs=()):
-    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes:
-    the one place a shader is loaded for a session. Returns ``(shader, defines)``: the front-end
+    """Load a fragment shader file with the ``MODEL_VERTEX_*`` defines of the mesh attributes (and
+    a session light's ``LIGHT_SHADOWMAP*``): the one place a shader is loaded for a session. Returns ``(shader, defines)``: the front-end
     ``Shader`` and every define it was loaded with.
 
     ``session_or_attributes`` is a session (the union of its meshes' attributes counts), an
     iterable of attribute names (``normal texcoord color tangent``) or None (no mesh defines).
     ``defines`` (e.g. from ``-D`` on the command line) are added and win over the mesh defines.
 
-    >>> shader, defines = load_for_meshes("marble.frag", {"normal", "texcoord"})   # doctest: +SKIP
-    >>> defines                                                                   # doctest: +SKIP
+    >>> shader, defines = load_for_meshes("shaders/glslviewer_basic.glsl", {"normal", "texcoord"})
+    >>> defines
     {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
     """
     from rrcache.glsl.frontend import load_shader
@@ -141,7 +160,9 @@ def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[
     if session_or_attributes is None:
         all_defines = {}
     elif hasattr(session_or_attributes, "objects"):
-        all_defines = mesh_defines(session_attributes(session_or_attributes))
+        # the meshes' MODEL_VERTEX_* and, when the light has a shadow map, LIGHT_SHADOWMAP*
+        all_defines = {**mesh_defines(session_attributes(session_or_attributes)),
+                       **shadow_defines(session_or_attributes)}
     else:
         all_defines = mesh_defines(frozenset(session_or_attributes))
     all_defines.update(defines or {})
@@ -149,10 +170,24 @@ def load_for_meshes(path, session_or_attributes=None, defines: Optional[Mapping[
 
 
 def prepare_file(path, session_or_attributes=(), extra_defines: Optional[Mapping[str, str]] = None,
-                 include_dirs=()) -> PreparedShader:
-    """:func:`load_for_meshes`, then :func:`prepare`.
+                 include_dirs=(), vertex=None) -> PreparedShader:
+    """:func:`load_for_meshes`, then :func:`prepare`; ``vertex`` is the path of the user's vertex
+    shader (None: the session's ``"vertex"`` when ``session_or_attributes`` is a session that has
+    one, else generated).
 
     >>> prepare_file("marble.frag", {"normal", "texcoord"}).defines     # doctest: +SKIP
     {'MODEL_VERTEX_NORMAL': '1', 'MODEL_VERTEX_TEXCOORD': '1'}
     """
-    return prepare(*load_for_meshes(path, session_or_attributes, extra_defines, include_dirs))
+    shader, defines = load_for_meshes(path, session_or_attributes, extra_defines, include_dirs)
+    return prepare(shader, defines, load_user_vertex(vertex, session_or_attributes, defines, include_dirs))
+
+
+def load_user_vertex(vertex, session=None, defines=None, include_dirs=()):
+    """The ``UserVertex`` of path ``vertex``, or of the session's ``"vertex"`` when ``vertex`` is
+    None; None when neither names one."""
+    path = vertex if vertex is not None else getattr(session, "vertex", None)
+    if path is None:
+        return None
+    from rrcache.harness.user_vertex import load_vertex
+
+    return load_vertex(path, defines, include_dirs)

@@ -5,10 +5,20 @@ profile. :class:`ReferenceCache` keys a frame by (shader hash, session hash, res
 index), keeps it in memory and, when given a directory, also as ``.npy`` files (image and coverage
 mask) so that a later run reuses them.
 
->>> cache = ReferenceCache("refs/")                          # doctest: +SKIP
->>> frames = cache.frames(prepared, session, [0, 1, 2])      # doctest: +SKIP
->>> cache.rendered, len(frames)                              # doctest: +SKIP
+>>> import tempfile
+>>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.session import load_session
+>>> session = load_session("sessions/marble.json")
+>>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+>>> refs = tempfile.mkdtemp()
+>>> cache = ReferenceCache(refs)
+>>> frames = cache.frames(prepared, session, [0, 1, 2], resolution=(32, 24))
+>>> cache.rendered, len(frames)
 (3, 3)
+>>> again = ReferenceCache(refs)          # a later run: read from the files, nothing drawn
+>>> _ = again.frames(prepared, session, [0, 1, 2], resolution=(32, 24))
+>>> again.rendered
+0
 """
 from __future__ import annotations
 

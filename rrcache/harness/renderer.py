@@ -9,11 +9,11 @@ samples that passed the depth test (an occlusion query: shaded fragments, overdr
 the wall time of the draws (``time.perf_counter()`` around clear, draws and ``ctx.finish()``,
 after one untimed warm-up draw of the program, since llvmpipe compiles on the first draw).
 
->>> from rrcache.session import load_session                      # doctest: +SKIP
->>> session = load_session("scenes/marble/session.json")          # doctest: +SKIP
->>> result = render("scenes/marble/marble.frag", session, frames=3)  # doctest: +SKIP
->>> result.frames[0].image.shape, result.ms_per_frame > 0          # doctest: +SKIP
-((480, 640, 4), True)
+>>> from rrcache.session import load_session
+>>> session = load_session("sessions/marble.json")
+>>> result = render("shaders/glslviewer_basic.glsl", session, frames=3, resolution=(64, 48))
+>>> result.frames[0].image.shape, result.ms_per_frame > 0, result.frames[0].covered_pixels > 0
+((48, 64, 4), True, True)
 """
 from __future__ import annotations
 
@@ -27,14 +27,15 @@ import numpy as np
 
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
+from rrcache import watchdog
 from rrcache.gl.formats import ERROR_FORMAT, color_dtype, texture_floats
-from rrcache.gl.limits import check_target_size
+from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
-from rrcache.harness.prepare import PreparedShader, prepare, prepare_file
-from rrcache.harness.vertex import vertex_source
+from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare, prepare_file
+from rrcache.harness.vertex import vertex_for
 
 #: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
 #: and flipped (32), the depth read back (4) and the coverage mask (1); checked before allocating
@@ -53,6 +54,7 @@ class FrameResult:
     ms: float
     mask: np.ndarray
     samples_passed: int = 0
+    cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
 
 
 @dataclass
@@ -93,8 +95,14 @@ class Renderer:
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
     images and masks are then of the window's size.
 
-    >>> with Renderer(prepared, session) as r:                # doctest: +SKIP
+    >>> from rrcache.harness.prepare import prepare_file
+    >>> from rrcache.session import load_session
+    >>> session = load_session("sessions/marble.json")
+    >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
+    >>> with Renderer(prepared, session, (32, 24)) as r:
     ...     first = r.render_frame(0)
+    >>> first.image.shape
+    (24, 32, 4)
     """
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
@@ -124,16 +132,19 @@ class Renderer:
         check_target_size(ctx, self.size, TARGET_BYTES_PER_PIXEL, where)
         inputs = {name: d.type for name, d in prepared.inputs.items()}
         locs = {name: d.loc for name, d in prepared.inputs.items()}
-        self.vertex_source = vertex_source(inputs, locs)
+        user = getattr(prepared, "vertex", None)
+        self.vertex_source = vertex_for(inputs, locs, user)
         self.program = self._scope.own(build_program(
-            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path))
+            ctx, self.vertex_source, prepared.source, prepared.line_map, fragment_name=prepared.path,
+            vertex_name=user.path if user is not None else "<generated vertex shader>"))
         self.drawer = SceneDrawer(ctx, self.session, prepared, self.size, self._scope, self.cull_back_faces)
         self.plan = self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
         w, h = self.size
-        self._color = self._scope.own(ctx.texture((w, h), 4, dtype=self._color_dtype))
-        self._depth = self._scope.own(ctx.depth_texture((w, h)))
-        self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
+        with target_guard(self.size, where):
+            self._color = self._scope.own(ctx.texture((w, h), 4, dtype=self._color_dtype))
+            self._depth = self._scope.own(ctx.depth_texture((w, h)))
+            self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
         self.fbo.scissor = self.window
         # moderngl's Query has no release(); it goes with the Python object
         self._query = ctx.query(samples=True)
@@ -143,6 +154,10 @@ class Renderer:
         return check_frame_index(self.session, index)
 
     def _draw(self, index: int, stages: Optional[dict] = None) -> tuple[float, int]:
+        ms, samples, self._cpu_ms = self._draw_timed(index, stages)
+        return ms, samples
+
+    def _draw_timed(self, index: int, stages: Optional[dict] = None) -> tuple[float, int, float]:
         ctx = self.ctx
         self.drawer.set_frame(index)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -151,7 +166,13 @@ class Renderer:
         self.fbo.viewport = (0, 0, *self.size)
         background = session_background(self.session)
         ctx.finish()
+        cpu_start = time.process_time()
         start = time.perf_counter()
+        if self.drawer.shadow_map is not None:  # the light's depth pass is part of the frame
+            self.drawer.render_shadow_map()
+            ctx.depth_func = "<"
+            self.fbo.use()
+            self.fbo.viewport = (0, 0, *self.size)
         self.fbo.clear(*background, depth=1.0)
         if stages is not None:
             ctx.finish()
@@ -160,12 +181,13 @@ class Renderer:
             self.drawer.draw(self.program)
         ctx.finish()
         end = time.perf_counter()
+        cpu_ms = (time.process_time() - cpu_start) * 1000.0
         samples = int(self._query.samples)
         if stages is not None:
             stages.setdefault("clear", []).append((cleared - start) * 1000.0)
             stages.setdefault("draw", []).append((end - cleared) * 1000.0)
             stages.setdefault("queries", []).append((time.perf_counter() - end) * 1000.0)
-        return (end - start) * 1000.0, samples
+        return (end - start) * 1000.0, samples, cpu_ms
 
     def render_frame(self, index: int, stages: Optional[dict] = None) -> FrameResult:
         """Render frame ``index`` (an int in ``0..session.frames-1``) and read it back.
@@ -175,10 +197,11 @@ class Renderer:
         and the read-back of this frame, the GPU waited for after each.
         """
         index = self._check_frame(index)
-        if not self._warm:
-            self._draw(index)
-            self._warm = True
-        ms, samples = self._draw(index, stages)
+        with watchdog.frame(f"frame {index} of the original"):
+            if not self._warm:
+                self._draw(index)
+                self._warm = True
+            ms, samples = self._draw(index, stages)
         read = time.perf_counter()
         w, h = self.size
         image = crop_rows(texture_floats(self._color.read(), self._color_dtype, (h, w, 4)), self.window).copy()
@@ -186,7 +209,7 @@ class Renderer:
         if stages is not None:
             stages.setdefault("read-back", []).append((time.perf_counter() - read) * 1000.0)
         mask = depth < 1.0
-        return FrameResult(index, image, int(mask.sum()), ms, mask, samples)
+        return FrameResult(index, image, int(mask.sum()), ms, mask, samples, self._cpu_ms)
 
     def frames(self, indices: Iterable[int]):
         """Yield a :class:`FrameResult` per frame index, in order."""
@@ -237,24 +260,30 @@ def frame_indices(session, frames=None) -> list[int]:
 
 def as_prepared(shader, session, defines=None) -> PreparedShader:
     """A :class:`PreparedShader` from a prepared shader, a front-end ``Shader`` or a shader path
-    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``)."""
+    (loaded with the session's ``MODEL_VERTEX_*`` defines plus ``defines``), with the session's
+    ``"vertex"`` shader when it names one."""
     if isinstance(shader, PreparedShader):
         return shader
     if hasattr(shader, "unit"):
-        return prepare(shader, defines)
+        return prepare(shader, defines, load_user_vertex(None, session, shader.defines or defines))
     return prepare_file(shader, session, defines)
 
 
 def render(shader, session, frames=None, resolution=None, defines=None,
-           progress: Optional[Callable[[FrameResult], None]] = None, color_format: str = ERROR_FORMAT) -> RenderResult:
+           progress: Optional[Callable[[FrameResult], None]] = None, keep_images: bool = True,
+           color_format: str = ERROR_FORMAT) -> RenderResult:
     """Render ``frames`` of ``session`` (None: all, an int: the first n, or a list of indices).
 
     ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
-    called with each :class:`FrameResult` as it is done; ``color_format`` the colour target
-    (:mod:`rrcache.gl.formats`).
+    called with each :class:`FrameResult` as it is done. With ``keep_images=False`` frames are
+    streamed: ``progress`` sees each image, and the result keeps only the per-frame figures
+    (``image`` and ``mask`` are None), so a session of a million frames runs in constant memory.
+    ``color_format``: the colour target (:mod:`rrcache.gl.formats`).
 
-    >>> result = render("marble.frag", load_session("session.json"), frames=2)   # doctest: +SKIP
-    >>> [f.index for f in result.frames]                                          # doctest: +SKIP
+    >>> from rrcache.session import load_session
+    >>> result = render("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"),
+    ...                 frames=2, resolution=(32, 24))
+    >>> [f.index for f in result.frames]
     [0, 1]
     """
     prepared = as_prepared(shader, session, defines)
@@ -262,9 +291,11 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     results = []
     with Renderer(prepared, session, resolution, color_format=color_format) as renderer:
         for result in renderer.frames(indices):
-            results.append(result)
             if progress is not None:
                 progress(result)
+            if not keep_images:
+                result.image = result.mask = None
+            results.append(result)
         notes = renderer.notes
         size = renderer.size
     ms = statistics.median(r.ms for r in results) if results else float("nan")

@@ -1,7 +1,7 @@
 """The generated vertex shader and the mesh-attribute defines.
 
 The harness draws every mesh with a vertex shader written here (``#version 330 core``) that
-outputs the glslViewer varyings a fragment shader may read (DESIGN.md §4), in world space:
+outputs the glslViewer varyings a fragment shader may read (docs/design.md §4), in world space:
 
 =====================  ======  =========================================================
 ``v_position``         vec4    world position (``u_modelMatrix * position``)
@@ -10,6 +10,8 @@ outputs the glslViewer varyings a fragment shader may read (DESIGN.md §4), in w
 ``v_color``            vec4    vertex colour (opaque white when the mesh has none)
 ``v_tangent``          vec4    world tangent, w = handedness (0 when the mesh has none)
 ``v_objectPosition``   vec3    object-space position (solid textures on moving objects)
+``v_lightCoord``       vec4    ``u_lightMatrix * v_position``: shadow-map coordinates (in
+                               [0, 1] after the divide by w) when the light has a shadow map
 ``rr_prevClip``        vec4    clip position at the previous frame (reprojection cache)
 =====================  ======  =========================================================
 
@@ -46,11 +48,13 @@ VARYINGS = {
     "v_color": (4, "a_color", ("color",), "1.0"),
     "v_tangent": (4, "vec4(normalize(mat3(u_modelMatrix) * a_tangent.xyz), a_tangent.w)", ("tangent",), "0.0"),
     "v_objectPosition": (3, "a_position", ("position",), "1.0"),
+    "v_lightCoord": (4, "u_lightMatrix * rr_world", ("position",), "1.0"),
     "rr_prevClip": (4, "u_prevModelViewProjectionMatrix * vec4(a_position, 1.0)", ("position",), "1.0"),
 }
 
 # uniforms the vertex shader reads (set per object by the renderer)
-VERTEX_UNIFORMS = ("u_modelMatrix", "u_modelViewProjectionMatrix", "u_normalMatrix", "u_prevModelViewProjectionMatrix")
+VERTEX_UNIFORMS = ("u_modelMatrix", "u_modelViewProjectionMatrix", "u_normalMatrix", "u_prevModelViewProjectionMatrix",
+                   "u_lightMatrix")
 
 _FLOAT_TYPES = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
 
@@ -93,6 +97,26 @@ def mesh_defines(attributes: Iterable[str]) -> dict[str, str]:
     return {name: "1" for name in sorted(names)}
 
 
+def shadow_defines(session) -> dict[str, str]:
+    """``LIGHT_SHADOWMAP`` and ``LIGHT_SHADOWMAP_SIZE`` (glslViewer's) when the session's light has
+    a shadow map, else nothing.
+
+    >>> from types import SimpleNamespace
+    >>> shadow_defines(SimpleNamespace(shadow_map=SimpleNamespace(size=512)))
+    {'LIGHT_SHADOWMAP': 'u_lightShadowMap', 'LIGHT_SHADOWMAP_SIZE': '512.0'}
+    """
+    shadow = getattr(session, "shadow_map", None)
+    if shadow is None:
+        return {}
+    return {"LIGHT_SHADOWMAP": "u_lightShadowMap", "LIGHT_SHADOWMAP_SIZE": f"{float(shadow.size)!r}"}
+
+
+def session_defines(session) -> dict[str, str]:
+    """Every define a session implies: the meshes' ``MODEL_VERTEX_*`` and the light's
+    ``LIGHT_SHADOWMAP*``."""
+    return {**mesh_defines(session_attributes(session)), **shadow_defines(session)}
+
+
 def _convert(expr: str, size: int, pad: str, declared: int) -> str:
     if declared == size:
         return expr
@@ -100,6 +124,29 @@ def _convert(expr: str, size: int, pad: str, declared: int) -> str:
         return f"({expr}).{'xyzw'[:declared]}"
     fill = ", ".join(["0.0"] * (declared - size - 1) + [pad])
     return f"vec{declared}({expr}, {fill})"
+
+
+def vertex_for(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None,
+               user=None, prev_clip: bool = False) -> str:
+    """The vertex shader of a program whose fragment shader reads ``inputs``: the user's own
+    (a :class:`rrcache.harness.user_vertex.UserVertex`, checked against ``inputs``) when given,
+    else the generated one; ``prev_clip`` adds ``rr_prevClip`` and ``invariant gl_Position`` (the
+    cached variants' passes).
+
+    >>> "out vec2 v_texcoord;" in vertex_for({"v_texcoord": "vec2"})
+    True
+    """
+    if user is not None:
+        user.check_inputs(inputs, locs)
+        return user.source(prev_clip=prev_clip)
+    wanted = dict(inputs)
+    if prev_clip:
+        wanted["rr_prevClip"] = "vec4"
+    text = vertex_source(wanted, locs)
+    if not prev_clip:
+        return text
+    first, _, rest = text.partition("\n")
+    return f"{first}\ninvariant gl_Position;\n{rest}"
 
 
 def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None) -> str:
@@ -119,7 +166,9 @@ def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optiona
             raise UnsupportedShaderError(
                 f"fragment input `{name}` is not a varying the harness supplies",
                 locs.get(name),
-                hint=f"use one of {', '.join(VARYINGS)} (DESIGN.md §4)",
+                hint=f"use one of {', '.join(v for v in VARYINGS if not v.startswith('rr_'))} "
+                     "(docs/design.md §4), or give the vertex shader that writes it (--vert FILE, or "
+                     "\"vertex\" in the session)",
             )
         if declared not in _FLOAT_TYPES:
             raise UnsupportedShaderError(
@@ -137,6 +186,8 @@ def vertex_source(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optiona
         lines.append("uniform mat3 u_normalMatrix;")
     if "rr_prevClip" in inputs:
         lines.append("uniform mat4 u_prevModelViewProjectionMatrix;")
+    if "v_lightCoord" in inputs:
+        lines.append("uniform mat4 u_lightMatrix;")
     lines += [f"out {declared} {name};" for name, declared, _ in outs]
     lines += ["void main() {", "    vec4 rr_world = u_modelMatrix * vec4(a_position, 1.0);"]
     lines += [f"    {name} = {value};" for name, _, value in outs]

@@ -29,6 +29,7 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.renderer import Renderer
 from rrcache.profiler.plan import Plan
 from rrcache.profiler.train import _Meter, _error_run, _timing_run, timing_frame_indices
+from rrcache.profiles.document import check_same_shader
 
 DEFAULT_PERIODS = (6, 14, 30)
 #: at most this many front nodes are measured (the front's nodes spread over its time range)
@@ -143,10 +144,8 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
         raise RRCacheError(f"nodes {unknown} are not trained in this profile", str(profile.path or "profile"),
                            hint="give trained node ids (profile.json lists them)")
     session = load_session(profile.session)
-    work = load_for_session(profile.shader, session, profile.defines)
-    if work.shader.hash != profile.shader_hash:
-        raise RRCacheError("the shader changed since it was profiled", str(profile.shader),
-                           hint="run 'rrcache profile' again")
+    work = load_for_session(profile.shader, session, profile.defines, profile.include_dirs, vertex=profile.vertex)
+    check_same_shader(profile, work)
     plan = Plan.from_json(profile.plan or {})
     full = tuple(int(v) for v in session.resolution)
     train_frames = list(range(settings.frames))

@@ -17,11 +17,15 @@ and nothing below imports it. Into the output folder it writes:
 """
 from __future__ import annotations
 
+import os
+import sqlite3
 import time
 from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.glsl.frontend import file_records
+from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
 from rrcache.profiler.train import ProgressFn, TrainingResult, train
 from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
@@ -41,11 +45,14 @@ def default_out_dir(shader_path, session_path) -> Path:
 
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
-            fresh: bool = False, plots: bool = True) -> Profile:
+            fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
+            vertex=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
-    moves it aside first. ``progress`` receives :class:`~rrcache.profiler.train.ProgressEvent`
+    moves it aside first. Another process profiling into the same folder holds its lock: this one
+    raises an error naming it, or with ``wait=True`` waits. ``vertex`` is the user's vertex shader
+    file (None: the session's ``"vertex"``, else generated). ``progress`` receives :class:`~rrcache.profiler.train.ProgressEvent`
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates.
 
@@ -56,35 +63,47 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     from rrcache.session import load_session
 
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, defines)
+    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
     resolved = (settings or TrainingSettings()).resolved(session)
     out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
-    key = StoreKey(work.shader.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
-    store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
-    started = time.time()
+    key = StoreKey(work.hash, session.hash, resolved.key_hash(), rrcache.__version__, resolved.key_json())
+    # one writer per folder: taken before the store is opened (or moved aside by --fresh)
+    lock = StoreLock.acquire(out / LOCK_NAME, wait=wait)
     try:
-        store.begin_run()
-        result = train(work, session, resolved, store, progress)
-        prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
-        prof.selections = _selections(prof, work, session, resolved, result, store, progress)
-        _write_outputs(prof, out, work, plots)
-        store.end_run("done")
-        _add_times(prof, store, time.time() - started)
-        prof.write(out)
-    except KeyboardInterrupt:
-        store.end_run("interrupted")
-        store.close()
-        raise
-    except BaseException:
+        store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
+        started = time.time()
         try:
-            store.end_run("failed")
-        finally:
-            store.close()
-        raise
-    store.close()
+            store.begin_run()
+            result = train(work, session, resolved, store, progress)
+            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+            prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+            _write_outputs(prof, out, work, plots)
+            store.end_run("done")
+            _add_times(prof, store, time.time() - started)
+            prof.write(out)
+        except KeyboardInterrupt:
+            _end_quietly(store, "interrupted")
+            raise
+        except BaseException:
+            _end_quietly(store, "failed")
+            raise
+        store.close()
+    finally:
+        lock.release()
     return prof
+
+
+def _end_quietly(store, status: str) -> None:
+    """Log how the run ended if the store can still be written (a full disk may forbid it; the
+    error that stopped the run is the one to report)."""
+    try:
+        store.end_run(status)
+    except (RRCacheError, OSError, sqlite3.Error):
+        pass
+    finally:
+        store.close()
 
 
 def _add_times(prof: Profile, store, run_wall_s: float) -> None:
@@ -106,7 +125,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     for nid in result.order:
         entry = by_id[nid]
         node = NodeProfile(nid, entry.type, entry.line, entry.column, entry.text, list(entry.call_chain),
-                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid))
+                           int(entry.cost), trained=nid in result.trained, note=result.notes.get(nid),
+                           file=getattr(entry, "file", None))
         runs = [r for r in store.error_runs(nid) if r.period in settings.periods]
         node.periods = [r.period for r in runs]
         node.errors = [r.mean_error for r in runs]
@@ -123,10 +143,13 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     plan = result.plan
     draft = Profile(
         shader=str(Path(shader_path).resolve()), session=str(Path(session_path).resolve()),
-        shader_hash=work.shader.hash, session_hash=session.hash, settings=settings,
+        shader_hash=work.hash, session_hash=session.hash, settings=settings,
+        shader_files=file_records(work.shader),
+        vertex=os.path.abspath(work.vertex.path) if work.vertex is not None else None,
+        vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
-        nodes=nodes, defines=dict(work.defines), plan=plan.to_json() if plan is not None else None,
+        nodes=nodes, defines=dict(work.defines), include_dirs=list(work.include_dirs), plan=plan.to_json() if plan is not None else None,
         untrained=list(result.untrained), budget_stopped=result.budget_stopped,
         mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,
         hit_fit=_fit_json(hit), overhead_ms=result.overhead_ms, original_ms=result.original_ms,

@@ -142,7 +142,17 @@ def training_order(work: ShaderWork, session, settings: TrainingSettings) -> Tra
     """The nodes to train in order, and the skipped ones with their reasons
     (:mod:`rrcache.profiler.order`)."""
     nodes = [n for _, n in sorted(enumerate(work.table.nodes), key=lambda item: (-item[1].cost, item[0]))]
+    # a fixed algorithm trains only the nodes it can cache ('auto' chooses among
+    # AUTO_CANDIDATES, which every listed node allows)
+    algorithm = settings.fixed_algorithm
+    invalid = {n.id: f"{algorithm} cannot cache it: {n.invalid[algorithm]}"
+               for n in nodes if algorithm in getattr(n, "invalid", {})}
+    if settings.algorithm != "auto":
+        nodes = [n for n in nodes if n.id not in invalid]
+    else:
+        invalid = {}
     keep, skipped = cost_filter(nodes, settings.min_saving)
+    skipped.update(invalid)
     changing = per_frame_uniforms(session)
     deps = dependency_map(work.table.shader.unit)
     inputs = shader_inputs(work.prepared.source)
@@ -258,6 +268,12 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         raise RRCacheError("the shader has no cacheable node to train", str(work.shader.path or "<shader>"),
                            hint="'rrcache nodes SHADER --all' lists the values left out and why")
     order = training_order(work, session, settings)
+    if not order.nodes and settings.algorithm != "auto" and any(
+            settings.fixed_algorithm in getattr(n, "invalid", {}) for n in work.table.nodes):
+        raise RRCacheError(f"no listed node of the shader can be cached with {settings.fixed_algorithm}",
+                           str(work.shader.path or "<shader>"),
+                           hint="'rrcache nodes SHADER' says why in its algorithms column; profile with "
+                                "--algorithm auto, three-pass or two-pass")
     ids = [n.id for n in order.nodes]
     train_frames = list(range(settings.frames))
     timing = timing_frame_indices(session.frames, settings.timing_frames)

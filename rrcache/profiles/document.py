@@ -83,6 +83,7 @@ class NodeProfile:
     error_fit: dict = field(default_factory=dict)
     perf_fit: dict = field(default_factory=dict)
     note: Optional[str] = None
+    file: Optional[str] = None  # the included file the node was written in (None: the shader itself)
 
 
 def _fit_json(fit) -> dict:
@@ -127,6 +128,8 @@ class Profile:
     algorithm: str
     nodes: list[NodeProfile]
     defines: dict[str, str] = field(default_factory=dict)
+    #: the -I folders of the profiling command (the session's own "include_dirs" come with it)
+    include_dirs: list[str] = field(default_factory=list)
     algorithm_times: dict[str, float] = _range(minimum=0, factory=dict)
     plan: Optional[dict] = None
     untrained: list[str] = field(default_factory=list)
@@ -144,6 +147,10 @@ class Profile:
     run_wall_s: Optional[float] = _range(None, minimum=0)
     precompute_s: Optional[float] = _range(None, minimum=0)
     invocations: int = _range(0, minimum=0)
+    #: every file the shader read, ``[{"path", "sha256"}]`` (``rrcache.glsl.frontend.file_records``)
+    shader_files: list[dict] = field(default_factory=list)
+    vertex: Optional[str] = None  # the user's vertex shader file, or None (generated)
+    vertex_hash: Optional[str] = None
     #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON; :attr:`measured_ceiling`)
     ceiling: Optional[dict] = None
     #: when the ceiling stopped the profile before training: ``choice`` ("original"), ``ceiling``,
@@ -349,10 +356,9 @@ class Profile:
         from rrcache.pipeline import load_for_session, variant_for_selection
         from rrcache.session import load_session
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines)
-        if work.shader.hash != self.shader_hash:
-            raise RRCacheError("the shader changed since it was profiled", str(self.shader),
-                               hint="run 'rrcache profile' again")
+        work = load_for_session(self.shader, load_session(self.session), self.defines, self.include_dirs,
+                                vertex=self.vertex)
+        check_same_shader(self, work)
         variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
         return variant.write(out, period=period, runtime=self.settings.cache_options())
 
@@ -504,6 +510,27 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
 
 
 # ---------------------------------------------------------------------- reading
+def check_same_shader(prof: Profile, work) -> None:
+    """Raise unless ``work`` (the shader loaded again for profile ``prof``) has the profiled hash;
+    the error says which file changed, or that none did (never blames an edit that did not
+    happen)."""
+    from rrcache.glsl.frontend import describe_change
+
+    if work.hash == prof.shader_hash:
+        return
+    what = describe_change(prof.shader_files or None, work.shader, prof.defines)
+    vertex_hash = work.vertex.hash if work.vertex is not None else None
+    if prof.vertex_hash is not None and vertex_hash != prof.vertex_hash:
+        changed = f"the vertex shader '{work.vertex.path if work.vertex is not None else prof.vertex}' changed"
+        what = changed if what.startswith("no shader file changed") else f"{what}; {changed}"
+    if what.startswith("no shader file changed") or what.startswith("the record predates"):
+        raise RRCacheError(f"the shader's hash differs from the profile's, though {what}" if what.startswith("no ")
+                           else f"the shader's hash differs from the profile's: {what}",
+                           str(prof.shader), hint="run 'rrcache profile' again to make a profile for it")
+    raise RRCacheError(f"the shader changed since it was profiled: {what}", str(prof.shader),
+                       hint="run 'rrcache profile' again, or restore the file")
+
+
 def algorithm_line(prof: Profile) -> str:
     """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
     0.377, three-pass 0.41 of the original's time)'."""

@@ -185,8 +185,9 @@ class TrainingSettings:
         if self.timing_format not in COLOR_FORMATS:
             raise _fail("timing_format", f"unknown colour format {self.timing_format!r}",
                         f"one of {', '.join(COLOR_FORMATS)}")
-        if not isinstance(self.budget_s, (int, float)) or not self.budget_s > 0:
-            raise _fail("budget_s", f"{self.budget_s!r} is not a positive number of seconds", "e.g. 480")
+        if isinstance(self.budget_s, bool) or not isinstance(self.budget_s, (int, float)) \
+                or not 0 < self.budget_s < float("inf"):
+            raise _fail("budget_s", f"{self.budget_s!r} is not a positive, finite number of seconds", "e.g. 480")
         object.__setattr__(self, "budget_s", float(self.budget_s))
 
     # ------------------------------------------------------------------ JSON

@@ -238,6 +238,51 @@ class TimingFrame:
     original_ms: float
 
 
+_INF = float("inf")
+_REAL, _INT = "number", "integer"
+#: the columns a stored row must keep in range: (kind, low, high); None: no bound
+_RANGES: dict[str, dict[str, tuple]] = {
+    "error_run": {"period": (_INT, 1, None), "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None),
+                  "hit_rate": (_REAL, 0.0, 1.0), "hits": (_INT, 0, None), "misses": (_INT, 0, None),
+                  "covered": (_INT, 0, None), "frames": (_INT, 0, None), "wall_s": (_REAL, 0.0, None)},
+    "error_frame": {"frame": (_INT, 0, None), "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None),
+                    "hits": (_INT, 0, None), "misses": (_INT, 0, None), "covered": (_INT, 0, None),
+                    "left_out": (_INT, 0, None)},
+    "timing_frame": {"period": (_INT, 1, None), "frame": (_INT, 0, None), "hits": (_INT, 0, None),
+                     "misses": (_INT, 0, None), "ms": (_REAL, 0.0, None), "original_ms": (_REAL, 0.0, None)},
+    "reference_timing": {"frame": (_INT, 0, None), "ms": (_REAL, 0.0, None), "covered": (_INT, 0, None)},
+    "overhead": {"width": (_INT, 1, None), "height": (_INT, 1, None), "frames": (_INT, 1, None),
+                 "ms": (_REAL, 0.0, None)},
+    "validation": {"max_error": (_REAL, 0.0, None), "period": (_INT, 1, None), "predicted_error": (_REAL, 0.0, None),
+                   "predicted_ms": (_REAL, 0.0, None), "predicted_speedup": (_REAL, 0.0, None),
+                   "measured_error": (_REAL, 0.0, None), "measured_psnr": (_REAL, None, None),
+                   "measured_ms": (_REAL, 0.0, None), "measured_original_ms": (_REAL, 0.0, None),
+                   "measured_speedup": (_REAL, 0.0, None), "hit_rate": (_REAL, 0.0, 1.0), "frames": (_INT, 0, None)},
+}
+#: the columns that name a row in an error message
+_KEYS = ("node", "period", "frame", "label")
+
+
+def _out_of_range(value, kind: str, low, high) -> Optional[str]:
+    """Why ``value`` does not fit (None: it fits). NULL is allowed only where the schema allows
+    it (``validation.node/period``: the original shader)."""
+    if value is None:
+        return None if kind == _INT else "is missing"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return f"is not a {kind}"
+    if kind == _INT and not isinstance(value, int):
+        return "is not an integer"
+    if isinstance(value, float) and value != value:
+        return "is not a number (NaN)"
+    if isinstance(value, float) and value in (_INF, -_INF) and not (low is None and high is None):
+        return "is infinite"
+    if low is not None and value < low:
+        return f"is below {low}"
+    if high is not None and value > high:
+        return f"is above {high}"
+    return None
+
+
 def _refuse(path: Path, message: str, hint: str) -> RRCacheError:
     return RRCacheError(message, str(path), hint=hint)
 
@@ -277,7 +322,12 @@ class ProfileStore:
             conn = cls._connect_existing(path)
             store = cls(path, conn)
             try:
-                store._check(key)
+                if store._is_empty():
+                    # a run killed while it created the store (its one transaction never
+                    # committed) leaves an SQLite file with no tables: nothing to lose, start it
+                    store._create(key)
+                else:
+                    store._check(key)
             except BaseException:
                 conn.close()
                 raise
@@ -307,6 +357,12 @@ class ProfileStore:
             detail = "; ".join(str(r[0]) for r in rows[:3])
             raise _refuse(path, f"the profile store is damaged (integrity check: {detail})", _FRESH_HINT)
         return conn
+
+    def _is_empty(self) -> bool:
+        try:
+            return self.conn.execute("SELECT COUNT(*) FROM sqlite_master").fetchone()[0] == 0
+        except sqlite3.DatabaseError:
+            return False  # _check reports the damage
 
     def _create(self, key: StoreKey) -> None:
         conn = self.conn
@@ -355,30 +411,37 @@ class ProfileStore:
         self.conn.execute("PRAGMA journal_mode=WAL")
 
     # ------------------------------------------------------------------ transactions
-    def _write(self, statements: Iterable[tuple[str, tuple]]) -> None:
+    def _write(self, statements: Iterable[tuple[str, tuple]]) -> sqlite3.Cursor:
+        """Run ``statements`` in one transaction; a failed write (a full disk, a read-only
+        folder) rolls back and raises an :class:`RRCacheError`: every earlier run stays stored."""
         conn = self.conn
-        conn.execute("BEGIN IMMEDIATE")
+        cur = None
         try:
-            for sql, args in statements:
-                conn.execute(sql, args)
-            conn.execute("UPDATE meta SET value = ? WHERE key = 'updated'", (repr(time.time()),))
-            conn.execute("COMMIT")
-        except BaseException:
-            if conn.in_transaction:
-                conn.execute("ROLLBACK")
-            raise
+            conn.execute("BEGIN IMMEDIATE")
+            try:
+                for sql, args in statements:
+                    cur = conn.execute(sql, args)
+                last = cur
+                conn.execute("UPDATE meta SET value = ? WHERE key = 'updated'", (repr(time.time()),))
+                conn.execute("COMMIT")
+            except BaseException:
+                if conn.in_transaction:
+                    try:
+                        conn.execute("ROLLBACK")
+                    except sqlite3.Error:
+                        pass
+                raise
+        except sqlite3.IntegrityError:
+            raise  # a run stored twice: a bug of the caller, not of the disk
+        except sqlite3.Error as err:
+            raise _refuse(self.path, f"cannot write the profile store: {err}",
+                          "free disk space or make the folder writable; what was stored before is kept, "
+                          "and running the same command again resumes") from None
+        return last
 
     def begin_run(self) -> int:
         """Log the start of a ``profile`` invocation; its id tags what it computes."""
-        conn = self.conn
-        conn.execute("BEGIN IMMEDIATE")
-        try:
-            cur = conn.execute("INSERT INTO run_log(started, status) VALUES (?, 'running')", (time.time(),))
-            conn.execute("COMMIT")
-        except BaseException:
-            if conn.in_transaction:
-                conn.execute("ROLLBACK")
-            raise
+        cur = self._write([("INSERT INTO run_log(started, status) VALUES (?, 'running')", (time.time(),))])
         self.run_id = int(cur.lastrowid)
         return self.run_id
 
@@ -477,22 +540,44 @@ class ProfileStore:
         return self.conn.execute("SELECT 1 FROM timing_run WHERE node = ? AND period = ?",
                                  (node, int(period))).fetchone() is not None
 
+    def _rows(self, table: str, sql: str, args: tuple = ()) -> list[tuple]:
+        """The rows of ``sql``, each checked against :data:`_RANGES` for ``table``: a stored value
+        of the wrong type, not finite or out of its range (a tampered or damaged store) is refused
+        with the table, the row and the column, never used."""
+        try:
+            cur = self.conn.execute(sql, args)
+            names = [d[0] for d in cur.description]
+            rows = cur.fetchall()
+        except sqlite3.DatabaseError as err:
+            raise _refuse(self.path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+        ranges = _RANGES[table]
+        for row in rows:
+            for name, value in zip(names, row):
+                rule = ranges.get(name)
+                if rule is not None:
+                    problem = _out_of_range(value, *rule)
+                    if problem:
+                        ident = ", ".join(f"{k}={v!r}" for k, v in zip(names, row) if k in _KEYS)
+                        raise _refuse(self.path, f"stored row {table}({ident}): {name} = {value!r} {problem}",
+                                      "the store was damaged or edited; " + _FRESH_HINT)
+        return rows
+
     def error_runs(self, node: Optional[str] = None) -> list[ErrorRun]:
         sql = "SELECT node, period, mean_error, psnr, hit_rate, hits, misses, covered, frames, wall_s FROM error_run"
-        rows = self.conn.execute(sql + (" WHERE node = ?" if node else "") + " ORDER BY node, period",
-                                 (node,) if node else ())
+        rows = self._rows("error_run", sql + (" WHERE node = ?" if node else "") + " ORDER BY node, period",
+                          (node,) if node else ())
         return [ErrorRun(*r) for r in rows]
 
     def error_frames(self, node: str, period: int) -> list[ErrorFrame]:
-        rows = self.conn.execute("SELECT frame, mean_error, psnr, hits, misses, covered, left_out FROM error_frame "
-                                 "WHERE node = ? AND period = ? ORDER BY frame", (node, int(period)))
+        rows = self._rows("error_frame", "SELECT frame, mean_error, psnr, hits, misses, covered, left_out FROM "
+                          "error_frame WHERE node = ? AND period = ? ORDER BY frame", (node, int(period)))
         return [ErrorFrame(*r) for r in rows]
 
     def timing_frames(self, node: str) -> dict[int, list[TimingFrame]]:
         """Per timing period, the timed frames of ``node``."""
         out: dict[int, list[TimingFrame]] = {}
-        rows = self.conn.execute("SELECT period, frame, hits, misses, ms, original_ms FROM timing_frame "
-                                 "WHERE node = ? ORDER BY period, frame", (node,))
+        rows = self._rows("timing_frame", "SELECT period, frame, hits, misses, ms, original_ms FROM timing_frame "
+                          "WHERE node = ? ORDER BY period, frame", (node,))
         for period, *rest in rows:
             out.setdefault(int(period), []).append(TimingFrame(*rest))
         return out
@@ -501,17 +586,18 @@ class ProfileStore:
         return {r[0] for r in self.conn.execute("SELECT DISTINCT node FROM timing_run")}
 
     def reference_timing(self) -> list[tuple[int, float, int]]:
-        return [tuple(r) for r in self.conn.execute("SELECT frame, ms, covered FROM reference_timing ORDER BY frame")]
+        return [tuple(r) for r in self._rows("reference_timing",
+                                             "SELECT frame, ms, covered FROM reference_timing ORDER BY frame")]
 
     def overhead(self) -> Optional[dict]:
-        row = self.conn.execute("SELECT node, width, height, frames, ms FROM overhead WHERE id = 1").fetchone()
-        if row is None:
+        rows = self._rows("overhead", "SELECT node, width, height, frames, ms FROM overhead WHERE id = 1")
+        if not rows:
             return None
-        return dict(zip(("node", "width", "height", "frames", "ms"), row))
+        return dict(zip(("node", "width", "height", "frames", "ms"), rows[0]))
 
     def validations(self) -> list[Selection]:
         """The measured selections, in label order."""
-        rows = self.conn.execute(f"SELECT {', '.join(_VALIDATION_COLUMNS)} FROM validation ORDER BY label")
+        rows = self._rows("validation", f"SELECT {', '.join(_VALIDATION_COLUMNS)} FROM validation ORDER BY label")
         out = []
         for label, max_error, parts, algorithm, *figures in rows:
             try:

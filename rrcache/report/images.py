@@ -157,7 +157,8 @@ class FrameShots:
         if work is None:
             from rrcache.pipeline import load_for_session
 
-            work = load_for_session(profile.shader, self.session, profile.defines)
+            work = load_for_session(profile.shader, self.session, profile.defines,
+                                    getattr(profile, "include_dirs", ()), vertex=profile.vertex)
         self.work = work
         self.size = image_size(self.session.resolution, max_width)
         self._originals: dict = {}

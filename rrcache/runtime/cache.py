@@ -5,10 +5,12 @@ inverse-depth textures, the depth buffer the passes share, the refresh pattern (
 seed: uniforms of the rule in :mod:`rrcache.runtime.refresh`; no texture), the clock
 and the occlusion queries that count shaded fragments. The application owns its geometry: each
 frame it hands the runtime a ``draw(program, pass_name)`` callback that sets its own uniforms on
-``program`` (including ``u_prevModelViewProjectionMatrix`` per object, for reprojection) and
-renders its vertex arrays with it.
+``program`` (including ``u_prevModelViewProjectionMatrix`` per object, for reprojection, or
+``u_reprojectionMatrix`` = previous MVP × inverse(this MVP) when the variant was compiled with the
+user's own vertex shader; the manifest lists the uniforms of each pass) and renders its vertex
+arrays with it.
 
-Passes (DESIGN.md §3; Sitthi-amorn 2008a §3):
+Passes (docs/design.md §3; Sitthi-amorn 2008a §3):
 
 three-pass (default; programs ``reproject``, ``payload``, ``shade``)
     1. ``reproject`` — depth test ``<`` with depth writes. At a hit it writes the reconstructed
@@ -51,9 +53,11 @@ from typing import Callable, Optional
 import moderngl
 import numpy as np
 
+from rrcache.budgets import MAX_RUNTIME_PERIOD, check_period
+from rrcache.errors import RRCacheError
 from rrcache.gl.context import bind_default_framebuffer
 from rrcache.gl.formats import bytes_per_texel, color_dtype, texture_floats
-from rrcache.gl.limits import check_target_size
+from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
 from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_uniforms
@@ -131,6 +135,8 @@ class CacheRuntime:
         depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
         clear_color: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
         cull_back_faces: Optional[bool] = None,
+        blend: float = 0.0,
+        phase_cycle: int = 1,
         color_format: str = "rgba32f",
     ):
         if algorithm not in ALGORITHMS:
@@ -156,6 +162,10 @@ class CacheRuntime:
         self.clear_color = clear_color
         self.cull_back_faces = cull_back_faces
         self.depth_epsilon = float(depth_epsilon)
+        self.blend = float(blend)  # λ of an amortized variant: c = λ·c_prev + (1-λ)·x at hits
+        # an amortized variant's per-phase programs: at clock % phase_cycle == k > 0 the pass
+        # "<name>@<k>" runs in the place of "<name>" (rrcache.compiler.amortize, "frame" mode)
+        self.phase_cycle = int(phase_cycle)
         self.seed = seed
         self._period = 1
         self.period = period
@@ -181,10 +191,10 @@ class CacheRuntime:
 
     @period.setter
     def period(self, value: int) -> None:
-        value = int(value)
-        if value < 1:
-            raise ValueError(f"the refresh period must be at least 1, not {value}")
-        self._period = value
+        try:
+            self._period = check_period(value, "period", MAX_RUNTIME_PERIOD)
+        except RRCacheError as err:  # the runtime's API has always raised ValueError here
+            raise ValueError(str(err)) from None
 
     def set_refresh(self, mode: Optional[str] = None, block: Optional[int] = None, seed: Optional[int] = None) -> None:
         """Change the refresh pattern (mode ``random``/``tiled``, block size k, seed)."""
@@ -210,25 +220,26 @@ class CacheRuntime:
         self._release_targets()
         ctx = self.ctx
         self.size = (w, h)
-        self.depth = ctx.depth_texture((w, h))
-        self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
-        self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
-        self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
-        for tex in self._payload + self._invdepth:
-            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            tex.repeat_x = tex.repeat_y = False
-        if self.algorithm == "three-pass":
-            self._cache_fbos = [ctx.framebuffer([self._payload[i], self._invdepth[i]], self.depth) for i in range(2)]
-        else:
-            self._cache_fbos = [
-                ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
-            ]
-        # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
-        # the colour to the background; the payload needs no clear (it is read only where the
-        # inverse depth says a surface was cached)
-        self._clear_fbos = [ctx.framebuffer([self._invdepth[i]], self.depth) for i in range(2)]
-        self._out_fbo = ctx.framebuffer([self.color], self.depth)
-        self._color_only_fbo = ctx.framebuffer([self.color])
+        with target_guard((w, h), "cache size"):
+            self.depth = ctx.depth_texture((w, h))
+            self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
+            self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
+            self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
+            for tex in self._payload + self._invdepth:
+                tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+                tex.repeat_x = tex.repeat_y = False
+            if self.algorithm == "three-pass":
+                self._cache_fbos = [ctx.framebuffer([self._payload[i], self._invdepth[i]], self.depth) for i in range(2)]
+            else:
+                self._cache_fbos = [
+                    ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
+                ]
+            # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
+            # the colour to the background; the payload needs no clear (it is read only where the
+            # inverse depth says a surface was cached)
+            self._clear_fbos = [ctx.framebuffer([self._invdepth[i]], self.depth) for i in range(2)]
+            self._out_fbo = ctx.framebuffer([self.color], self.depth)
+            self._color_only_fbo = ctx.framebuffer([self.color])
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
         if self.window is not None:
@@ -300,9 +311,14 @@ class CacheRuntime:
             self._set(program, name, value)
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
+        # amortized sampling (rrcache.compiler.amortize): the frame picks the subset, λ the blend
+        self._set(program, "rr_amortFrame", self.clock)
+        self._set(program, "rr_lambda", self.blend)
 
     def _run(self, pass_name: str, draw: DrawCallback, query: Optional[moderngl.Query] = None) -> None:
         program = self.programs[pass_name]
+        if self.phase_cycle > 1 and self.clock % self.phase_cycle:
+            program = self.programs.get(f"{pass_name}@{self.clock % self.phase_cycle}", program)
         self._bind_cache_uniforms(program)
         if query is None:
             draw(program, pass_name)

@@ -10,7 +10,7 @@ depth edges, where it mixes foreground and background (Nehab 2007 §3.2). Compar
 to the expected value keeps the test meaningful for any near/far range (1e-4 to 1e6 included),
 unlike window depth, which saturates near 1.
 
-Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (DESIGN.md §3):
+Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (docs/design.md §3):
 
     expected = 1 / rr_prevClip.w;  uv = rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5
     hit = rr_valid && uv inside [0,1]² && |bilinear(prevInvDepth, uv) - expected| <= ε · expected
@@ -103,6 +103,20 @@ vec4 rr_previous() {
 _CURRENT = """
 vec4 rr_current() {
     return texelFetch(rr_curPayload, ivec2(gl_FragCoord.xy), 0);
+}
+"""
+
+
+AMORTIZE_GLSL = """
+// ---- amortized sampling (rrcache.compiler.amortize) ----
+uniform float rr_lambda;
+"""
+
+#: the "pixel" phase of amortized sampling: the subset's phase from the frame and the pixel
+AMORTIZE_PIXEL_GLSL = """uniform int rr_amortFrame;
+int rr_amortPhase(int period) {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    return (rr_amortFrame + p.x + 2 * p.y) % period;
 }
 """
 

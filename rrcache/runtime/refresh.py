@@ -21,7 +21,7 @@ side by side, 2026-12-01). One compiled variant still serves every Δn (the peri
 The scale ``Δn / 2^24`` or ``Δn / B`` is computed here in float32 and passed as a uniform, so the
 shader does one IEEE multiplication and :func:`refresh_phases` reproduces its result bit for
 bit (tests compare hit maps pixel for pixel). Blocks are aligned to the target's origin so that,
-with k = 4, they coincide with llvmpipe's 4×4 early-depth blocks (DESIGN.md §5).
+with k = 4, they coincide with llvmpipe's 4×4 early-depth blocks (docs/design.md §5).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Session loading: a JSON session file (DESIGN.md §4b) → a validated :class:`Session`.
+"""Session loading: a JSON session file (docs/design.md §4b) → a validated :class:`Session`.
 
 >>> from rrcache.session import load_session
 >>> s = load_session("tests/data/sessions/minimal.json")

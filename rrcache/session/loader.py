@@ -3,8 +3,11 @@
 Steps: read and parse the JSON (syntax errors give line and column; duplicate keys, NaN and
 Infinity are rejected), check ``rrcache_session`` is 1, validate against ``schema.json``, then
 build the camera, light, objects (mesh files and procedural meshes), uniforms and textures.
-Meshes and images are decoded eagerly, so every missing or unreadable asset is reported here
-as an AssetError naming the session file, the JSON path and the resolved file. ``Session.hash``
+Meshes are decoded and image headers read here, so every missing or unreadable asset is reported
+here as an AssetError naming the session file, the JSON path and the resolved file (an image's
+pixels are decoded when a shader first samples it). Mesh, image and include paths are confined
+to the session file's folder tree unless the session says ``"allow_outside_paths": true`` or the
+command line ``rrcache --allow-outside-paths``. ``Session.hash``
 is a sha256 over the canonical JSON and the bytes of every asset file read.
 
 >>> s = load_session("tests/data/sessions/minimal.json")
@@ -19,10 +22,11 @@ import math
 import os
 from typing import Any
 
-from rrcache.errors import AssetError, SessionError
+from rrcache.budgets import budget
+from rrcache.errors import AssetError, SessionError, printable
 from rrcache.session import procedural, textures as tex
 from rrcache.session.meshes import MeshLoadError, load_mesh_file
-from rrcache.session.model import MeshData, SceneObject, Session, TextureAsset
+from rrcache.session.model import DEFAULT_FILTER, MeshData, SceneObject, Session, TextureAsset
 from rrcache.session.scene import camera_function, light_function, model_function
 from rrcache.session.uniforms import BUILTIN_UNIFORMS, uniform_function
 from rrcache.session.validation import json_path, validate_document
@@ -63,13 +67,26 @@ def parse_json(text: str, file: str) -> Any:
         raise SessionError(f"invalid JSON: {e}", file, None) from None
 
 
+def _check_text(text: str, file: str, parts: list) -> None:
+    """A JSON string may spell a lone UTF-16 surrogate (``"\\ud800"``), which is no character:
+    refused here, at its path, rather than failing later when it is written out."""
+    for ch in text:
+        if "\ud800" <= ch <= "\udfff":
+            raise SessionError(f"the text holds a lone surrogate (\\u{ord(ch):04x}), which is not a character",
+                               file, json_path(parts) or None, "write the text as plain UTF-8")
+
+
 def _check_numbers(value: Any, file: str, parts: list) -> None:
+    if isinstance(value, str):
+        _check_text(value, file, parts)
+        return
     if isinstance(value, float) and not math.isfinite(value):
         raise SessionError(f"number {value} is out of range", file, json_path(parts))
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2 ** 63 - 1:
         raise SessionError("integer is out of range", file, json_path(parts))
     if isinstance(value, dict):
         for k, v in value.items():
+            _check_text(k, file, parts + [k])
             _check_numbers(v, file, parts + [k])
     elif isinstance(value, list):
         for k, v in enumerate(value):
@@ -93,17 +110,31 @@ def check_version(doc: Any, file: str) -> None:
 class _Assets:
     """Resolves asset paths, loads each file once and records the files for the hash."""
 
-    def __init__(self, file: str):
+    def __init__(self, file: str, confine: bool = True):
         self.file = file
         self.base = os.path.dirname(os.path.abspath(file))
+        self.root = os.path.realpath(self.base)
+        self.confine = confine
         self.files: list[tuple[str, str]] = []  # (path as written, resolved)
         self.meshes: dict[str, MeshData] = {}
+        self.image_headers: dict[str, tuple[int, int, int]] = {}
 
-    def resolve(self, written: str) -> str:
-        return os.path.normpath(os.path.join(self.base, os.path.expanduser(written)))
+    def resolve(self, written: str, where: str | None = None, what: str = "file") -> str:
+        """The path of ``written`` (relative to the session's folder); with confinement on, it
+        must lie inside the session file's folder tree (symbolic links followed)."""
+        path = os.path.normpath(os.path.join(self.base, os.path.expanduser(written)))
+        if self.confine:
+            real = os.path.realpath(path)
+            if real != self.root and not real.startswith(self.root.rstrip(os.sep) + os.sep):
+                raise AssetError(f"the {what} {printable(written)!r} resolves to {printable(real)}, outside the "
+                                 f"session's folder {printable(self.root)}", self.file, where,
+                                 'paths are confined to the session file\'s folder tree; if you trust the '
+                                 'session, allow others with "allow_outside_paths": true in it or '
+                                 "'rrcache --allow-outside-paths ...'")
+        return path
 
     def mesh(self, written: str, where: str) -> tuple[MeshData, str]:
-        path = self.resolve(written)
+        path = self.resolve(written, where, "mesh")
         if path not in self.meshes:
             try:
                 self.meshes[path] = load_mesh_file(path)
@@ -114,14 +145,24 @@ class _Assets:
         return self.meshes[path], path
 
     def image(self, written: str, where: str):
-        path = self.resolve(written)
+        """The image's header (width, height, channels) and path; its pixels are decoded later,
+        by :meth:`decode`, when a shader samples it."""
+        path = self.resolve(written, where, "image")
         try:
-            data = tex.read_image(path)
+            header = tex.read_header(path)
         except tex.ImageLoadError as e:
-            raise AssetError(f"{e}: {path}", self.file, where,
+            raise AssetError(f"{e}: {printable(path)}", self.file, where,
                              "image paths are relative to the session file's folder") from None
         self.files.append((written, path))
-        return data, path
+        self.image_headers[path] = header
+        return header, path
+
+    def decode(self, path: str, where: str):
+        try:
+            return tex.read_image(path)
+        except tex.ImageLoadError as e:
+            raise AssetError(f"{e}: {printable(path)}", self.file, where,
+                             "image paths are relative to the session file's folder") from None
 
     def digest(self, doc: dict) -> str:
         h = hashlib.sha256(f"rrcache-session-1 loader-{LOADER_VERSION}\0".encode())
@@ -178,29 +219,59 @@ def _textures(doc: dict, file: str, assets: _Assets) -> dict[str, TextureAsset]:
             raise SessionError("six 'faces' make a cube map; kind must be \"cube\"", file,
                                json_path(base + ["kind"]))
         if "faces" in spec:
-            faces, files = [], []
+            files, wheres, header = [], [], None
             for k, face in enumerate(spec["faces"]):
-                data, path = assets.image(face, json_path(base + ["faces", k]))
-                faces.append(data)
+                wheres.append(json_path(base + ["faces", k]))
+                face_header, path = assets.image(face, wheres[-1])
+                header = header or face_header
                 files.append(path)
-            try:
-                data = tex.stack_cube_faces(faces)
-            except tex.ImageLoadError as e:
-                raise AssetError(str(e), file, json_path(base + ["faces"])) from None
+            headers = [assets.image_headers[p] for p in files]
+            w0, h0, c0 = headers[0]
+            if w0 != h0:
+                raise AssetError(f"cube faces must be square, face 0 is {w0}×{h0}", file, json_path(base + ["faces"]))
+            for k, (w, h, c) in enumerate(headers):
+                if (w, h, c) != (w0, h0, c0):
+                    raise AssetError(f"cube face {k} is {w}×{h}×{c}, face 0 is {w0}×{h0}×{c0}", file,
+                                     json_path(base + ["faces"]))
+            loader = _cube_faces_loader(assets, list(files), wheres, file, json_path(base + ["faces"]))
         else:
             at = where if isinstance(doc["textures"][name], str) else json_path(base + ["path"])
-            data, path = assets.image(spec["path"], at)
+            header, path = assets.image(spec["path"], at)
             files = [path]
             if kind == "cube":
                 try:
-                    data = tex.split_cube_strip(data)
+                    size = tex.cube_face_size(header[0], header[1])
                 except tex.ImageLoadError as e:
-                    raise AssetError(f"{e}: {path}", file, at) from None
-        out[name] = TextureAsset(name=name, path=files[0], kind=kind, data=data,
-                                 filter=spec.get("filter", "linear"),
+                    raise AssetError(f"{e}: {printable(path)}", file, at) from None
+                header = (size, size, header[2])
+            loader = _image_loader(assets, path, at, file, kind == "cube")
+        out[name] = TextureAsset(name=name, path=files[0], kind=kind, loader=loader, header=header,
+                                 filter=spec.get("filter", DEFAULT_FILTER),
                                  wrap=spec.get("wrap", "clamp" if kind == "cube" else "repeat"),
                                  files=tuple(files))
     return out
+
+
+def _image_loader(assets: _Assets, path: str, at: str, file: str, cube: bool):
+    def load():
+        data = assets.decode(path, at)
+        if cube:
+            try:
+                data = tex.split_cube_strip(data)
+            except tex.ImageLoadError as e:
+                raise AssetError(f"{e}: {printable(path)}", file, at) from None
+        return data
+    return load
+
+
+def _cube_faces_loader(assets: _Assets, paths: list, wheres: list, file: str, at: str):
+    def load():
+        faces = [assets.decode(p, w) for p, w in zip(paths, wheres)]
+        try:
+            return tex.stack_cube_faces(faces)
+        except tex.ImageLoadError as e:
+            raise AssetError(str(e), file, at) from None
+    return load
 
 
 def _uniforms(doc: dict, file: str):
@@ -233,15 +304,32 @@ def load_session(path: str | os.PathLike) -> Session:
     check_version(doc, file)
     _check_numbers(doc, file, [])
     validate_document(doc, file)
-    assets = _Assets(file)
+    allow_outside = bool(doc.get("allow_outside_paths", False)) or budget.allow_outside_paths
+    assets = _Assets(file, confine=not allow_outside)
     camera = camera_function(doc["camera"], file)
     light = light_function(doc.get("light"), camera, file)
     objects = _objects(doc, file, assets)
     uniforms = _uniforms(doc, file)
     textures = _textures(doc, file, assets)
+    vertex = None
+    if "vertex" in doc:
+        vertex = assets.resolve(doc["vertex"], "vertex", "vertex shader")
+        if not os.path.isfile(vertex):
+            raise AssetError(f"cannot find the vertex shader {printable(vertex)}", file, "vertex",
+                             "the path is relative to the session file's folder")
+    include_dirs = []
+    for k, written in enumerate(doc.get("include_dirs", [])):
+        where = json_path(["include_dirs", k])
+        folder = assets.resolve(written, where, "include folder")
+        if not os.path.isdir(folder):
+            raise AssetError(f"include folder not found: {printable(folder)}", file, where,
+                             "include folders are relative to the session file's folder")
+        include_dirs.append(folder)
     return Session(
         path=file, resolution=(int(doc["resolution"][0]), int(doc["resolution"][1])),
         frames=int(doc["frames"]), fps=float(doc.get("fps", 30)), objects=objects, textures=textures,
         hash=assets.digest(doc), name=doc.get("name", ""), description=doc.get("description", ""),
         background=tuple(float(c) for c in doc.get("background", (0.0, 0.0, 0.0, 0.0))), document=doc,
-        _camera=camera, _light=light, _uniforms=uniforms)
+        include_dirs=tuple(include_dirs),
+        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex,
+        notes=[f"{path}: {note}" for path, mesh in assets.meshes.items() for note in mesh.notes])

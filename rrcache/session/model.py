@@ -40,6 +40,8 @@ class MeshData:
     texcoords: np.ndarray | None = None
     colors: np.ndarray | None = None
     tangents: np.ndarray | None = None
+    #: one line per complaint of the mesh file's loader (e.g. a missing texture it names)
+    notes: tuple = ()
 
     @property
     def vertex_count(self) -> int:
@@ -80,12 +82,25 @@ class Camera:
         return perspective(self.fov, aspect, self.near, self.far)
 
 
+@dataclass(frozen=True)
+class ShadowMap:
+    """A session light's shadow map: ``size`` texels square, the light looking at ``target``
+    (None: the centre of the scene's bounds) over ``extent`` either side (None: their radius);
+    see :mod:`rrcache.session.shadow`."""
+
+    size: int
+    target: tuple[float, float, float] | None = None
+    extent: float | None = None
+
+
 @dataclass(eq=False)
 class Light:
-    """A point light at one frame: world ``position`` and linear RGB ``color`` (float64 3-vectors)."""
+    """A point light at one frame: world ``position`` and linear RGB ``color`` (float64 3-vectors),
+    and its ``shadow_map`` (None when the session asks for none)."""
 
     position: np.ndarray
     color: np.ndarray
+    shadow_map: ShadowMap | None = None
 
 
 @dataclass(eq=False)
@@ -109,7 +124,10 @@ class SceneObject:
         return self._model(check_frame(frame))
 
 
-@dataclass(eq=False)
+#: the filter of a session texture that names none (see :class:`TextureAsset`)
+DEFAULT_FILTER = "mipmap"
+
+
 class TextureAsset:
     """An image bound to a sampler uniform.
 
@@ -118,26 +136,55 @@ class TextureAsset:
     kept bit-exact. Row 0 is the image's *top* row: for a 2D texture the harness must flip rows
     (``data[::-1]``) before upload so that texcoord v = 0 samples the image's bottom row as GL
     expects; cube-map faces are uploaded as stored (GL's cube-map convention has row 0 at the top).
-    ``filter`` is ``linear|nearest|mipmap``, ``wrap`` ``repeat|clamp|mirror``. ``path`` is the
+    ``filter`` is ``linear|nearest|mipmap``, ``wrap`` ``repeat|clamp|mirror``; a texture given
+    without a filter gets :data:`DEFAULT_FILTER` (``mipmap``: mipmaps generated and trilinear
+    filtering, as an application sets up a texture its shader samples with an implicit level of
+    detail; without mipmaps a minified ``texture()`` lookup aliases). ``path`` is the
     resolved file (the +X face for a cube map given as six files); ``files`` lists every file read.
+
+    The session loader reads only the image headers (size checked against the pixel budget) and
+    gives a ``loader``: the pixels are decoded the first time ``data`` is read, so a texture the
+    shader never samples is never decoded. ``header`` is the (width, height, channels) of the file.
     """
 
-    name: str
-    path: str
-    kind: str
-    data: np.ndarray
-    filter: str = "linear"
-    wrap: str = "repeat"
-    files: tuple[str, ...] = ()
+    def __init__(self, name: str, path: str, kind: str, data: "np.ndarray | None" = None,
+                 filter: str = DEFAULT_FILTER, wrap: str = "repeat", files: tuple[str, ...] = (),
+                 loader: "Callable[[], np.ndarray] | None" = None,
+                 header: "tuple[int, int, int] | None" = None):
+        if data is None and loader is None:
+            raise ValueError("a TextureAsset needs data or a loader")
+        self.name, self.path, self.kind = name, path, kind
+        self.filter, self.wrap, self.files = filter, wrap, tuple(files)
+        self._data, self._loader, self.header = data, loader, header
+
+    def __repr__(self) -> str:
+        return (f"TextureAsset(name={self.name!r}, path={self.path!r}, kind={self.kind!r}, "
+                f"loaded={self.loaded}, filter={self.filter!r}, wrap={self.wrap!r})")
+
+    @property
+    def loaded(self) -> bool:
+        """Whether the pixels have been decoded."""
+        return self._data is not None
+
+    @property
+    def data(self) -> np.ndarray:
+        """The decoded pixels (decoded now if they were not yet)."""
+        if self._data is None:
+            self._data = self._loader()
+        return self._data
 
     @property
     def size(self) -> tuple[int, int]:
         """(width, height) of the image (of one face for a cube map)."""
+        if self._data is None and self.header is not None and self.kind == "2d":
+            return int(self.header[0]), int(self.header[1])
         h, w = self.data.shape[-3], self.data.shape[-2]
         return int(w), int(h)
 
     @property
     def channels(self) -> int:
+        if self._data is None and self.header is not None:
+            return int(self.header[2])
         return int(self.data.shape[-1])
 
 
@@ -170,6 +217,12 @@ class Session:
     description: str = ""
     background: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     document: dict = field(default_factory=dict, repr=False)
+    #: the user's vertex shader file (``"vertex"``, resolved), or None for a generated one
+    vertex: str | None = None
+    #: what loading the session's assets had to say that is not an error (one line each)
+    notes: list = field(default_factory=list)
+    #: the session's "include_dirs", resolved against its folder (after the command line's -I)
+    include_dirs: tuple[str, ...] = ()
     _camera: Callable[[int], Camera] | None = field(default=None, repr=False)
     _light: Callable[[int], Light] | None = field(default=None, repr=False)
     _uniforms: Callable[[int], dict[str, Any]] | None = field(default=None, repr=False)
@@ -190,6 +243,11 @@ class Session:
     def light_at(self, frame: int) -> Light:
         """The :class:`Light` at ``frame``."""
         return self._light(check_frame(frame))
+
+    @property
+    def shadow_map(self) -> ShadowMap | None:
+        """The light's :class:`ShadowMap` settings (None when the session has no shadow map)."""
+        return self.light_at(0).shadow_map if self._light is not None else None
 
     def uniform_values(self, frame: int) -> dict[str, Any]:
         """Session uniforms at ``frame``: name → int, bool, float or numpy array.

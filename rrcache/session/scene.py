@@ -13,7 +13,7 @@ import numpy as np
 from rrcache.errors import SessionError
 from rrcache.session.camera import orbit_position, trs_matrix
 from rrcache.session.keyframes import RotationTrack, Track
-from rrcache.session.model import Camera, Light
+from rrcache.session.model import Camera, Light, ShadowMap
 from rrcache.session.validation import json_path
 
 
@@ -42,7 +42,18 @@ def _orbit(spec: dict) -> Callable[[int], np.ndarray]:
     return lambda frame: orbit_position(center, radius, height, start + step * frame)
 
 
+#: the largest coordinate a camera may have: beyond it a 32-bit GPU float cannot place anything
+#: near the camera (and squaring it overflows even 64-bit floats near 1e154)
+MAX_COORDINATE = 1e15
+
+
 def _check_view(eye, target, up, file: str, where: str) -> None:
+    for name, value in (("eye", eye), ("target", target), ("up", up)):
+        big = float(np.max(np.abs(np.asarray(value, float))))
+        if not big <= MAX_COORDINATE:
+            raise SessionError(f"the camera's {name} has a coordinate of magnitude {big:.3g}, beyond the "
+                               f"{MAX_COORDINATE:.0e} a GPU's 32-bit floats can place", file, where,
+                               "scale the scene down (orbit radius, eye and target positions)")
     f = np.asarray(target, float) - np.asarray(eye, float)
     scale = max(1.0, float(np.abs(eye).max()), float(np.abs(target).max()))
     if np.linalg.norm(f) <= 1e-9 * scale:
@@ -86,7 +97,13 @@ def light_function(light: dict | None, camera: Callable[[int], Camera], file: st
         pos = channel(light["keyframes"], "position", [0.0, 0.0, 0.0]).at
     else:
         pos = lambda frame: camera(frame).eye  # noqa: E731
-    return lambda frame: Light(np.asarray(pos(frame), dtype=np.float64), color.copy())
+    spec = light.get("shadow_map")
+    shadow = None
+    if spec is not None:
+        target = spec.get("target")
+        shadow = ShadowMap(int(spec["size"]), tuple(float(v) for v in target) if target is not None else None,
+                           float(spec["extent"]) if "extent" in spec else None)
+    return lambda frame: Light(np.asarray(pos(frame), dtype=np.float64), color.copy(), shadow)
 
 
 def _scale3(value) -> np.ndarray:

@@ -24,7 +24,7 @@ from rrcache.errors import SessionError
 from rrcache.session.keyframes import Track
 from rrcache.session.validation import json_path
 
-#: Uniforms the harness sets itself (DESIGN.md §4); a session may not set them.
+#: Uniforms the harness sets itself (docs/design.md §4); a session may not set them.
 BUILTIN_UNIFORMS = frozenset({
     "u_camera", "u_light", "u_lightColor", "u_resolution", "u_time", "u_frame", "u_modelMatrix",
     "u_viewMatrix", "u_projectionMatrix", "u_modelViewProjectionMatrix", "u_normalMatrix"})

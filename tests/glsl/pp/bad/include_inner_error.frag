@@ -1,2 +1,2 @@
-// ERROR ../inc_error.glsl:2:1 #error inside the include
-#include "../inc_error.glsl"
+// ERROR inc/inc_error.glsl:2:1 #error inside the include
+#include "inc/inc_error.glsl"

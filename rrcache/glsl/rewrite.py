@@ -1,21 +1,30 @@
-"""Tree utilities shared by the analysis passes (not a pass itself).
+"""Building and rewriting syntax trees: what the analysis passes and the compiler make new code
+with (none of it is a pass itself).
 
-- :func:`children` / :func:`walk` / :func:`iter_exprs`: traversal that follows the syntax tree
-  only. ``Node.walk`` also follows ``Call.target`` (a ``FunctionDecl`` after semantic analysis)
-  and so revisits function bodies; the passes and node ids use these functions instead.
-- :func:`clone`: a fast structural copy (``loc``, ``type``, ``symbol``, ``target``, ``kind`` and
-  the ``FullType`` of declarations are shared, not copied), optionally rewriting every ``loc``.
+- :func:`clone`: a fast structural copy (semantic annotations and declaration types shared),
+  optionally rewriting every ``loc``; it follows the tree's one spec
+  (:func:`rrcache.glsl.ast.child_fields`).
 - :class:`InlinedLoc`: a :class:`SourceLoc` that also records the inlined call chain (and the
   unrolled loop iterations) that produced a node, outermost first.
 - :class:`NameAllocator`: fresh names ``_rr_<base>_<n>`` for generated variables; names starting
   with ``_rr`` are reserved for rrcache (:func:`check_reserved_names`).
 - :func:`rewrite_scoped`: a scope-aware rename/substitute of variables in a statement.
+- :func:`declare`, :func:`declare_typed`, :func:`assign`: generated statements.
 - :func:`paused_gc`: the cyclic garbage collector paused while a pass builds trees.
 
 >>> from rrcache.glsl.parser import parse_source
->>> unit = parse_source("void main() { float x = 1.0; x = x + 2.0; }")
->>> [type(e).__name__ for e in iter_exprs(unit)]
-['FloatLit', 'Assign', 'Ident', 'Binary', 'Ident', 'FloatLit']
+>>> from rrcache.glsl.printer import print_glsl
+>>> unit = parse_source("void main() { float x = 1.0; x = x + y; }")
+>>> copy = clone(unit)
+>>> _ = rewrite_scoped(copy.decls[0].body, {"y": "z"}, NameAllocator().fresh)
+>>> print(print_glsl(copy).strip())
+void main()
+{
+    float _rr_x_0 = 1.0;
+    _rr_x_0 = _rr_x_0 + z;
+}
+>>> print(print_glsl(unit).strip().splitlines()[2])
+    float x = 1.0;
 """
 from __future__ import annotations
 
@@ -23,21 +32,12 @@ import contextlib
 import gc
 import re
 from dataclasses import dataclass, fields
-from typing import Callable, Iterator, Optional, Union
+from typing import Callable, Optional, Union
 
 from rrcache.errors import SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.types import Type
 
-#: Semantic annotations, never tree children (``target`` and ``kind`` only on ``Call``:
-#: ``Assign.target`` is a child).
-_ANNOTATIONS = frozenset({"loc", "symbol"})
-_CALL_ANNOTATIONS = frozenset({"target", "kind"})
-#: Field annotations that can never hold a node (names, operators, literal values, spellings):
-#: traversal skips such fields without looking at them.
-_ATOMIC_FIELDS = frozenset({"str", "bool", "int", "float", "Optional[str]", "Optional[int]"})
-_SCALAR_FIELDS = _ATOMIC_FIELDS | {"list[str]", "list[tuple[str, str]]", "list[SourceLoc]"}
-_FIELD_CACHE: dict[tuple[type, bool], tuple[str, ...]] = {}
 _CLONE_FIELDS: dict[type, tuple[str, ...]] = {}
 
 RESERVED_PREFIX = "_rr"
@@ -64,83 +64,29 @@ def with_chain(loc: Optional[SourceLoc], step: str) -> Optional[SourceLoc]:
     return InlinedLoc(loc.file, loc.line, loc.col, (step,) + chain_of(loc))
 
 
-def tree_fields(cls: type, decl_types: bool = False) -> tuple[str, ...]:
-    """The names of the fields of AST class ``cls`` that can hold syntax children.
 
-    Never the semantic annotations (``loc``, ``Expr.type``, ``Ident.symbol``, ``Call.target``,
-    ``Call.kind``). The ``type`` of a declaration (a ``FullType``: struct names and array sizes
-    live there) is followed only with ``decl_types``: the analysis passes share it between
-    copies and do not number what is inside; the compiler's rewrites follow it.
-
-    >>> from rrcache.glsl.parser import parse_source
-    >>> decl = parse_source("float[2] a;").decls[0]
-    >>> tree_fields(type(decl)), tree_fields(type(decl), decl_types=True)
-    (('declarators',), ('type', 'declarators'))
-    """
-    key = (cls, decl_types)
-    names = _FIELD_CACHE.get(key)
-    if names is None:
-        skip = set(_ANNOTATIONS)
-        if issubclass(cls, A.Call):
-            skip |= _CALL_ANNOTATIONS
-        if not decl_types or issubclass(cls, A.Expr):
-            skip.add("type")
-        names = tuple(f.name for f in fields(cls)
-                      if f.name not in skip and f.type not in _SCALAR_FIELDS)
-        _FIELD_CACHE[key] = names
-    return names
-
-
-def _child_list(node: A.Node, decl_types: bool = False) -> list:
-    """The direct syntax children of ``node`` in source order, as a list."""
-    out = []
-    node_cls = A.Node
-    d = node.__dict__
-    names = _FIELD_CACHE.get((node.__class__, decl_types)) or tree_fields(node.__class__, decl_types)
-    for name in names:
-        value = d[name]
-        if value is None:
-            continue
-        if isinstance(value, node_cls):
-            out.append(value)
-        elif isinstance(value, list):
-            for item in value:
-                if isinstance(item, node_cls):
-                    out.append(item)
-                elif item.__class__ is tuple:
-                    out.extend(sub for sub in item if isinstance(sub, node_cls))
-    return out
-
-
-def children(node: A.Node, decl_types: bool = False) -> Iterator[A.Node]:
-    """The direct syntax children of ``node`` in source order (``Call.target`` never;
-    declaration types only with ``decl_types``, see :func:`tree_fields`)."""
-    return iter(_child_list(node, decl_types))
-
-
-def walk(node: A.Node, decl_types: bool = False) -> Iterator[A.Node]:
-    """``node`` and its syntax descendants, pre-order (iterative: deep trees are fine)."""
-    stack = [node]
-    pop, extend = stack.pop, stack.extend
-    while stack:
-        n = pop()
-        yield n
-        kids = _child_list(n, decl_types)
-        if kids:
-            kids.reverse()
-            extend(kids)
-
-
-def iter_exprs(unit: A.Node) -> Iterator[A.Expr]:
-    """Every expression node under ``unit`` in pre-order: the order that numbers node ids."""
-    expr_cls = A.Expr
-    for n in walk(unit):
-        if isinstance(n, expr_cls):
-            yield n
+def _clone_fields(cls: type) -> tuple[str, ...]:
+    """The fields :func:`clone` copies: the syntax child fields without declaration types
+    (:func:`rrcache.glsl.ast.child_fields`), plus the lists of names and places (copied so that
+    a copy's list can change alone)."""
+    syntax = set(A.child_fields(cls, decl_types=False))
+    return tuple(f.name for f in fields(cls)
+                 if f.name in syntax or f.type.startswith("list["))
 
 
 def clone(node, loc_fn: Optional[Callable[[SourceLoc], SourceLoc]] = None):
-    """A structural copy of ``node``; ``loc_fn`` maps every location of the copy."""
+    """A structural copy of ``node``; ``loc_fn`` maps every location of the copy.
+
+    The semantic annotations (``loc``, ``Expr.type``, ``Ident.symbol``, ``Call.target``,
+    ``Call.kind``) and the ``FullType`` of declarations are shared with the original, not
+    copied.
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> decl = parse_source("float a = 1.0;").decls[0]
+    >>> copy = clone(decl)
+    >>> copy == decl, copy.declarators[0] is decl.declarators[0], copy.type is decl.type
+    (True, False, True)
+    """
     cls = node.__class__
     if cls is list:
         return [clone(x, loc_fn) for x in node]
@@ -152,11 +98,8 @@ def clone(node, loc_fn: Optional[Callable[[SourceLoc], SourceLoc]] = None):
     d = node.__dict__.copy()
     node_cls = A.Node
     names = _CLONE_FIELDS.get(cls)
-    if names is None:      # the syntax fields plus lists of names (copied, not shared)
-        names = _CLONE_FIELDS[cls] = tuple(
-            f.name for f in fields(cls) if f.type not in _ATOMIC_FIELDS
-            and f.name not in _ANNOTATIONS and f.name != "type"
-            and not (f.name in _CALL_ANNOTATIONS and issubclass(cls, A.Call)))
+    if names is None:
+        names = _CLONE_FIELDS[cls] = _clone_fields(cls)
     for name in names:
         value = d[name]
         if value is not None and (isinstance(value, node_cls) or value.__class__ is list):
@@ -197,7 +140,7 @@ def paused_gc():
 def check_reserved_names(unit: A.TranslationUnit) -> None:
     """Raise :class:`UnsupportedShaderError` when the shader declares a name starting with
     ``_rr`` (reserved for the variables the passes generate)."""
-    for n in walk(unit):
+    for n in A.walk(unit, decl_types=False):
         names: list[tuple[str, Optional[SourceLoc]]] = []
         if isinstance(n, A.Declarator):
             names.append((n.name, n.loc))
@@ -223,7 +166,7 @@ class NameAllocator:
     def __init__(self, unit: Optional[A.Node] = None):
         self.counter = 0
         if unit is not None:
-            for n in walk(unit):
+            for n in A.walk(unit, decl_types=False):
                 name = getattr(n, "name", None)
                 if isinstance(name, str):
                     m = _GENERATED.match(name)
@@ -244,7 +187,7 @@ def is_live_flag(name: str) -> bool:
     return bool(re.match(r"^_rr_live_\d+$", name))
 
 
-# ----------------------------------------------------------------------------- types
+# ----------------------------------------------------------------------------- generated statements
 
 
 def type_spec(t: Type) -> tuple[A.FullType, Optional[list]]:
@@ -274,61 +217,6 @@ def declare_typed(name: str, t: Type, init: Optional[A.Expr] = None,
 def assign(name: str, value: A.Expr, loc: Optional[SourceLoc] = None) -> A.ExprStmt:
     """``name = value;``"""
     return A.ExprStmt(A.Assign("=", A.Ident(name, loc=loc), value, loc=loc), loc=loc)
-
-
-# ----------------------------------------------------------------------------- predicates
-
-
-def lvalue_root(e: A.Expr) -> Optional[A.Ident]:
-    """The variable an l-value expression writes (``a`` in ``a[i].xy``)."""
-    while isinstance(e, (A.Field, A.Index)):
-        e = e.obj
-    return e if isinstance(e, A.Ident) else None
-
-
-def written_roots(e: A.Node) -> Iterator[A.Ident]:
-    """The variables an expression (or statement) writes: assignment targets, ``++``/``--`` operands, and
-    arguments passed to ``out``/``inout`` parameters (of calls with a resolved target)."""
-    for n in walk(e):
-        target = None
-        if isinstance(n, A.Assign):
-            target = n.target
-        elif isinstance(n, A.Unary) and n.op in ("++", "--"):
-            target = n.operand
-        elif isinstance(n, A.Call) and n.target is not None:
-            for q, arg in zip(out_qualifiers(n), n.args):
-                if q != "in":
-                    root = lvalue_root(arg)
-                    if root is not None:
-                        yield root
-        if target is not None:
-            root = lvalue_root(target)
-            if root is not None:
-                yield root
-
-
-def out_qualifiers(call: A.Call) -> tuple[str, ...]:
-    """The parameter qualifiers (``in``/``out``/``inout``) of a resolved call."""
-    target = call.target
-    if target is None:
-        return ()
-    if isinstance(target, A.FunctionDecl):
-        return tuple(param_qualifier(p) for p in target.params)
-    return tuple(getattr(target, "qualifiers", ()))
-
-
-def param_qualifier(p: A.Param) -> str:
-    """``in``, ``out`` or ``inout`` for a parameter."""
-    quals = [q for q in p.type.qualifiers if isinstance(q, str)]
-    if "inout" in quals:
-        return "inout"
-    if "out" in quals:
-        return "out"
-    return "in"
-
-
-def is_literal(e: A.Expr) -> bool:
-    return isinstance(e, (A.IntLit, A.FloatLit, A.BoolLit))
 
 
 # ----------------------------------------------------------------------------- scoped rewriting
@@ -370,7 +258,7 @@ class _ScopedRewriter:
             if rep is not None:
                 return rep(e)
             return e
-        for name in tree_fields(type(e)):
+        for name in A.child_fields(e.__class__, decl_types=False):
             value = getattr(e, name)
             if isinstance(value, A.Expr):
                 setattr(e, name, self.expr(value))

@@ -1,0 +1,446 @@
+"""Pass: find the *estimators* of a shader, loops that sum independent samples (Nehab 2007 §6).
+
+An estimator is a ``for`` loop of ``main`` in the inlined program (:func:`inline_calls`; loops are
+*not* unrolled here, since amortization keeps the loop and changes which iterations run) with
+
+- a constant trip count ``N``: ``for (int i = c; i < K; i++)`` (``<``, ``<=``, ``>``, ``>=``,
+  ``!=``; step ``++``, ``--``, ``+=``/``-=`` a constant; ``c`` and ``K`` literals, ``const``
+  globals or macros), an ``int`` index the body does not write;
+- a body with no ``break``, ``return`` or ``discard`` (``continue`` is allowed), not itself inside
+  another loop;
+- *accumulators*: the variables declared before the loop that the body writes. Every mention of
+  one in the body is ``acc += term``, ``acc -= term``, ``acc = acc + term`` or ``acc = acc - term``
+  where no term reads any accumulator, and the accumulators are ``float`` or ``vec2``-``vec4``
+  with at most 4 components together (they must fit in the cache's payload).
+
+Each iteration's contribution then depends only on the index and on values from before the
+loop, and only adds into the accumulators: the loop computes ``a0 + Σ_i t(i)``, and any subset
+of the iterations, scaled by ``N/m``, is an estimate of that sum (see
+:mod:`rrcache.compiler.amortize`).
+
+``#pragma rrcache estimator`` on a line before a loop (the next loop that starts after the pragma,
+in the same file) marks a loop the analysis cannot prove: the accumulator checks are skipped
+(the accumulators are still every variable from before the loop that the body writes, and the
+bound must still be constant). Its amortized variant at ``m = N, λ = 0`` is the original loop,
+so a run at that setting shows the marked loop is computed right; whether its terms are really
+independent is the author's promise.
+
+Ids are ``e1``, ``e2``, ... for the loops of ``main`` in program order (every loop counts, so an
+id does not change when another loop stops qualifying).
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> s = parse_shader("uniform sampler2D t; varying vec2 uv;\\n"
+...                  "float tap(vec2 o) { return texture2D(t, uv + o).r; }\\n"
+...                  "void main() { float s = 0.0;\\n"
+...                  "  for (int i = 0; i < 8; i++) s += tap(vec2(float(i) * 0.01, 0.0));\\n"
+...                  "  gl_FragColor = vec4(s / 8.0); }")
+>>> table = find_estimators(s)
+>>> [(e.id, e.samples, e.accumulators) for e in table.estimators]
+[('e1', 8, ['s'])]
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+from rrcache.glsl import ast as A
+from rrcache.glsl.printer import print_expr
+from rrcache.glsl.ast import walk
+from rrcache.glsl.rewrite import paused_gc
+from rrcache.glsl.writes import written_roots
+
+__all__ = ["Estimator", "NotEstimator", "EstimatorTable", "find_estimators", "estimator_loops",
+           "loop_header", "display_name", "ACCUMULATOR_TYPES", "MAX_SAMPLES", "PRAGMA"]
+
+#: accumulator types and their component counts
+ACCUMULATOR_TYPES = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
+#: the largest trip count considered
+MAX_SAMPLES = 65536
+#: the pragma text (after ``#pragma``) that marks a loop as an estimator
+PRAGMA = "rrcache estimator"
+
+_COMPARE = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
+            ">=": lambda a, b: a >= b, "!=": lambda a, b: a != b}
+_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!="}
+
+
+@dataclass
+class Estimator:
+    """A loop that sums ``samples`` independent terms into ``accumulators`` (names, with their
+    GLSL types in ``types``). ``start``/``step`` give the index values ``start + k * step``,
+    ``k = 0..samples-1``; ``index`` is the loop variable. ``pragma``: marked by
+    ``#pragma rrcache estimator`` rather than proven."""
+
+    id: str
+    line: Optional[int]
+    column: Optional[int]
+    samples: int
+    text: str
+    accumulators: list[str]
+    types: list[str]
+    index: str
+    start: int
+    step: int
+    pragma: bool = False
+    loop: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def components(self) -> int:
+        return sum(ACCUMULATOR_TYPES[t] for t in self.types)
+
+    def to_json(self) -> dict:
+        return {"id": self.id, "line": self.line, "column": self.column, "samples": self.samples,
+                "text": display_name(self.text), "accumulators": [display_name(a) for a in self.accumulators],
+                "pragma": self.pragma}
+
+
+@dataclass
+class NotEstimator:
+    """A loop of ``main`` that is not an estimator, and why."""
+
+    id: str
+    line: Optional[int]
+    column: Optional[int]
+    text: str
+    reason: str
+
+    def to_json(self) -> dict:
+        return {"id": self.id, "line": self.line, "column": self.column, "text": display_name(self.text),
+                "reason": self.reason}
+
+
+@dataclass
+class EstimatorTable:
+    """The estimators of a shader and the loops that are not, both in program order; ``shader``
+    is the inlined shader whose loops the ids name."""
+
+    shader: Any
+    estimators: list[Estimator]
+    rejected: list[NotEstimator]
+
+    def find(self, estimator_id: str) -> Estimator:
+        """The estimator ``estimator_id``; an unknown id or a loop that is not one raises
+        :class:`~rrcache.errors.RRCacheError` saying why."""
+        from rrcache.errors import RRCacheError
+
+        for e in self.estimators:
+            if e.id == estimator_id:
+                return e
+        for r in self.rejected:
+            if r.id == estimator_id:
+                raise RRCacheError(f"loop {r.id} at line {r.line} is not an estimator: {r.reason}",
+                                   str(getattr(self.shader, "path", None) or "<string>"),
+                                   hint="mark it with '#pragma rrcache estimator' if its terms are "
+                                        "independent samples")
+        raise RRCacheError(f"no loop '{estimator_id}' in the shader",
+                           str(getattr(self.shader, "path", None) or "<string>"),
+                           hint="estimator ids look like 'e1'; list them with 'rrcache nodes SHADER --json'")
+
+    def to_json(self) -> dict:
+        return {"estimators": [e.to_json() for e in self.estimators],
+                "not_estimators": [r.to_json() for r in self.rejected]}
+
+
+# ----------------------------------------------------------------------------- the loops
+
+def _main(unit: A.TranslationUnit) -> Optional[A.FunctionDecl]:
+    for d in unit.decls:
+        if isinstance(d, A.FunctionDecl) and d.name == "main" and d.body is not None:
+            return d
+    return None
+
+
+def estimator_loops(unit: A.TranslationUnit) -> list[tuple[A.For, int]]:
+    """Every loop of ``main`` (``for``, ``while``, ``do``) in program order, with its depth (0: not
+    inside another loop). The position in this list (from 1) is the loop's id number."""
+    out: list = []
+
+    def visit(node, depth: int) -> None:
+        if isinstance(node, (A.For, A.While, A.DoWhile)):
+            out.append((node, depth))
+            depth += 1
+        for child in _child_nodes(node):
+            visit(child, depth)
+
+    main = _main(unit)
+    if main is not None:
+        visit(main.body, 0)
+    return out
+
+
+def _child_nodes(node):
+    from rrcache.glsl.ast import children
+
+    return [c for c in children(node) if isinstance(c, A.Stmt)]
+
+
+def _const_values(info) -> dict:
+    if info is None:
+        return {}
+    return {name: sym.const_value for name, sym in info.globals.items()
+            if sym.kind == "const" and isinstance(sym.const_value, (int, float, bool))
+            and not isinstance(sym.const_value, bool) and not sym.type.dims}
+
+
+def _const(e, consts: dict) -> Optional[int]:
+    """The value of a constant integer expression, or None."""
+    if isinstance(e, A.IntLit) and not e.unsigned:
+        return int(e.value)
+    if isinstance(e, A.Ident):
+        v = consts.get(e.name)
+        return v if isinstance(v, int) else None
+    if isinstance(e, A.Unary) and e.op in ("-", "+"):
+        v = _const(e.operand, consts)
+        return None if v is None else (-v if e.op == "-" else v)
+    if isinstance(e, A.Binary) and e.op in ("+", "-", "*", "/"):
+        a, b = _const(e.left, consts), _const(e.right, consts)
+        if a is None or b is None or (e.op == "/" and b == 0):
+            return None
+        if e.op == "/":
+            return int(a / b)  # GLSL integer division truncates
+        return a + b if e.op == "+" else a - b if e.op == "-" else a * b
+    if isinstance(e, A.Call) and e.name == "int" and len(e.args) == 1:
+        return _const(e.args[0], consts)
+    return None
+
+
+def loop_header(loop: A.For, consts: dict) -> tuple[Optional[tuple[str, int, int, int]], str]:
+    """``((index, start, step, samples), "")`` for a constant-bound ``int`` loop, else
+    ``(None, reason)``."""
+    init = loop.init
+    if not (isinstance(init, A.DeclStmt) and isinstance(init.decl, A.VariableDecl)
+            and len(init.decl.declarators) == 1):
+        return None, "the loop does not declare its index in its header"
+    decl = init.decl
+    d = decl.declarators[0]
+    if decl.type.spec.name != "int" or d.array_dims or decl.type.spec.array_dims:
+        return None, "the loop index is not an int"
+    name = d.name
+    start = _const(d.init, consts) if d.init is not None else None
+    if start is None:
+        return None, "the loop index does not start at a constant"
+    cond = loop.cond
+    if not isinstance(cond, A.Binary) or cond.op not in _COMPARE:
+        return None, "the loop condition is not a comparison of the index with a constant"
+    if isinstance(cond.left, A.Ident) and cond.left.name == name:
+        op, bound = cond.op, _const(cond.right, consts)
+    elif isinstance(cond.right, A.Ident) and cond.right.name == name:
+        op, bound = _FLIP[cond.op], _const(cond.left, consts)
+    else:
+        return None, "the loop condition does not compare the index"
+    if bound is None:
+        return None, "the loop bound is not constant"
+    s = loop.step
+    step = None
+    if isinstance(s, A.Unary) and s.op in ("++", "--") and isinstance(s.operand, A.Ident) and s.operand.name == name:
+        step = 1 if s.op == "++" else -1
+    elif isinstance(s, A.Assign) and isinstance(s.target, A.Ident) and s.target.name == name:
+        if s.op in ("+=", "-="):
+            v = _const(s.value, consts)
+            step = None if v is None else (v if s.op == "+=" else -v)
+        elif s.op == "=" and isinstance(s.value, A.Binary) and s.value.op in ("+", "-") \
+                and isinstance(s.value.left, A.Ident) and s.value.left.name == name:
+            v = _const(s.value.right, consts)
+            step = None if v is None else (v if s.value.op == "+" else -v)
+    if not step:
+        return None, "the loop step is not a constant increment of the index"
+    n, v = 0, start
+    while _COMPARE[op](v, bound):
+        n += 1
+        v += step
+        if n > MAX_SAMPLES:
+            return None, f"the loop runs more than {MAX_SAMPLES} times (or forever)"
+    if n < 2:
+        return None, f"the loop runs {n} time{'s' if n != 1 else ''}"
+    return (name, start, step, n), ""
+
+
+def _declared(node) -> set[str]:
+    return {n.name for n in walk(node) if isinstance(n, A.Declarator)}
+
+
+def _mentions(node, names: set[str]) -> bool:
+    return any(isinstance(n, A.Ident) and n.name in names for n in walk(node))
+
+
+def _accumulation(e: A.Assign, accs: set[str]) -> Optional[A.Expr]:
+    """The term of ``acc += t`` / ``acc -= t`` / ``acc = acc ± t`` (None when ``e`` is not one)."""
+    if not isinstance(e.target, A.Ident) or e.target.name not in accs:
+        return None
+    if e.op in ("+=", "-="):
+        return e.value
+    if e.op == "=" and isinstance(e.value, A.Binary) and e.value.op in ("+", "-"):
+        v = e.value
+        if isinstance(v.left, A.Ident) and v.left.name == e.target.name:
+            return v.right
+        if v.op == "+" and isinstance(v.right, A.Ident) and v.right.name == e.target.name:
+            return v.left
+    return None
+
+
+def _type_name(ident: A.Ident) -> Optional[str]:
+    t = getattr(ident, "type", None)
+    if t is None:
+        sym = getattr(ident, "symbol", None)
+        t = getattr(sym, "type", None)
+    return t.glsl_name() if t is not None and hasattr(t, "glsl_name") else None
+
+
+def classify(loop, depth: int, consts: dict, pragma: bool):
+    """``(header, accumulators, types, reason)`` for one loop (reason "" when it qualifies)."""
+    if not isinstance(loop, A.For):
+        return None, [], [], "only for loops with a constant bound are estimators"
+    if depth > 0:
+        return None, [], [], "inside another loop (the outer loop may be the estimator)"
+    header, why = loop_header(loop, consts)
+    if header is None:
+        return None, [], [], why
+    index = header[0]
+    body = loop.body
+    for n in walk(body):
+        if isinstance(n, A.Break):
+            return None, [], [], "the body has a break"
+        if isinstance(n, A.Return):
+            return None, [], [], "the body has a return"
+        if isinstance(n, A.Discard):
+            return None, [], [], "the body has a discard"
+    locals_ = _declared(body)
+    written: dict[str, A.Ident] = {}
+    for n in walk(body):
+        if isinstance(n, A.Expr):
+            for root in written_roots(n):
+                if root.name not in locals_:
+                    written.setdefault(root.name, root)
+    if index in written:
+        return None, [], [], "the body writes the loop index"
+    if not written:
+        return None, [], [], "the body accumulates nothing that outlives the loop"
+    accs = sorted(written, key=lambda name: _first_write(body, name))
+    types = [_type_name(written[a]) for a in accs]
+    for a, t in zip(accs, types):
+        if t not in ACCUMULATOR_TYPES:
+            return None, [], [], (f"`{display_name(a)}` is {t or 'of unknown type'}; accumulators are "
+                                  "float or vec2-vec4")
+    if sum(ACCUMULATOR_TYPES[t] for t in types) > 4:
+        return None, [], [], "the accumulators need more than the 4 components a payload holds"
+    if not pragma:
+        why = _only_additions(body, set(accs))
+        if why:
+            return None, [], [], why
+    return header, accs, types, ""
+
+
+def _first_write(body, name: str) -> int:
+    for k, n in enumerate(walk(body)):
+        if isinstance(n, A.Expr) and any(r.name == name for r in written_roots(n)):
+            return k
+    return 0
+
+
+def _only_additions(body, accs: set[str]) -> str:
+    """"" when every mention of an accumulator in ``body`` adds a term that reads none of them."""
+    allowed: set[int] = set()
+    terms = []
+    for n in walk(body):
+        if isinstance(n, A.Assign):
+            term = _accumulation(n, accs)
+            if term is None:
+                continue
+            terms.append((n.target.name, term))
+            allowed.add(id(n.target))
+            if n.op == "=":
+                v = n.value
+                allowed.add(id(v.left if isinstance(v.left, A.Ident) and v.left.name == n.target.name else v.right))
+    in_terms = {id(n) for _name, term in terms for n in walk(term)}
+    for n in walk(body):
+        if isinstance(n, A.Ident) and n.name in accs and id(n) not in allowed and id(n) not in in_terms:
+            return (f"`{display_name(n.name)}` is carried from one iteration to the next (used otherwise "
+                    "than by adding a term to it)")
+    for name, term in terms:
+        if _mentions(term, accs):
+            return f"the term added to `{display_name(name)}` reads an accumulator (iterations are not independent)"
+    return ""
+
+
+_INLINED_NAME = re.compile(r"\b_rr_([A-Za-z]\w*?)_\d+\b")
+
+
+def display_name(text: str) -> str:
+    """A name (or text) as the user wrote it: the inliner's ``_rr_<name>_<n>`` → ``<name>``.
+
+    >>> display_name("for (int _rr_i_13 = 0; _rr_i_13 < 16; _rr_i_13++)")
+    'for (int i = 0; i < 16; i++)'
+    """
+    return _INLINED_NAME.sub(lambda m: m.group(1), text)
+
+
+def _pragma_lines(shader) -> list[tuple[str, int]]:
+    out = []
+    for text, loc in getattr(shader, "pragmas", None) or []:
+        if " ".join(str(text).split()) == PRAGMA and loc is not None:
+            out.append((loc.file, loc.line))
+    return out
+
+
+def _loop_text(loop) -> str:
+    if isinstance(loop, A.For):
+        parts = []
+        init = loop.init
+        if isinstance(init, A.DeclStmt):
+            d = init.decl.declarators[0]
+            parts.append(f"{init.decl.type.spec.name} {d.name}"
+                         + (f" = {print_expr(d.init)}" if d.init is not None else ""))
+        elif isinstance(init, A.ExprStmt) and init.expr is not None:
+            parts.append(print_expr(init.expr))
+        else:
+            parts.append("")
+        parts.append(print_expr(loop.cond) if isinstance(loop.cond, A.Expr) else "")
+        parts.append(print_expr(loop.step) if loop.step is not None else "")
+        return f"for ({'; '.join(parts)})"
+    if isinstance(loop, A.While):
+        return f"while ({print_expr(loop.cond) if isinstance(loop.cond, A.Expr) else '...'})"
+    return "do ... while"
+
+
+def _marked(loop, pragmas: list[tuple[str, int]], loops: list) -> bool:
+    """Whether a pragma line precedes ``loop`` with no other loop of the same file in between."""
+    loc = loop.loc
+    if loc is None or not pragmas:
+        return False
+    for file, line in pragmas:
+        if loc.file != file or loc.line <= line:
+            continue
+        # the first loop after the pragma is the one it marks
+        first = min((other.loc.line, other.loc.col or 0) for other, _ in loops
+                    if other.loc is not None and other.loc.file == file and other.loc.line > line)
+        if (loc.line, loc.col or 0) == first:
+            return True
+    return False
+
+
+def find_estimators(shader, inlined: Any = None) -> EstimatorTable:
+    """The estimators of ``shader`` (a checked :class:`~rrcache.glsl.frontend.Shader`): see the
+    module docstring. ``inlined`` is the result of :func:`inline_calls` when the caller has it."""
+    from rrcache.analysis.inline import inline_calls
+
+    with paused_gc():
+        if inlined is None:
+            inlined = inline_calls(shader)
+        consts = _const_values(getattr(shader, "info", None))
+        pragmas = _pragma_lines(shader)
+        loops = estimator_loops(inlined.unit)
+        found, rejected = [], []
+        for k, (loop, depth) in enumerate(loops, start=1):
+            loc = loop.loc
+            line, column = (loc.line, loc.col) if loc is not None else (None, None)
+            text = _loop_text(loop)
+            pragma = _marked(loop, pragmas, loops)
+            header, accs, types, why = classify(loop, depth, consts, pragma)
+            if why:
+                rejected.append(NotEstimator(f"e{k}", line, column, text, why))
+                continue
+            index, start, step, n = header
+            found.append(Estimator(f"e{k}", line, column, n, text, accs, types, index, start, step,
+                                   pragma, loop))
+        return EstimatorTable(inlined, found, rejected)

@@ -1,0 +1,130 @@
+"""The source text of a listed node as the user wrote it (not a pass: it reads the table).
+
+The analysis numbers the nodes of the *analysed* program (calls inlined, loops unrolled), where
+an expression that came from a function body reads the inliner's temporaries
+(``_rr_sum_3 + _rr_amp_3 * _rr_snoise_5``). The node table shows what the user wrote instead:
+:func:`attach_source_text` finds, for each node, the expression of the original program at the
+same place (file, line, column) with the same shape (the inliner and the unroller only replace
+sub-expressions by temporaries or constants), and takes its printed text
+(``sum + amp * snoise(p)``); the call chain stays beside it in the table. It also records the
+file of a node that comes from an included file, so the table can say
+``lygia/generative/fbm.glsl:31``.
+
+>>> from rrcache.glsl.frontend import parse_shader
+>>> from rrcache.analysis.cacheable import cacheable_nodes
+>>> s = parse_shader("varying vec2 v;\\nfloat f(float x) { return sin(x) * cos(x * 3.0) + x; }\\n"
+...                  "void main() { gl_FragColor = vec4(f(v.x) * f(v.y)); }", "a.frag")
+>>> table = cacheable_nodes(s)
+>>> texts = [n.text for n in table.nodes + table.excluded]
+>>> "sin(x) * cos(x * 3.0) + x" in texts and not any("_rr_" in t for t in texts)
+True
+"""
+from __future__ import annotations
+
+import os
+import re
+from typing import Optional
+
+from rrcache.glsl import ast as A
+from rrcache.glsl.ast import children, iter_exprs
+from rrcache.glsl.printer import print_expr
+
+__all__ = ["attach_source_text", "display_file"]
+
+_GENERATED = re.compile(r"^_rr_(.+)_(\d+)$")  # the names the passes make (glsl/rewrite.NameAllocator)
+_MATCH_DEPTH = 6  # enough to tell apart the left-nested chains that share a start
+
+
+def _key(loc) -> Optional[tuple]:
+    return (loc.file, loc.line, loc.col) if loc is not None else None
+
+
+def _is_temporary(e) -> bool:
+    return isinstance(e, A.Ident) and _GENERATED.match(e.name) is not None
+
+
+def _same_shape(analysed, original, depth: int = 0) -> bool:
+    """Whether ``analysed`` is ``original`` with names replaced by the inliner's (renamed locals
+    and parameters, hoisted call results) or the unroller's constants (compared to a bounded
+    depth)."""
+    if _is_temporary(analysed):  # a renamed local or parameter, or a call's hoisted result
+        return isinstance(original, (A.Ident, A.Call))
+    if isinstance(analysed, (A.IntLit, A.FloatLit, A.BoolLit)) and isinstance(original, A.Ident):
+        return True  # an unrolled loop index or a constant argument
+    if type(analysed) is not type(original):
+        return False
+    for attr in ("op", "name", "value"):
+        if getattr(analysed, attr, None) != getattr(original, attr, None):
+            return False
+    if depth >= _MATCH_DEPTH:
+        return True
+    a, o = list(children(analysed)), list(children(original))
+    a = [x for x in a if isinstance(x, A.Expr)]
+    o = [x for x in o if isinstance(x, A.Expr)]
+    return len(a) == len(o) and all(_same_shape(x, y, depth + 1) for x, y in zip(a, o))
+
+
+def attach_source_text(table, original_unit: A.TranslationUnit) -> None:
+    """Set each node's ``text`` (listed and excluded) to the original expression's text where
+    the node came from inlined or unrolled code, and its ``file`` to the file it was written in
+    (None for the main file's own lines)."""
+    main_file = None
+    shader = getattr(table, "shader", None)
+    if shader is not None:
+        main_file = getattr(shader, "path", None)
+    main_file = str(main_file) if main_file else None
+    functions = {d.name for d in original_unit.decls if isinstance(d, A.FunctionDecl)}
+    index: dict[tuple, list] = {}
+    for e in iter_exprs(original_unit):
+        k = _key(e.loc)
+        if k is not None:
+            index.setdefault(k, []).append(e)
+    for entry in list(table.nodes) + list(table.excluded):
+        e = entry.node
+        loc = getattr(e, "loc", None)
+        if loc is None:
+            continue
+        file = str(loc.file) if loc.file else None
+        if file and file != main_file and not file.startswith("<"):
+            entry.file = file
+        if not entry.call_chain and "_rr_" not in entry.text:
+            continue
+        for candidate in index.get(_key(loc), ()):
+            if _same_shape(e, candidate):
+                entry.text = print_expr(candidate)
+                break
+        else:
+            if "_rr_" in entry.text:  # made by a pass (``p *= 2.0`` → ``p * 2.0``): names as written
+                entry.text = _TEMP.sub(lambda m: _written_name(m, functions), entry.text)
+
+
+_TEMP = re.compile(r"\b_rr_(\w+?)_(\d+)\b")
+_PASS_TEMPORARIES = {"t", "cond", "sel", "live", "arg"}
+
+
+def _written_name(m: "re.Match", functions: set) -> str:
+    """The user's name behind a generated one: a renamed variable's own name, ``f(…)`` for the
+    result of an inlined call of ``f``; the passes' own temporaries stay as they are."""
+    base = m.group(1)
+    if base in functions:
+        return f"{base}(…)"
+    if base in _PASS_TEMPORARIES:
+        return m.group(0)
+    return base
+
+
+def display_file(file: Optional[str], main_path: Optional[str]) -> Optional[str]:
+    """How a table names an included file: relative to the main shader's folder when below it
+    (``lygia/generative/fbm.glsl``), else as it was found.
+
+    >>> display_file("/p/shaders/lygia/fbm.glsl", "/p/shaders/main.frag")
+    'lygia/fbm.glsl'
+    """
+    if not file:
+        return None
+    if main_path:
+        base = os.path.dirname(os.path.abspath(main_path))
+        rel = os.path.relpath(os.path.abspath(file), base)
+        if not rel.startswith(".."):
+            return rel
+    return file
