@@ -12,8 +12,9 @@ comparisons (``speedup_range``; the summary is the median repeat's). ``noise`` i
 frame-to-frame noise of the original's times (:mod:`rrcache.harness.timing`); above 10% a warning
 says the machine's load made the timing unreliable (``reliable: false``).
 
-Frames are drawn into ``--color-format`` (default: rgba8 as applications draw, rgba32f with
-``--out``). With ``--out`` each frame is written as ``frame_NNNN.exr`` and ``frame_NNNN.png``.
+Frames are drawn into ``--color-format`` (default: rgba8 for a ``--node`` comparison without
+``--out``, as applications draw; rgba32f otherwise: exact images, and NaN/Inf can only be counted
+in a float target). With ``--out`` each frame is written as ``frame_NNNN.exr`` and ``frame_NNNN.png``.
 The summary is a table (or, with ``--json``, an object with ``frames``, ``resolution``,
 ``ms_per_frame``, ``frame_ms``, ``noise``, ``reliable``, ``color_format``, and per frame
 ``covered_pixels`` and ``nonfinite_pixels``: pixels with a NaN or an infinity); notes on the
@@ -69,8 +70,8 @@ from rrcache.session import load_session
               help="Relative tolerance of the reprojected depth test.")
 @click.option("--color-format", type=click.Choice(("auto",) + tuple(COLOR_FORMATS)), default="auto",
               show_default=True,
-              help="Colour target of every render: auto = rgba32f with --out (exact images), else rgba8 "
-                   "(as applications draw; times depend on it).")
+              help="Colour target of every render: auto = rgba8 for a --node comparison without --out (as "
+                   "applications draw; times depend on it), else rgba32f (exact images, NaN/Inf counted).")
 @click.option("--repeats", type=click.IntRange(min=1, max=50), default=1, show_default=True,
               help="With --node: run the side-by-side comparison this many times (the speed-up is the "
                    "median repeat, with the range).")
@@ -83,7 +84,9 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
     err_console = Console(stderr=True)
     loaded = load_session(session)
     if color_format == "auto":
-        color_format = ERROR_FORMAT if out_dir else DEFAULT_TIMING_FORMAT
+        # a replay is exact (its images, its NaN/Inf counts need floats); a comparison with
+        # --node is a timing: as applications draw, unless its images are written
+        color_format = DEFAULT_TIMING_FORMAT if node is not None and not out_dir else ERROR_FORMAT
     if node is not None:
         _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,

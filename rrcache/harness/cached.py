@@ -333,6 +333,10 @@ class Comparison:
         return self.original_ms_per_frame / self.ms_per_frame if self.ms_per_frame > 0 else float("nan")
 
     @property
+    def _float(self) -> bool:
+        return self.color_format != "rgba8"
+
+    @property
     def speedup_interval(self) -> tuple[float, float]:
         """A 95% bootstrap interval of :attr:`speedup` over the steady frame pairs
         (:func:`rrcache.harness.timing.ratio_interval`)."""
@@ -357,8 +361,9 @@ class Comparison:
             "original_ms_per_frame": self.original_ms_per_frame, "speedup": self.speedup,
             # pixels with NaN/Inf (variant and original), and covered pixels the error left out
             # because either image was not finite there: summed over the summary's frames
-            "nonfinite_pixels": sum(f.nonfinite for f in self._steady()),
-            "original_nonfinite_pixels": sum(f.original_nonfinite for f in self._steady()),
+            # (None in an 8-bit target, where a NaN or an infinity cannot be told from a colour)
+            "nonfinite_pixels": sum(f.nonfinite for f in self._steady()) if self._float else None,
+            "original_nonfinite_pixels": sum(f.original_nonfinite for f in self._steady()) if self._float else None,
             "error_left_out_pixels": sum(f.left_out for f in self._steady()),
             "payload_dtype": self.payload_dtype,
             "color_format": self.color_format,
