@@ -508,7 +508,9 @@ class ProfileStore:
                       f"VALUES ({', '.join('?' * len(_VALIDATION_COLUMNS))})",
                       (sel.label, sel.max_error, json.dumps(parts_to_json(sel.parts)), sel.algorithm,
                        sel.predicted_error, sel.predicted_ms, sel.predicted_speedup, sel.measured_error,
-                       sel.measured_psnr, sel.measured_ms, sel.measured_original_ms, sel.measured_speedup,
+                       # an exact image (PSNR ∞, null in the document) is stored at the cap
+                       sel.measured_psnr if sel.measured_psnr is not None else 100.0, sel.measured_ms,
+                       sel.measured_original_ms, sel.measured_speedup,
                        sel.hit_rate, sel.frames))])
 
     # ------------------------------------------------------------------ readers
