@@ -33,7 +33,7 @@ class Budget:
     """The adjustable limits (see the module docstring)."""
 
     image_pixels: int = 64 * 1024 * 1024      # 8192 x 8192
-    analysis_nodes: int = 400_000
+    analysis_nodes: int = 1_000_000    # ~2 GB of analysis (a 100k-term chain: 200k nodes, 400 MB)
     expression_depth: int = 125_000   # a 100,000-term chain nests ~100,010 deep
     source_bytes: int = 16 * 1024 * 1024
     #: not a size: whether session paths may leave the session's folder tree (the opt-out)

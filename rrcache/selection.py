@@ -175,6 +175,10 @@ class Selection:
     - ``measured_*``, ``hit_rate``, ``frames`` (rendered frames), ``speedups`` (one per
       side-by-side repeat): set by a measurement beside the original; None until then.
     - ``files``: the folder of its shader files, relative to the profile folder.
+    - ``min_psnr``, ``predicted_psnr`` (± ``predicted_psnr_uncertainty``),
+      ``predicted_speedup_range``, ``measured_noise``, ``exact``, ``visible_artifacts``,
+      ``fallback``: the PSNR level, the predictions' uncertainty and what validation found
+      (see the field comments).
     """
 
     parts: tuple = field(default=(), metadata={"parts": True})
@@ -193,6 +197,21 @@ class Selection:
     frames: int = _at_least(0)
     speedups: tuple[float, ...] = field(default=(), metadata={"minimum": 0})
     files: Optional[str] = None
+    #: the PSNR level (dB) it was selected at (None: selected at ``max_error``)
+    min_psnr: Optional[float] = None
+    #: the PSNR predicted from the error (:mod:`rrcache.model.psnr`) and its ± uncertainty (dB)
+    predicted_psnr: Optional[float] = None
+    predicted_psnr_uncertainty: Optional[float] = _at_least(None)
+    #: the predicted speed-up's range from the performance fits' residuals (low, high)
+    predicted_speedup_range: tuple[float, ...] = field(default=(), metadata={"minimum": 0})
+    #: the relative noise of the original's frame times while it was measured
+    measured_noise: Optional[float] = _at_least(None)
+    #: the image is the original's (nothing cached, or every pixel recomputed): PSNR ∞
+    exact: bool = False
+    #: below 30 dB (measured, else predicted): a choice with visible artifacts
+    visible_artifacts: bool = False
+    #: why this selection stands instead of the models' first choice (a measured slowdown)
+    fallback: Optional[str] = None
 
     @classmethod
     def original(cls, original_ms: float, **kw) -> "Selection":
@@ -297,4 +316,10 @@ class Selection:
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out["parts"] = parts_to_json(self.parts)
         out["speedups"] = list(self.speedups)
+        out["predicted_speedup_range"] = list(self.predicted_speedup_range)
         return out
+
+    @property
+    def speedup_range(self) -> tuple:
+        """(lowest, highest) measured speed-up of the repeats (empty when not measured)."""
+        return (min(self.speedups), max(self.speedups)) if self.speedups else ()

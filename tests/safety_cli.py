@@ -32,7 +32,7 @@ SESSION = {
 
 #: the smallest profile run: a few seconds on llvmpipe
 QUICK_PROFILE = ["--budget", "3", "--periods", "2,4", "--timing-periods", "2", "--timing-frames", "2",
-                 "--no-validate", "--algorithm", "three-pass"]
+                 "--no-validate", "--algorithm", "three-pass", "--min-gain", "0"]
 
 
 def session(**changes) -> dict:

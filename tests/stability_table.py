@@ -157,6 +157,8 @@ def pytest_sessionfinish(session, exitstatus):
         "    tests/test_cli_profile.py::test_resume_after_sigkill \\",
         "    tests/test_cli_profile.py::test_sigint_exits_130_and_keeps_the_store \\",
         "    tests/test_model_fuzz.py tests/test_frontend_fuzz.py tests/test_session_fuzz.py \\",
+        "    tests/test_safety_includes.py tests/test_safety_cli.py tests/test_safety_store.py \\",
+        "    tests/test_safety_budgets.py tests/test_safety_profile_doc.py tests/test_safety_fuzz.py \\",
         "    --stability-table docs/stability.md",
         "```",
         "",

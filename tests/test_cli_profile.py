@@ -102,6 +102,16 @@ def test_profile_end_to_end(full):
             assert list((out / "optimized" / sel["label"]).glob("*.frag"))
     assert f"nodes trained: {len(data['nodes'])} of {len(data['nodes'])}" in proc.stdout
     assert "selections" in proc.stdout and "μ =" in proc.stdout
+    # every selection is stored as validated (the original ones too), and counted after validation
+    assert data["counts"]["validations"] >= 4
+    # default levels: predicted PSNR >= 45, 40, 35, 30 dB; the original's image is exact, never "100.0"
+    assert [s["min_psnr"] for s in data["selections"]] == [45.0, 40.0, 35.0, 30.0]
+    for sel in data["selections"]:
+        if not sel["parts"]:
+            assert sel["exact"] and sel["measured_psnr"] is None and sel["measured_speedup"] == 1.0
+    if any(not s["parts"] for s in data["selections"]):
+        assert "∞ (exact)" in proc.stdout
+    assert data["ceiling"] is not None and data["verdict"] is None  # --min-gain 0: measured, never stops
 
 
 def test_select_json_and_out(full, tmp_path):
@@ -109,10 +119,17 @@ def test_select_json_and_out(full, tmp_path):
     out = folder / "out"
     proc = rrcache("select", out, "--max-error", "1e9", "--json")
     choice = json.loads(proc.stdout)
-    assert set(choice) == {"node", "period", "predicted_error", "predicted_ms", "predicted_speedup"}
+    assert set(choice) == {"node", "period", "predicted_error", "predicted_ms", "predicted_speedup",
+                           "predicted_speedup_range", "predicted_psnr", "predicted_psnr_uncertainty", "exact",
+                           "visible_artifacts"}
     data = json.loads((out / "profile.json").read_text())
     if choice["node"] is not None:
         assert choice["node"] in {n["id"] for n in data["nodes"]} and 1 <= choice["period"] <= 50
+    by_psnr = json.loads(rrcache("select", out, "--min-psnr", "40", "--json").stdout)
+    assert by_psnr["node"] is None or by_psnr["predicted_psnr"] >= 40 - 1e-9
+    assert by_psnr["exact"] == (by_psnr["node"] is None or by_psnr["predicted_error"] == 0)
+    both = rrcache("select", out, "--min-psnr", "40", "--max-error", "0.1", check=False)
+    assert both.returncode == 2 and "one of --max-error and --min-psnr" in both.stderr
     strict = json.loads(rrcache("select", out / "profile.json", "--max-error", "0", "--json").stdout)
     assert strict["predicted_error"] <= 1e-12 and strict["predicted_ms"] >= choice["predicted_ms"]
     written = rrcache("select", out, "--max-error", "1e9", "--out", tmp_path / "opt")
@@ -163,7 +180,11 @@ def test_resume_after_sigkill(full, tmp_path, stability_case):
     shader, session = write_scene(tmp_path)
     out = tmp_path / "out"
     store_path = out / "profile.sqlite"
-    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS)
+    # the same algorithm as the uninterrupted run: 'auto' chooses by timing, and on a loaded
+    # machine the two runs could choose differently (three-pass and two-pass images differ in
+    # the last bits, and so would the fitted α, λ)
+    algorithm = json.loads((folder / "out" / "profile.json").read_text())["algorithm"]
+    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS, "--algorithm", algorithm)
     _wait_for_runs(proc, store_path, 3)
     proc.send_signal(signal.SIGKILL)
     proc.wait(timeout=30)
@@ -173,7 +194,7 @@ def test_resume_after_sigkill(full, tmp_path, stability_case):
     assert 3 <= killed_at < total
     assert not (out / "profile.json").exists()  # nothing is written before training finishes
 
-    again = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS)
+    again = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--algorithm", algorithm)
     assert f"computed; {killed_at} error and" in again.stdout  # the summary: stored runs skipped
     with read_store(store_path) as store:
         log = store.run_log()

@@ -63,7 +63,10 @@ def test_json_summary(gl_ctx, files, capsys):
     main([ "render", str(shader), str(session), "--json", "--frames", "2"])
     captured = capsys.readouterr()
     summary = json.loads(captured.out)
-    assert set(summary) == {"frames", "resolution", "ms_per_frame", "covered_pixels", "nonfinite_pixels"}
+    assert set(summary) == {"frames", "resolution", "ms_per_frame", "covered_pixels", "nonfinite_pixels", "frame_ms",
+                            "color_format", "noise", "reliable"}
+    # a replay draws exactly (NaN/Inf can only be counted in a float target)
+    assert summary["color_format"] == "rgba32f" and len(summary["frame_ms"]) == 2 and summary["noise"] >= 0
     assert summary["nonfinite_pixels"] == [0, 0]
     assert summary["frames"] == 2 and summary["resolution"] == [64, 48]
     assert summary["ms_per_frame"] > 0
@@ -151,6 +154,24 @@ def test_render_node_compares_with_the_original(files, capsys):
     assert doc["hits"] > 0 and doc["speedup"] > 0
 
 
+def test_render_node_speedup_has_a_spread(files, capsys):
+    """``--repeats``: the speed-up is the median of whole side-by-side comparisons, with their
+    range and a bootstrap interval over frame pairs; the noise of the original's times is there,
+    and a run noisier than 10% says so on stderr and in ``reliable``."""
+    shader, session = files
+    node = _final_node(shader, session, capsys)
+    main(["render", str(shader), str(session), "--node", node, "--period", "4", "--frames", "8", "--repeats", "3",
+          "--json"])
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)
+    assert doc["repeats"] == 3 and len(doc["speedup_repeats"]) == 3
+    lo, hi = doc["speedup_range"]
+    assert lo <= doc["speedup"] <= hi and sorted(doc["speedup_repeats"])[1] == doc["speedup"]
+    ci_lo, ci_hi = doc["speedup_ci95"]
+    assert 0 < ci_lo <= ci_hi and doc["noise"] >= 0 and doc["color_format"] == "rgba8"
+    assert doc["reliable"] == (doc["noise"] <= 0.1 and "unreliable" not in captured.err)
+
+
 def test_render_unknown_node_is_a_clear_error(files, capsys):
     shader, session = files
     with pytest.raises(SystemExit) as info:
@@ -192,4 +213,24 @@ def test_bench_cache_measures_every_configuration(files, capsys):
         assert row["ms_per_frame"] > 0 and row["original_ms_per_frame"] > 0
     assert doc["no_refresh"]["hit_rate"] >= doc["periods"][0]["hit_rate"]
     assert doc["limit_speedup"] > 0 and doc["limit_ms"] > 0
-    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1
+    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1 and "limit: every pixel hits" in captured.err
+    assert doc["color_format"] == "rgba8"
+
+
+def test_bench_cache_breakdown(files, capsys):
+    """``--breakdown``: the all-hit frame stage by stage, per algorithm and colour format, with
+    each stage's fixed cost at 8×8 and its cost per covered pixel, beside the original's."""
+    shader, session = files
+    node = _final_node(shader, session, capsys)
+    main(["bench-cache", str(shader), str(session), "--node", node, "--frames", "3", "--breakdown", "--repeats", "1",
+          "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    configs = [(r["algorithm"], r["color_format"]) for r in doc["rows"]]
+    assert configs == [("three-pass", "rgba32f"), ("three-pass", "rgba8"), ("two-pass", "rgba32f"),
+                       ("two-pass", "rgba8")]
+    for row in doc["rows"]:
+        passes = ("reproject", "payload", "shade") if row["algorithm"] == "three-pass" else ("hit", "miss")
+        assert set(row["cached"]["full_ms"]) == {"clear", *passes, "queries", "read-back"}
+        assert set(row["original"]["full_ms"]) == {"clear", "draw", "queries", "read-back"}
+        assert all(v >= 0 for v in row["cached"]["per_pixel_ns"].values())
+        assert row["cached"]["pixels"] > 0 and row["cached"]["plain_ms"] > 0 and row["original"]["plain_ms"] > 0

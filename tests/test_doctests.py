@@ -30,7 +30,9 @@ def test_every_module_is_found():
 
 
 @pytest.mark.parametrize("name", MODULES)
-def test_docstring_examples(name, monkeypatch):
+def test_docstring_examples(name, monkeypatch, gl_ctx):
+    """Every module's examples pass and leave the shared GL context without an error (the
+    ``gl_ctx`` fixture checks the flag before and after, as for any GL test)."""
     monkeypatch.chdir(ROOT)
     module = importlib.import_module(name)
     finder = doctest.DocTestFinder(exclude_empty=True)

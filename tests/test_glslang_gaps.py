@@ -337,16 +337,72 @@ def test_uint_is_an_ordinary_name_before_it_became_a_type():
         accepted("#version 300 es\nprecision mediump float;\nint uint;\nvoid main() {}")
 
 
+# ----------------------------------------------------------------- found on the whole OpenGL set
+
+def test_arb_texture_query_lod_spelling():
+    """GL_ARB_texture_query_lod names its function textureQueryLOD (glslang's textureQueryLOD.frag);
+    GLSL 4.00 renamed it textureQueryLod. Both take derivatives like an implicit-LOD lookup."""
+    from rrcache.glsl.builtins import DERIVATIVE_FUNCTIONS
+    unit = accepted("""
+        #version 150
+        #extension GL_ARB_texture_query_lod : enable
+        uniform sampler2DShadow s;
+        uniform sampler2D t;
+        in vec2 uv;
+        out vec4 color;
+        void main() {
+            vec2 a = textureQueryLOD(s, uv);
+            vec2 b = textureQueryLod(t, uv);
+            color = vec4(a, b);
+        }
+    """)
+    assert [str(c.type) for c in calls(unit, "textureQueryLOD")] == ["vec2"]
+    assert "textureQueryLOD" in DERIVATIVE_FUNCTIONS
+    with pytest.raises(SemanticError, match="textureQueryLOD"):
+        accepted("#version 150\nuniform sampler2D t;\nout vec4 c;\n"
+                 "void main() { c = vec4(textureQueryLOD(t, 1.0), 0.0, 0.0); }")
+
+
+def test_gl_fragcoord_redeclared_again_with_the_same_qualifiers():
+    """glslang's gl_FragCoord.frag redeclares gl_FragCoord twice, identically, with a use between
+    (GLSL 4.60 §7.1.2: every redeclaration must have the same qualifiers)."""
+    unit = accepted("""
+        #version 150 core
+        layout(origin_upper_left, pixel_center_integer) in vec4 gl_FragCoord;
+        float x = gl_FragCoord.x;
+        layout(origin_upper_left, pixel_center_integer) in vec4 gl_FragCoord;
+        out vec4 c;
+        void main() { c = vec4(x, gl_FragCoord.y, 0.0, 1.0); }
+    """)
+    assert len([d for d in unit.decls if isinstance(d, A.VariableDecl)
+                and d.declarators and d.declarators[0].name == "gl_FragCoord"]) == 2
+    with pytest.raises(SemanticError, match="redefinition of 'gl_FragCoord'"):
+        accepted("#version 150\nlayout(origin_upper_left) in vec4 gl_FragCoord;\n"
+                 "layout(pixel_center_integer) in vec4 gl_FragCoord;\nout vec4 c;\n"
+                 "void main() { c = gl_FragCoord; }\n")
+    with pytest.raises(SemanticError, match="redefinition of 'gl_FragDepth'"):
+        accepted("#version 420\nlayout(depth_greater) out float gl_FragDepth;\n"
+                 "layout(depth_less) out float gl_FragDepth;\nout vec4 c;\n"
+                 "void main() { c = vec4(1.0); gl_FragDepth = 0.5; }\n")
+
+
 # ----------------------------------------------------------------- the measuring tool
 
-def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
+def _tool():
     import importlib.util
-    import json
+    import sys
     from pathlib import Path
     tool = Path(__file__).resolve().parent.parent / "tools" / "glsl_conformance.py"
     spec = importlib.util.spec_from_file_location("glsl_conformance", tool)
     mod = importlib.util.module_from_spec(spec)
+    sys.modules["glsl_conformance"] = mod  # the worker pool pickles its functions by module name
     spec.loader.exec_module(mod)
+    return mod
+
+
+def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
+    import json
+    mod = _tool()
     shaders = {
         "plain.frag": "void main() { gl_FragColor = vec4(1.0); }",
         "spv.sep.frag": VULKAN,
@@ -370,3 +426,37 @@ def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
     assert {n: r["category"] for n, r in rows.items() if n != "bad.frag"} == {
         "plain.frag": "core", "spv.sep.frag": "vulkan", "ext.frag": "extension"}
     assert rows["bad.frag"]["outcome"] == "rejected"
+    assert (rows["bad.frag"]["parse"], rows["bad.frag"]["check"]) == ("ok", "rejected")
+
+
+def test_conformance_tool_stages_opengl_rule_and_time_limit(tmp_path, capsys):
+    """Each stage is counted, the OpenGL rule drops Vulkan/HLSL names, a slow shader is cut off
+    by the per-shader limit without stopping the others."""
+    import json
+    mod = _tool()
+    many_defines = "".join(f"#define M{i}(x) M{i - 1}(x)+M{i - 1}(x)\n" for i in range(1, 40))
+    shaders = {
+        "lit.frag": "varying vec3 n;\nvoid main() { gl_FragColor = vec4(sin(n) * cos(n), 1.0); }",
+        "two.frag": "#version 330\nout vec4 a;\nout vec4 b;\n"
+                    "void main() { a = vec4(1.0); b = vec4(0.0); }",
+        "badtype.frag": "void main() { gl_FragColor = vec3(1.0); }",
+        "syntax.frag": "void main() { gl_FragColor = ; }",
+        # macro expansion doubling 39 times: far beyond any time limit
+        "slow.frag": "#define M0(x) x\n" + many_defines + "void main() { float f = M39(1.0); }",
+        "spv.vk.frag": "void main() {}", "vk.relaxed.frag": "void main() {}",
+        "enhanced.0.frag": "void main() {}", "web.array.frag": "void main() {}",
+    }
+    for name, text in shaders.items():
+        (tmp_path / name).write_text(text)
+    report = tmp_path / "report.json"
+    rc = mod.main([str(tmp_path), "--opengl", "--timeout", "3", "--json", str(report)])
+    out = capsys.readouterr().out
+    rows = {r["file"]: r for r in json.loads(report.read_text())["results"]}
+    assert set(rows) == {"lit.frag", "two.frag", "badtype.frag", "syntax.frag", "slow.frag"}
+    assert [rows["lit.frag"][s] for s in mod.STAGES] == ["ok"] * 4 and rows["lit.frag"]["listed"] >= 1
+    assert [rows["two.frag"][s] for s in mod.STAGES] == ["ok", "ok", "unsupported", "skipped"]
+    assert [rows["badtype.frag"][s] for s in mod.STAGES] == ["ok", "rejected", "skipped", "skipped"]
+    assert rows["syntax.frag"]["parse"] == "rejected" and rows["syntax.frag"]["stage"] == "parse"
+    assert rows["slow.frag"]["parse"] in ("timeout", "rejected"), rows["slow.frag"]
+    assert rc == 0 and "crashes (non-rrcache exceptions, bugs): 0" in out
+    assert "unknown" in out and "parse" in out

@@ -241,7 +241,7 @@ def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
     frag, session = _scene(tmp_path, vertex=False)
     vert = frag.with_suffix(".vert")
     settings = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), timing_frames=4, timing_periods=(2, 8),
-                                validate=False)
+                                validate=False, min_gain=0)
     prof = profile(frag, session, tmp_path / "out", settings, vertex=vert, plots=False)
     assert prof.vertex == str(vert) and prof.vertex_hash
     node = next(n.id for n in prof.nodes if n.trained)

@@ -51,7 +51,7 @@ float wave(vec3 p, float f) {
 """
 
 SETTINGS = ["--periods", "2,4,8", "--resolution", "32x24", "--timing-frames", "4",
-            "--timing-periods", "2,8", "--no-validate"]
+            "--timing-periods", "2,8", "--no-validate", "--min-gain", "0"]
 
 
 def _run(*args, cwd, check=True):

@@ -1,36 +1,42 @@
 #!/usr/bin/env python3
-"""Measure the rrcache GLSL front-end on a directory of fragment shaders with known verdicts.
+"""Measure the rrcache GLSL front-end and node analysis on a folder of fragment shaders with known verdicts.
 
 Meant for a GLSL compiler's own test suite laid out like glslang's ``Test/`` folder: each
 ``NAME.frag`` has an expected-result file ``NAME.frag.out`` (beside it, or in a baseResults
 directory given with ``--results``). A test is *valid* when its ``.out`` has no line starting
-with ``ERROR:``, *invalid* when it has one, and of *unknown* validity when no ``.out`` exists.
+with ``ERROR:`` (glslang's own rule: compile and link the file alone), *invalid* when it has one,
+and of *unknown* validity when it has no ``.out`` of its own (glslang's multi-file link tests).
 
-Each shader is run through :func:`rrcache.glsl.frontend.parse_shader` (preprocess, lex, parse,
-type-check, and rrcache's fragment-only restrictions) and classified as
+Every shader runs in a fresh worker process (``--jobs`` at a time, one shader per process) under
+a time limit (``--timeout``, a SIGALRM in the worker) and an address-space limit (``--memory``),
+so one slow or huge shader cannot stall or sink the run. Each goes through four stages, each one
+only public functions that every revision of rrcache has had:
 
-* ``ok``           accepted;
-* ``unsupported``  rejected with :class:`~rrcache.errors.UnsupportedShaderError` (a construct
-  or extension rrcache does not handle, named in the message: a product limit, not a bug);
-* ``rejected``     rejected with another rrcache error (``ParseError``, ``SemanticError``,
-  ``PreprocessorError``...): on a valid shader this is a front-end gap;
-* ``crash``        any other exception escaped: always a bug.
+* ``parse``   :func:`rrcache.glsl.preprocessor.preprocess` + :func:`rrcache.glsl.parser.parse_preprocessed`;
+* ``check``   :func:`rrcache.glsl.semantic.check` on that tree (the language: types, scopes, built-ins);
+* ``accept``  :func:`rrcache.glsl.frontend.parse_shader` (the whole front-end, with rrcache's
+  fragment-only product checks: one colour output, no other stage);
+* ``nodes``   :func:`rrcache.analysis.cacheable_nodes` on the accepted shader (inlining, unrolling,
+  def-use, costs); the number of cacheable nodes it lists is recorded.
 
-With ``--frontend-only`` the fragment-only product checks of ``parse_shader`` (one colour output,
-no other stage) are skipped: preprocess → parse → check, which measures the language coverage.
+A stage's result is ``ok``; ``unsupported`` (:class:`~rrcache.errors.UnsupportedShaderError`, a
+product limit named in the message); ``rejected`` (another :class:`~rrcache.errors.RRCacheError`);
+``timeout`` / ``memory`` (the limits above); or ``crash`` (any other exception: always a bug,
+listed with the exception and where it was raised). A stage after a failed one is ``skipped``.
 
-``--exclude`` leaves files out by glob (``--exclude 'hlsl.*'`` for glslang's HLSL tests);
-``--verdicts FILE`` takes the expected verdicts from a list of ``NAME<TAB>valid|invalid`` lines
-instead of ``.out`` files. Valid shaders are also counted per category: ``vulkan`` (glslang's
-``spv.*``/``vulkan*`` tests, compiled with Vulkan semantics), ``extension`` (other files with an
-``#extension`` directive) and ``core`` (GLSL 1.10–4.60, ES, compatibility, no extension).
+The old ``outcome`` of a file (``ok unsupported rejected crash``) is the ``accept`` stage, or with
+``--frontend-only`` the ``check`` stage (language coverage without the product checks).
+
+``--opengl`` keeps only glslang's OpenGL fragment tests (see :data:`VULKAN_OR_HLSL` and
+:data:`VULKAN_ONLY_FILES`); ``--exclude`` leaves out files by glob; ``--verdicts FILE`` takes the
+expected verdicts from ``NAME<TAB>valid|invalid`` lines instead of ``.out`` files. Valid shaders
+are also counted per category: ``vulkan`` (``spv.*``/``vulkan*``), ``extension`` (an
+``#extension`` directive) and ``core``.
 
 Nothing here needs network access. Usage::
 
-    python tools/glsl_conformance.py /tmp/glslang_tests
-    python tools/glsl_conformance.py /tmp/glslang_tests --json report.json -v
-    python tools/glsl_conformance.py glslang/Test --results glslang/Test/baseResults \
-        --exclude 'hlsl.*' --frontend-only
+    python tools/glsl_conformance.py glslang/Test --results glslang/Test/baseResults --opengl \\
+        --json report.json -v
 """
 from __future__ import annotations
 
@@ -38,20 +44,29 @@ import argparse
 import fnmatch
 import glob
 import json
+import multiprocessing
 import os
 import re
 import sys
+import time
 import traceback
 from collections import Counter
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(_HERE))
+if not os.environ.get("PYTHONPATH"):  # an explicit PYTHONPATH picks the rrcache to measure
+    sys.path.insert(0, os.path.dirname(_HERE))
 
-from rrcache.errors import RRCacheError, UnsupportedShaderError  # noqa: E402
-from rrcache.glsl.frontend import parse_shader  # noqa: E402
-from rrcache.glsl.parser import parse_preprocessed  # noqa: E402
-from rrcache.glsl.preprocessor import preprocess  # noqa: E402
-from rrcache.glsl.semantic import check  # noqa: E402
+#: Name globs of glslang tests that are not OpenGL GLSL: HLSL, and the suites glslang compiles
+#: for Vulkan (or WebGPU through Vulkan) by name.
+VULKAN_OR_HLSL = ("hlsl.*", "spv.*", "vk.*", "vulkan*", "*.vk.*", "web.*")
+#: OpenGL-looking names whose only driver in glslang compiles them for Vulkan: ``Test/runtests``
+#: runs them with ``-V``/``-H`` (Vulkan SPIR-V), or ``gtests/Spv.FromFile.cpp`` lists them only
+#: under a Vulkan target (``CompileVulkanToSpirvTest``, ``VulkanSemantics``).
+VULKAN_ONLY_FILES = ("enhanced.*.frag", "glsl.versionOverride.frag",
+                     "glsl.autosampledtextures.frag", "link.crossStageOptimization.frag",
+                     "rayQuery-allOps.frag", "samplerlessTextureFunctions.frag")
+
+STAGES = ("parse", "check", "accept", "nodes")
 
 
 def expected_validity(frag_path: str, results_dir: str | None) -> str:
@@ -91,28 +106,117 @@ def read_verdicts(path: str) -> dict[str, str]:
     return verdicts
 
 
-def run_one(path: str, frontend_only: bool = False) -> tuple[str, str]:
-    """Returns ``(outcome, message)``; outcome in ``ok unsupported rejected crash``."""
+class _TimeLimit(BaseException):
+    """Raised by the worker's alarm; a BaseException so no ``except Exception`` swallows it."""
+
+
+def _on_alarm(signum, frame):  # noqa: ARG001
+    raise _TimeLimit()
+
+
+def _where(e: BaseException) -> str:
+    tb = traceback.extract_tb(e.__traceback__)
+    if not tb:
+        return ""
+    last = tb[-1]
+    return f" (at {os.path.basename(last.filename)}:{last.lineno} in {last.name})"
+
+
+def run_one(path: str, timeout: float = 0, memory_mb: int = 0) -> dict:
+    """Run the four stages on ``path``; returns ``{stage: result, "message", "listed", "stage",
+    "seconds"}``: ``listed`` is the number of cacheable nodes, ``stage`` the first stage that did
+    not succeed (``None`` when all did)."""
+    from rrcache.errors import RRCacheError, UnsupportedShaderError
+
+    if memory_mb:
+        import resource
+        limit = memory_mb * 1024 * 1024
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    if timeout:
+        import signal
+        signal.signal(signal.SIGALRM, _on_alarm)
+        signal.setitimer(signal.ITIMER_REAL, timeout)
+    row: dict = {s: "skipped" for s in STAGES}
+    row.update(message="", listed=None, stage=None)
+    start = time.perf_counter()
+    stage = "parse"
     try:
+        from rrcache.analysis import cacheable_nodes
+        from rrcache.glsl.frontend import parse_shader
+        from rrcache.glsl.parser import parse_preprocessed
+        from rrcache.glsl.preprocessor import preprocess
+        from rrcache.glsl.semantic import check
+
         with open(path, encoding="utf-8-sig", errors="replace") as f:
             source = f.read()
-        if frontend_only:
-            pp = preprocess(source, path, {}, (os.path.dirname(path),))
-            unit = parse_preprocessed(pp, path)
-            check(unit, path)
-        else:
-            parse_shader(source, path, include_dirs=(os.path.dirname(path),))
-        return "ok", ""
+        include_dirs = (os.path.dirname(path),)
+        pp = preprocess(source, path, {}, include_dirs)
+        unit = parse_preprocessed(pp, path)
+        row["parse"] = "ok"
+        stage = "check"
+        check(unit, path)
+        row["check"] = "ok"
+        stage = "accept"
+        shader = parse_shader(source, path, include_dirs=include_dirs)
+        row["accept"] = "ok"
+        stage = "nodes"
+        table = cacheable_nodes(shader)
+        row["listed"] = len(table.nodes)
+        row[stage] = "ok"
+        stage = None
+    except _TimeLimit:
+        row[stage] = "timeout"
+        row["message"] = f"over the {timeout:g} s limit in {stage}"
     except UnsupportedShaderError as e:
-        return "unsupported", str(e)
+        row[stage], row["message"] = "unsupported", str(e)
     except RRCacheError as e:
-        return "rejected", f"{type(e).__name__}: {e}"
-    except RecursionError as e:  # still a bug, but report it without a giant traceback
-        return "crash", f"RecursionError: {e}"
+        row[stage], row["message"] = "rejected", f"{type(e).__name__}: {e}"
+    except MemoryError as e:
+        row[stage], row["message"] = "memory", f"MemoryError over {memory_mb} MB{_where(e)}"
+    except RecursionError as e:  # a bug, reported without a giant traceback
+        row[stage], row["message"] = "crash", f"RecursionError: {e}{_where(e)}"
     except Exception as e:  # noqa: BLE001 - anything else escaping is what we look for
-        tb = traceback.extract_tb(e.__traceback__)[-1]
-        return "crash", (f"{type(e).__name__}: {e} (at {os.path.basename(tb.filename)}:"
-                         f"{tb.lineno})")
+        row[stage], row["message"] = "crash", f"{type(e).__name__}: {e}{_where(e)}"
+    finally:
+        if timeout:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+    row["stage"] = stage
+    row["seconds"] = round(time.perf_counter() - start, 3)
+    return row
+
+
+def _job(args: tuple) -> dict:
+    return run_one(*args)
+
+
+def outcome(row: dict, frontend_only: bool) -> str:
+    """The file's front-end verdict: ``ok unsupported rejected crash`` (timeouts count as crash)."""
+    for s in (("parse", "check") if frontend_only else ("parse", "check", "accept")):
+        if row[s] != "ok":
+            return row[s] if row[s] in ("unsupported", "rejected") else "crash"
+    return "ok"
+
+
+def select_files(directory: str, pattern: str, exclude: list[str], opengl: bool) -> list[str]:
+    globs = list(exclude) + (list(VULKAN_OR_HLSL + VULKAN_ONLY_FILES) if opengl else [])
+    return sorted(p for p in glob.glob(os.path.join(directory, pattern))
+                  if not any(fnmatch.fnmatch(os.path.basename(p), g) for g in globs))
+
+
+def stage_table(rows: list[dict]) -> list[str]:
+    """One line per verdict: files, parse, check, accept, nodes, >=1 node, crashes."""
+    head = ["files", "parse", "check", "accept", "nodes", ">=1 node", "crash", "timeout"]
+    lines = [f"{'expected':<10}" + "".join(f"{h:>10}" for h in head)]
+    for exp in ("valid", "invalid", "unknown", "all"):
+        sel = [r for r in rows if exp in ("all", r["expected"])]
+        if not sel:
+            continue
+        counts = [len(sel)] + [sum(r[s] == "ok" for r in sel) for s in STAGES] + [
+            sum(bool(r["listed"]) for r in sel),
+            sum(any(r[s] == "crash" for s in STAGES) for r in sel),
+            sum(any(r[s] in ("timeout", "memory") for s in STAGES) for r in sel)]
+        lines.append(f"{exp:<10}" + "".join(f"{c:>10}" for c in counts))
+    return lines
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -122,41 +226,55 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--pattern", default="*.frag", help="file glob (default *.frag)")
     ap.add_argument("--exclude", action="append", default=[], metavar="GLOB",
                     help="leave out files matching GLOB (repeatable), e.g. 'hlsl.*'")
+    ap.add_argument("--opengl", action="store_true",
+                    help="keep only glslang's OpenGL tests (no HLSL, Vulkan or WebGPU ones)")
     ap.add_argument("--verdicts", metavar="FILE",
                     help="expected verdicts as NAME<TAB>valid|invalid lines (instead of .out)")
     ap.add_argument("--frontend-only", action="store_true",
-                    help="skip parse_shader's fragment-only product checks")
+                    help="the summary's outcome is the type check, without parse_shader's "
+                         "fragment-only product checks")
+    ap.add_argument("--timeout", type=float, default=20.0,
+                    help="seconds per shader, all stages (default 20; 0: none)")
+    ap.add_argument("--memory", type=int, default=4096,
+                    help="address-space limit per shader in MB (default 4096, of which rrcache's "
+                         "deep-recursion thread reserves 1024 of stack; 0: none)")
+    ap.add_argument("-j", "--jobs", type=int, default=1, help="shaders at a time (default 1)")
     ap.add_argument("--json", metavar="FILE", help="also write the per-file results as JSON")
     ap.add_argument("-v", "--verbose", action="store_true", help="list every non-ok result")
     args = ap.parse_args(argv)
 
-    files = sorted(p for p in glob.glob(os.path.join(args.directory, args.pattern))
-                   if not any(fnmatch.fnmatch(os.path.basename(p), g) for g in args.exclude))
+    files = select_files(args.directory, args.pattern, args.exclude, args.opengl)
     verdicts = read_verdicts(args.verdicts) if args.verdicts else {}
     if not files:
         print(f"no files matching {args.pattern} in {args.directory}", file=sys.stderr)
         return 2
+    start = time.perf_counter()
+    jobs = [(p, args.timeout, args.memory) for p in files]
+    # one shader per process: a fresh analysis each, and a worker that ran out of memory or time
+    # takes nothing of the next shader with it
+    with multiprocessing.get_context("fork").Pool(max(1, args.jobs), maxtasksperchild=1) as pool:
+        results = pool.map(_job, jobs, chunksize=1)
+    elapsed = time.perf_counter() - start
     rows = []
-    for path in files:
+    for path, res in zip(files, results):
         validity = verdicts.get(os.path.basename(path)) or expected_validity(path, args.results)
-        outcome, message = run_one(path, args.frontend_only)
-        rows.append({"file": os.path.basename(path), "expected": validity, "outcome": outcome,
-                     "category": category(path), "message": message})
+        rows.append({"file": os.path.basename(path), "expected": validity,
+                     "outcome": outcome(res, args.frontend_only), "category": category(path),
+                     **res})
+
+    print(f"{len(rows)} shaders in {elapsed:.1f} s ({args.jobs} at a time, "
+          f"{args.timeout:g} s and {args.memory} MB each)\n")
+    print("\n".join(stage_table(rows)))
+    print("\n(parse: preprocess+parse; check: type check; accept: parse_shader; nodes: "
+          "cacheable_nodes ran; >=1 node: it listed one or more)\n")
 
     table = Counter((r["expected"], r["outcome"]) for r in rows)
-    outcomes = ["ok", "unsupported", "rejected", "crash"]
-    print(f"{'expected':<10}" + "".join(f"{o:>13}" for o in outcomes) + f"{'total':>9}")
-    for exp in ("valid", "invalid", "unknown"):
-        n = sum(table[(exp, o)] for o in outcomes)
-        if n:
-            print(f"{exp:<10}" + "".join(f"{table[(exp, o)]:>13}" for o in outcomes)
-                  + f"{n:>9}")
     valid = [r for r in rows if r["expected"] == "valid"]
     invalid = [r for r in rows if r["expected"] == "invalid"]
-    crashes = [r for r in rows if r["outcome"] == "crash"]
+    crashes = [r for r in rows if any(r[s] == "crash" for s in STAGES)]
     if valid:
         ok = sum(r["outcome"] == "ok" for r in valid)
-        print(f"\nvalid shaders accepted: {ok}/{len(valid)}")
+        print(f"valid shaders accepted: {ok}/{len(valid)}")
         for cat in ("core", "vulkan", "extension"):
             in_cat = [r for r in valid if r["category"] == cat]
             if in_cat:
@@ -166,15 +284,20 @@ def main(argv: list[str] | None = None) -> int:
         print(f"invalid shaders also rejected: {rej}/{len(invalid)}")
     print(f"crashes (non-rrcache exceptions, bugs): {len(crashes)}")
 
-    shown = [r for r in rows if r["outcome"] == "crash" or (
-        r["outcome"] != "ok" and (args.verbose or r["expected"] != "invalid"))]
+    def failed(r: dict) -> bool:
+        return r["stage"] is not None
+
+    shown = [r for r in rows if r in crashes or (failed(r) and (
+        args.verbose or r["expected"] != "invalid"))]
     if shown:
-        print("\nnot accepted:" if args.verbose else "\nnot accepted (valid/unknown), crashes:")
+        print("\nstopped before the end (stage, result):" if args.verbose else
+              "\nstopped before the end (valid/unknown), crashes:")
         for r in shown:
-            print(f"  [{r['expected']}/{r['outcome']}] {r['file']}: {r['message']}")
+            print(f"  [{r['expected']}] {r['file']}: {r['stage']} {r[r['stage']]}: {r['message']}")
     if args.json:
         with open(args.json, "w", encoding="utf-8") as f:
-            json.dump({"summary": {f"{e}/{o}": n for (e, o), n in sorted(table.items())},
+            json.dump({"seconds": round(elapsed, 1), "stages": stage_table(rows),
+                       "summary": {f"{e}/{o}": n for (e, o), n in sorted(table.items())},
                        "results": rows}, f, indent=1)
     return 1 if crashes else 0
 

@@ -44,6 +44,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
+from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
 from rrcache.glsl.ast import walk
@@ -419,6 +420,7 @@ def _marked(loop, pragmas: list[tuple[str, int]], loops: list) -> bool:
     return False
 
 
+@deep
 def find_estimators(shader, inlined: Any = None) -> EstimatorTable:
     """The estimators of ``shader`` (a checked :class:`~rrcache.glsl.frontend.Shader`): see the
     module docstring. ``inlined`` is the result of :func:`inline_calls` when the caller has it."""

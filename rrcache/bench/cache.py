@@ -25,8 +25,9 @@ import statistics
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Optional
 
-from rrcache.harness.cached import CachedRenderer, compare
-from rrcache.harness.renderer import Renderer
+from rrcache.gl.formats import DEFAULT_TIMING_FORMAT
+from rrcache.harness.cached import compare
+from rrcache.harness.limit import all_hit_limit, probe_frames
 from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
 
@@ -73,6 +74,8 @@ class CacheBench:
     #: the node at the compared period with refresh turned off: only disocclusions miss (the
     #: gap between this row and the limit is what disocclusions cost, the rest is the refresh)
     no_refresh: Optional[BenchRow] = None
+    #: the colour target every render drew into
+    color_format: str = DEFAULT_TIMING_FORMAT
 
     @property
     def limit_fraction(self) -> float:
@@ -92,7 +95,7 @@ class CacheBench:
     def markdown(self) -> str:
         """The tables as Markdown (for the README)."""
         lines = [f"`{self.shader}` × `{self.session}`, caching `{self.node}` (`{self.node_text}`), "
-                 f"{self.resolution[0]}×{self.resolution[1]}, {self.frames} frames", ""]
+                 f"{self.resolution[0]}×{self.resolution[1]}, {self.frames} frames, {self.color_format} colour target", ""]
         header = "| | algorithm | Δn | k | speed-up (repeats) | hit rate | mean error | PSNR dB | ms | original ms |"
         rule = "|---|---|---|---|---|---|---|---|---|---|"
         for title, rows in (("refresh period", self.periods), ("algorithm", self.algorithms),
@@ -119,20 +122,22 @@ class CacheBench:
 
 def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), compare_period: int = 16,
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
-        progress: Optional[Callable[[str], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
-        limit_algorithm: str = "three-pass", vertex: Optional[str] = None, include_dirs=()) -> CacheBench:
+        progress: Optional[Callable[[str, int, int], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
+        limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT, vertex: Optional[str] = None,
+        include_dirs=()) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
-    ``limit_algorithm``. ``vertex``: the user's vertex shader (None: the session's, else
-    generated)."""
-    say = progress or (lambda _msg: None)
+    ``limit_algorithm``; every render draws into a ``color_format`` colour target (the errors
+    are then those of that format). ``progress(message, done, total)`` after each step.
+    ``vertex``: the user's vertex shader (None: the session's, else generated)."""
+    step = {"done": 0}
     session = load_session(session_path)
     work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
     bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices),
-                       compare_period=compare_period)
+                       compare_period=compare_period, color_format=color_format)
 
     plan = [("periods", f"Δn={period}", "three-pass", period, 4, period) for period in periods]
     # only the algorithms the node table allows for this node (one-pass cannot cache a value
@@ -147,12 +152,19 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     for _group, _label, algorithm, period, _block, _run in plan:
         if algorithm not in variants:
             variants[algorithm] = variant_for(work, node_id, algorithm)
+    total = len(plan) * repeats + 1
+
+    def say(message):  # after each step: the reporter counts finished work
+        step["done"] += 1
+        if progress is not None:
+            progress(message, step["done"], total)
+
     runs: list[list] = [[] for _ in plan]
     for repeat in range(repeats):
         for i, (_group, label, algorithm, period, block, run_period) in enumerate(plan):
-            say(f"[{repeat + 1}/{repeats}] {label}: {algorithm}, Δn={period}, k={block}")
             runs[i].append(compare(variants[algorithm], session, work.prepared, indices, period=run_period,
-                                   resolution=resolution, block=block))
+                                   resolution=resolution, block=block, color_format=color_format))
+            say(f"[{repeat + 1}/{repeats}] {label}: {algorithm}, Δn={period}, k={block}")
     for (group, label, algorithm, period, block, _run), repeated in zip(plan, runs):
         speedups = sorted(c.speedup for c in repeated)
         c = sorted(repeated, key=lambda c: c.speedup)[len(repeated) // 2]  # the median run
@@ -163,18 +175,100 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         else:
             getattr(bench, group).append(row)
 
-    say("limit: every pixel hits")
-    probe = list(indices)[:: max(1, len(indices) // 5)][:5]
     variant = variant_for(work, node_id, limit_algorithm)
-    cached_ms, original_ms = [], []
-    with Renderer(work.prepared, session, resolution) as original, \
-            CachedRenderer(variant, session, work.prepared, resolution, period=compare_period) as cached:
-        for index in probe:
-            # alternating with the original frame by frame, as every other row is measured
-            times: list[float] = []
-            cached_ms.append(cached.render_static(
-                index, repeats=5, between=lambda: times.append(original.render_frame(index).ms)))
-            original_ms.append(statistics.median(times[2:]))
-    bench.limit_ms = statistics.median(cached_ms)
-    bench.limit_original_ms = statistics.median(original_ms)
+    limit = all_hit_limit(variant, session, work.prepared, probe_frames(indices), resolution, period=compare_period,
+                          color_format=color_format)
+    bench.limit_ms = limit.limit_ms
+    bench.limit_original_ms = limit.original_median_ms
+    say("limit: every pixel hits")
     return bench
+
+
+@dataclass
+class BreakdownRow:
+    """One configuration's all-hit frame, stage by stage (:func:`rrcache.harness.limit.all_hit_breakdown`)."""
+
+    algorithm: str
+    color_format: str
+    cached: dict
+    original: dict
+    payload: str = "f4"
+
+    @property
+    def speedup(self) -> float:
+        return self.original["plain_ms"] / self.cached["plain_ms"] if self.cached["plain_ms"] else float("nan")
+
+
+@dataclass
+class Breakdown:
+    """The all-hit cost per stage of each (algorithm, colour format), measured side by side with
+    the original, ``repeats`` times (each row the median repeat by speed-up; ``ranges`` the
+    repeats' speed-ups)."""
+
+    shader: str
+    session: str
+    node: str
+    resolution: tuple[int, int]
+    frames: list[int]
+    rows: list[BreakdownRow] = field(default_factory=list)
+    ranges: list = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+    def markdown(self) -> str:
+        lines = [f"All-hit frame of `{self.shader}` caching `{self.node}`, {self.resolution[0]}×{self.resolution[1]}, "
+                 f"frames {self.frames}; each stage waited for (ctx.finish) before the next; fixed = the same stage "
+                 f"at 8×8 (geometry, state changes); per pixel = (ms − fixed) / covered pixels.", ""]
+        lines += ["| algorithm | colour | payload | stage | ms | fixed ms | ns per covered pixel |",
+                  "|---|---|---|---|---|---|---|"]
+        for row in self.rows:
+            for who, data in (("cached", row.cached), ("original", row.original)):
+                for stage, ms in data["full_ms"].items():
+                    lines.append(f"| {row.algorithm} | {row.color_format} | {row.payload} | {who}: {stage} | {ms:.2f} | "
+                                 f"{data['fixed_ms'].get(stage, float('nan')):.2f} | {data['per_pixel_ns'][stage]:.1f} |")
+        lines += ["", "| algorithm | colour | payload | all-hit ms (no waits) | original ms | limit speed-up (repeats) "
+                  "| covered pixels |", "|---|---|---|---|---|---|---|"]
+        for row, (lo, hi) in zip(self.rows, self.ranges):
+            lines.append(f"| {row.algorithm} | {row.color_format} | {row.payload} | {row.cached['plain_ms']:.2f} | "
+                         f"{row.original['plain_ms']:.2f} | {row.speedup:.2f}× ({lo:.2f}–{hi:.2f}) | "
+                         f"{row.cached['pixels']:.0f} |")
+        return "\n".join(lines)
+
+
+def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("three-pass", "two-pass"),
+              formats=("rgba32f", "rgba8"), frames: int = 60, resolution: Optional[tuple[int, int]] = None,
+              period: int = 16, repeats: int = 3, payloads=("f4",),
+              progress: Optional[Callable[[str, int, int], None]] = None, vertex: Optional[str] = None,
+              include_dirs=()) -> Breakdown:
+    """Measure the all-hit frame stage by stage for every algorithm, colour format and payload
+    precision (see :class:`Breakdown`); the configurations take turns within each repeat. (A
+    16-bit payload is used as asked: its range is not checked here.)"""
+    from rrcache.harness.limit import all_hit_breakdown
+
+    session = load_session(session_path)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
+    work.node(node_id)
+    indices = probe_frames(range(min(frames, session.frames)), 3)
+    size = tuple(resolution or session.resolution)
+    out = Breakdown(shader_path, session_path, node_id, size, list(indices))
+    configs = [(a, f, p) for a in algorithms for p in payloads for f in formats]
+    variants = {(a, p): variant_for(work, node_id, a, payload_dtype=p) for a in algorithms for p in payloads}
+    measured = {c: [] for c in configs}
+    done, total = 0, len(configs) * repeats
+    for repeat in range(repeats):
+        for algorithm, fmt, payload in configs:
+            cached, original = all_hit_breakdown(variants[(algorithm, payload)], session, work.prepared, indices,
+                                                 resolution, period=period, color_format=fmt)
+            cj, oj = cached.to_json(), original.to_json()
+            # the original's frame without waits: clear + draw (its stages are one of each)
+            oj["plain_ms"] = original.frame_ms
+            measured[(algorithm, fmt, payload)].append(BreakdownRow(algorithm, fmt, cj, oj, payload))
+            done += 1
+            if progress is not None:
+                progress(f"[{repeat + 1}/{repeats}] breakdown {algorithm} {fmt} payload {payload}", done, total)
+    for config in configs:
+        rows = sorted(measured[config], key=lambda r: r.speedup)
+        out.rows.append(rows[len(rows) // 2])
+        out.ranges.append((rows[0].speedup, rows[-1].speedup))
+    return out

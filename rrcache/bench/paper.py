@@ -381,7 +381,7 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     _say(progress, f"algorithms and limit on {medium.node}")
     bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
-                            progress=lambda msg: _say(progress, f"algorithms: {msg}"))
+                            progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
                                    r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]
     originals += [r.original_ms for r in result.algorithms]

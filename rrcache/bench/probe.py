@@ -20,6 +20,25 @@ import sys
 import time
 
 
+def _exprs_of(root):
+    """The expression nodes under ``root``, for versions of rrcache without
+    ``rrcache.glsl.ast.iter_exprs`` (a generic walk over the syntax fields)."""
+    from rrcache.glsl import ast as A
+
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, A.Expr):
+            yield node
+        for name, value in vars(node).items():
+            if name in ("loc", "symbol", "type") or (name == "target" and isinstance(node, A.Call)):
+                continue
+            for item in (value if isinstance(value, (list, tuple)) else (value,)):
+                for sub in (item if isinstance(item, tuple) else (item,)):
+                    if isinstance(sub, A.Node):
+                        stack.append(sub)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("shader")
@@ -29,7 +48,7 @@ def main(argv=None) -> None:
     try:
         from rrcache.glsl.ast import iter_exprs
     except ImportError:      # versions before the AST traversal moved to glsl/ast.py
-        from rrcache.glsl.ast import iter_exprs
+        iter_exprs = _exprs_of
     from rrcache.glsl.frontend import parse_shader
 
     source = open(args.shader, encoding="utf-8").read()

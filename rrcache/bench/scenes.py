@@ -10,6 +10,7 @@ session's own resolution.
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
@@ -71,10 +72,19 @@ def resolve_scenes(spec: str, root: Optional[Path] = None) -> list[Scene]:
     return scenes
 
 
-def _absolute(doc: dict, base: Path) -> None:
+def _absolute(doc: dict, base: Path) -> list[str]:
+    """Make the session's file paths absolute (resolved against ``base``); returns them."""
+    fixed: list[str] = []
+
     def fix(path: str) -> str:
         p = Path(path).expanduser()
-        return str(p if p.is_absolute() else (base / p).resolve())
+        fixed.append(str(p if p.is_absolute() else (base / p).resolve()))
+        return fixed[-1]
+
+    if isinstance(doc.get("vertex"), str):
+        doc["vertex"] = fix(doc["vertex"])
+    if isinstance(doc.get("include_dirs"), list):
+        doc["include_dirs"] = [fix(d) if isinstance(d, str) else d for d in doc["include_dirs"]]
 
     for obj in doc.get("objects", []):
         if isinstance(obj, dict) and isinstance(obj.get("mesh"), str):
@@ -88,6 +98,7 @@ def _absolute(doc: dict, base: Path) -> None:
                 spec["path"] = fix(spec["path"])
             if isinstance(spec.get("faces"), list):
                 spec["faces"] = [fix(f) if isinstance(f, str) else f for f in spec["faces"]]
+    return fixed
 
 
 def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: int) -> Path:
@@ -102,7 +113,17 @@ def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: 
         raise RRCacheError("not a session (no JSON object)", str(source), hint="give a session JSON file")
     doc["resolution"] = [int(resolution[0]), int(resolution[1])]
     doc["frames"] = int(frames)
-    _absolute(doc, source.resolve().parent)
+    folder = source.resolve().parent
+    paths = _absolute(doc, folder)
+    if not doc.get("allow_outside_paths"):
+        # the copy lives elsewhere: its paths are the original's, confined to the original's folder
+        root = os.path.realpath(folder)
+        outside = [p for p in paths if not os.path.realpath(p).startswith(root.rstrip(os.sep) + os.sep)]
+        if outside:
+            raise RRCacheError(f"the session names {outside[0]}, outside its folder {root}", str(source),
+                               hint='paths are confined to the session file\'s folder tree; if you trust the '
+                                    'session, say "allow_outside_paths": true in it')
+        doc["allow_outside_paths"] = True
     out = Path(out_path)
     out.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps(doc, indent=2) + "\n"

@@ -125,6 +125,9 @@ def main(argv=None):
         click.echo("rrcache: aborted", err=True)
         sys.exit(130)
     except click.ClickException as err:
+        if "\n" in err.format_message():  # 'rrcache' alone: click's help text, as click shows it
+            err.show()
+            sys.exit(err.exit_code)
         # one line, like every other error (click's own form adds the usage text)
         hint = ""
         ctx = getattr(err, "ctx", None)

@@ -5,8 +5,9 @@
     rrcache bench --scenes marble,my.frag:my.json --out bench-out --json
 
 Writes ``bench.md`` and ``bench.json`` into ``--out`` after every scene, with each scene's
-profile in ``<out>/<scene>.rrprofile`` (a rerun resumes the profiles). A progress bar runs on
-stderr. ``--json`` prints the bench document; otherwise the Markdown is printed.
+profile in ``<out>/<scene>.rrprofile`` (a rerun resumes the profiles). Progress goes to stderr
+(:mod:`rrcache.cli.progress`: a bar on a terminal, a line per finished step elsewhere, none with
+``--quiet``). ``--json`` prints the bench document; otherwise the Markdown is printed.
 """
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ import sys
 
 import click
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+from rrcache.cli.progress import Reporter, quiet_option
 
 
 @click.command("bench")
@@ -25,7 +27,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="rrcache-bench", show_default=True,
               help="Folder for bench.md, bench.json and the profiles.")
 @click.option("--json", "as_json", is_flag=True, help="Print the bench as JSON.")
-def command(quick, scenes, out_dir, as_json):
+@quiet_option
+def command(quick, scenes, out_dir, as_json, quiet):
     """Profile each scene, measure its four selections, the cache algorithms, the speed-up limit,
     and dynamic resolution and simplification at equal time, side by side."""
     from rrcache.bench.paper import FULL, QUICK, run
@@ -34,19 +37,14 @@ def command(quick, scenes, out_dir, as_json):
 
     chosen = resolve_scenes(scenes)
     err = Console(stderr=True)
-    bar = Progress(TextColumn("{task.description:<60}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                   console=err, transient=True, disable=not err.is_terminal)
-    task = bar.add_task("starting", total=None)
-
-    def progress(stage, done, total):
-        bar.update(task, description=stage[:60], completed=done or 0, total=total)
+    reporter = Reporter(err, quiet=quiet, width=60)
 
     def finished(scene):
-        err.print(f"{scene.name}: done in {scene.wall_s:.0f} s; {out_dir}/bench.json updated", highlight=False)
+        reporter.line(f"{scene.name}: done in {scene.wall_s:.0f} s; {out_dir}/bench.json updated")
 
     try:
-        with bar:
-            result = run(chosen, QUICK if quick else FULL, out_dir, progress, on_scene=finished)
+        with reporter:
+            result = run(chosen, QUICK if quick else FULL, out_dir, reporter.update, on_scene=finished)
     except KeyboardInterrupt:
         err.print(f"rrcache: interrupted; finished scenes are in {out_dir}/bench.json and the profiles resume",
                   highlight=False)

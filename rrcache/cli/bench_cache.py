@@ -1,6 +1,12 @@
 """``rrcache bench-cache SHADER SESSION --node ID``: one node cached at several periods, with the
 three algorithms and three refresh block sizes, and the all-hit limit, side by side with the
-original in one run (see :mod:`rrcache.bench.cache`)."""
+original in one run (see :mod:`rrcache.bench.cache`).
+
+``--breakdown`` measures only the all-hit frame, stage by stage (clears, each pass, the query
+results, the read-back; each stage's fixed cost at 8×8 and its cost per covered pixel), for the
+three-pass and two-pass algorithms in each of ``--formats`` (default rgba32f, rgba8: the colour
+target timings used before and the one applications draw into), side by side with the original.
+"""
 from __future__ import annotations
 
 import json
@@ -9,6 +15,8 @@ import click
 from rich.console import Console
 
 from rrcache.cli.options import include_dirs_option, resolution_option as _resolution, vert_option
+from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 
 
 @click.command("bench-cache")
@@ -21,23 +29,51 @@ from rrcache.cli.options import include_dirs_option, resolution_option as _resol
 @click.option("--repeats", default=3, show_default=True, type=click.IntRange(1, 50),
               help="Measurements of each configuration (rows show the median and the range).")
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
+@click.option("--timing-format", type=click.Choice(tuple(COLOR_FORMATS)), default=DEFAULT_TIMING_FORMAT,
+              show_default=True, help="Colour target of every render, original and variants alike.")
+@click.option("--breakdown", is_flag=True, help="Only the all-hit frame, stage by stage, per algorithm and format.")
+@click.option("--formats", default="rgba32f,rgba8", show_default=True,
+              help="Colour formats of --breakdown, side by side.")
+@click.option("--payloads", default="f4", show_default=True,
+              help="Payload precisions of --breakdown (f4, f2), side by side.")
+@click.option("--algorithms", default="three-pass,two-pass", show_default=True,
+              help="Algorithms of --breakdown, side by side.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
+@quiet_option
 @vert_option
 @include_dirs_option
-def command(shader, session, node, periods, compare_period, frames, repeats, resolution, as_json, markdown,
-            vert, include_dirs):
+def command(shader, session, node, periods, compare_period, frames, repeats, resolution, timing_format, breakdown,
+            formats, payloads, algorithms, as_json, markdown, quiet, vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
-    from rrcache.bench.cache import run
+    from rrcache.bench.cache import breakdown as run_breakdown, run
 
     err = Console(stderr=True)
     try:
         period_list = [int(p) for p in periods.split(",") if p.strip()]
     except ValueError:
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
-    bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution, repeats=repeats,
-                include_dirs=include_dirs,
-                progress=lambda msg: err.print(f"[dim]{msg}[/dim]"), vertex=vert)
+    format_list = [f.strip() for f in formats.split(",") if f.strip()]
+    bad = [f for f in format_list if f not in COLOR_FORMATS]
+    if bad or not format_list:
+        raise click.BadParameter(f"{formats!r}: give colour formats from {', '.join(COLOR_FORMATS)}",
+                                 param_hint="--formats")
+    payload_list = [p.strip() for p in payloads.split(",") if p.strip()]
+    if not payload_list or any(p not in ("f4", "f2") for p in payload_list):
+        raise click.BadParameter(f"{payloads!r}: give f4 and/or f2", param_hint="--payloads")
+    algorithm_list = [a.strip() for a in algorithms.split(",") if a.strip()]
+    if not algorithm_list or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
+        raise click.BadParameter(f"{algorithms!r}: give three-pass, two-pass and/or one-pass", param_hint="--algorithms")
+    with Reporter(err, quiet=quiet) as reporter:
+        if breakdown:
+            bench = run_breakdown(shader, session, node, algorithms=tuple(algorithm_list), formats=tuple(format_list),
+                                  payloads=tuple(payload_list), frames=frames,
+                                  resolution=resolution, period=compare_period, repeats=repeats,
+                                  progress=reporter.update, vertex=vert, include_dirs=include_dirs)
+        else:
+            bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution,
+                        repeats=repeats, progress=reporter.update, color_format=timing_format, vertex=vert,
+                        include_dirs=include_dirs)
     if as_json:
         click.echo(json.dumps(bench.to_json()))
     else:

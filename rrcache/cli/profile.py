@@ -4,7 +4,10 @@
     rrcache profile marble.frag marble.json --out marble.rrprofile --budget 900 -D OCTAVES=5
     rrcache profile noise.frag orbit.json --resolution 32x24 --periods 2,4,8 --timing-frames 6
 
-A progress bar with an ETA runs on stderr while training (when stderr is a terminal). Rerunning
+The ceiling (:mod:`rrcache.profiler.ceiling`) is measured first, in seconds: when no cached variant
+can reach ``--min-gain`` (default 1.1×) the command stops there and says so, with the measured
+ceiling, why, and what would change it. Progress goes to stderr (:mod:`rrcache.cli.progress`: a bar
+on a terminal, a line per finished step elsewhere; ``--quiet`` for none). Rerunning
 the same command resumes: every stored run is skipped (the summary says how many). Ctrl-C stops
 after the run in flight is dropped: what is stored stays, it is listed, and the exit code is 130.
 The closing summary gives the nodes trained, μ, the overhead, the original's frame time and the
@@ -18,16 +21,18 @@ import warnings
 
 import click
 from rich.console import Console
-from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
-                           TimeRemainingColumn)
 from rich.table import Table
 
 from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
+from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.gl.formats import COLOR_FORMATS
+from rrcache.harness.timing import UNRELIABLE_NOISE
+from rrcache.model.psnr import VISIBLE_DB, psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
 from rrcache.profiles.document import algorithm_line
 from rrcache.profiles.store import STORE_NAME
-from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, TrainingSettings, parse_periods
+from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_KINDS, TrainingSettings, parse_periods
 
 
 def _periods(ctx, param, value):
@@ -81,19 +86,32 @@ def _fmt(value, spec=".3g", none="–"):
               help="Render each selection over the first N frames (default: all).")
 @click.option("--no-validate", is_flag=True, help="Do not render the four selections against the original.")
 @click.option("--fresh", is_flag=True, help="Move an existing profile.sqlite aside (.bak) and start over.")
+@click.option("--min-gain", type=click.FloatRange(min=0, max=100, max_open=True), default=None,
+              help=f"The least speed-up worth having (default: {TrainingSettings.min_gain:g}): the ceiling is "
+                   "measured first and the profile stops with the answer 'the original' when nothing can "
+                   "reach it; nodes whose best case is below it are not trained. 0: never stop.")
+@click.option("--timing-format", type=click.Choice(tuple(COLOR_FORMATS)), default=None,
+              help="Colour target of every timed run, original and variants alike (default: "
+                   f"{TrainingSettings.timing_format}, as applications draw); error runs use rgba32f.")
+@click.option("--levels", type=click.Choice(LEVEL_KINDS), default="psnr", show_default=True,
+              help="The four selection levels e1..e4: psnr = predicted PSNR against the original >= 45, 40, 35, "
+                   "30 dB; relative = the paper's error thresholds (fractions of the largest error seen).")
 @click.option("--wait", is_flag=True,
               help="If another rrcache process is profiling into the same --out, wait for it (default: exit 2).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, wait, defines, vert, include_dirs):
+            algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            wait, defines, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
-                  validate=not no_validate, validation_frames=validation_frames)
-    for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving)):
+                  validate=not no_validate, validation_frames=validation_frames, levels=levels)
+    for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
+                        ("min_gain", min_gain), ("timing_format", timing_format)):
         if value is not None:
             kwargs[name] = value
     if periods is not None:
@@ -103,19 +121,11 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
     settings = TrainingSettings(**kwargs)
     out = out_dir if out_dir is not None else default_out_dir(shader, session)
 
-    bar = Progress(TextColumn("{task.description:<32}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                   TextColumn("ETA"), TimeRemainingColumn(), console=err_console, transient=True,
-                   disable=not err_console.is_terminal)
-    task = bar.add_task("starting", total=None)
-
-    def progress(event):
-        bar.update(task, completed=event.done, total=event.total, description=f"{event.stage} {event.detail}"[:32])
-
     try:
-        with bar, warnings.catch_warnings(record=True) as caught:
+        with Reporter(err_console, quiet=quiet) as reporter, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), progress, fresh=fresh,
+                prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
                                vertex=vert, include_dirs=include_dirs, wait=wait)
             finally:
                 for w in caught:
@@ -146,14 +156,41 @@ def _interrupted(out, err_console) -> None:
         err_console.print(f"nothing readable is stored ({err})", highlight=False, markup=False)
 
 
+def _verdict(prof, console: Console) -> None:
+    v, ceiling = prof.verdict, prof.measured_ceiling
+    console.print(f"profile: {prof.path}", highlight=False)
+    console.print(f"answer: {v['answer']}", highlight=False)
+    if ceiling is not None:
+        console.print(f"ceiling: {ceiling.summary()}", highlight=False)
+    _ceiling_noise(ceiling, console)
+    console.print(f"why: {v['reason']}", highlight=False)
+    console.print("what would change it:", highlight=False)
+    for change in v["changes"]:
+        console.print(f"  - {change}", highlight=False)
+
+
+def _ceiling_noise(ceiling, console: Console) -> None:
+    if ceiling is not None and ceiling.noise > UNRELIABLE_NOISE:
+        console.print(f"warning: the original's repeated frames varied by ±{ceiling.noise:.0%} while the ceiling was "
+                      "measured: other work on the machine made it unreliable; profile again on a quieter machine "
+                      "(the profile folder keeps it: use --fresh)", highlight=False)
+
+
 def _summary(prof, console: Console) -> None:
+    if prof.verdict is not None:
+        _verdict(prof, console)
+        return
     c = prof.counts
     trained = len(prof.trained_nodes)
     console.print(f"profile: {prof.path}", highlight=False)
-    cheap = sum(1 for n in prof.nodes if not n.trained and n.note and "static cost" in n.note)
+    pruned = sum(1 for n in prof.nodes if not n.trained and n.note and "best case" in n.note)
+    cheap = sum(1 for n in prof.nodes if not n.trained and n.note and "static cost" in n.note
+                and "best case" not in n.note)
     late = sum(1 for n in prof.nodes if not n.trained and n.note and "budget" in n.note)
     console.print(f"nodes trained: {trained} of {len(prof.nodes)}; {cheap} too cheap to win (static cost under "
-                  f"{prof.settings.min_saving:.0%} of the costliest), {late} not reached within the budget", highlight=False)
+                  f"{prof.settings.min_saving:.0%} of the costliest), {pruned} whose best case under the measured "
+                  f"ceiling is below {prof.settings.min_gain:.2f}×, {late} not reached within the budget",
+                  highlight=False)
     console.print(f"runs: {c.get('error_runs_computed', 0)} error and {c.get('timing_runs_computed', 0)} timing runs "
                   f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
                   "runs were stored and skipped", highlight=False)
@@ -161,16 +198,80 @@ def _summary(prof, console: Console) -> None:
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
+    ceiling = prof.measured_ceiling
+    if ceiling is not None:
+        console.print(f"ceiling: {ceiling.summary()}", highlight=False)
+        _ceiling_noise(ceiling, console)
+    noise = prof.timing_noise
+    if noise is not None and not prof.timing_reliable:
+        console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "
+                      "other work on the machine made the timings unreliable; profile again on a quieter machine",
+                      highlight=False)
+    console.print(_table(prof))
+    for s in prof.selections:
+        if s.fallback:
+            console.print(f"{s.label}: {s.fallback}", highlight=False)
+    if any(s.visible_artifacts for s in prof.selections):
+        marked = ", ".join(s.label for s in prof.selections if s.visible_artifacts)
+        console.print(f"{marked}: below {VISIBLE_DB:.0f} dB PSNR: visible artifacts (a choice, not a default)",
+                      highlight=False)
+    noisy = [s.label for s in prof.selections if s.measured_noise is not None and s.measured_noise > UNRELIABLE_NOISE]
+    if noisy:
+        console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
+                      f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
+
+
+def _level(s) -> str:
+    if s.min_psnr is not None:
+        return f"≥ {s.min_psnr:g} dB"
+    return f"error ≤ {_fmt(s.max_error)}"
+
+
+def _speedup(s) -> str:
+    if s.measured_speedup is None:
+        return "–"
+    if len(s.speedups) > 1:
+        lo, hi = s.speedup_range
+        return f"{s.measured_speedup:.2f} ({lo:.2f}–{hi:.2f})"
+    return f"{s.measured_speedup:.2f}"
+
+
+def _predicted_speedup(s) -> str:
+    if not s.parts or len(s.predicted_speedup_range) != 2:
+        return _fmt(s.predicted_speedup, ".2f")
+    lo, hi = s.predicted_speedup_range
+    return f"{s.predicted_speedup:.2f} ({lo:.2f}–{hi:.2f})"
+
+
+def _predicted_psnr(s) -> str:
+    if s.exact or not s.parts:
+        return psnr_text(math.inf)
+    if s.predicted_psnr is None:
+        return "–"
+    return f"{psnr_text(s.predicted_psnr)} ± {s.predicted_psnr_uncertainty or 0:.1f}"
+
+
+def _measured_psnr(s) -> str:
+    if s.measured_error is None:
+        return "–"
+    if s.exact or not s.parts:
+        return psnr_text(math.inf)
+    text = psnr_text(s.measured_psnr)
+    return text + (" (visible)" if s.visible_artifacts else "")
+
+
+def _table(prof) -> Table:
     table = Table(title="selections")
-    for name in ("level", "max error", "node", "Δn", "speed-up pred.", "speed-up meas.", "error pred.",
-                 "error meas.", "PSNR"):
+    for name in ("level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
+                 "error pred.", "error meas."):
         if name == "node":
-            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=40)
+            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=36)
         else:
             table.add_column(name, justify="right")
     for s in prof.selections:
         node = "(original)" if s.node is None else f"{s.node}: {s.text}"
-        table.add_row(s.label, _fmt(s.max_error), node, _fmt(s.period, "d"), _fmt(s.predicted_speedup, ".2f"),
-                      _fmt(s.measured_speedup, ".2f"), _fmt(s.predicted_error), _fmt(s.measured_error),
-                      _fmt(s.measured_psnr, ".1f"))
-    console.print(table)
+        if s.fallback:
+            node = "↩ " + node
+        table.add_row(f"{s.label} {_level(s)}", node, _fmt(s.period, "d"), _predicted_speedup(s), _speedup(s),
+                      _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
+    return table

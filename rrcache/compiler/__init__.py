@@ -34,9 +34,7 @@ from typing import Any, Union
 from rrcache.errors import UnsupportedShaderError
 from rrcache.deep import deep
 from rrcache.glsl import ast as A
-from rrcache.compiler.emit import (
-    fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
-)
+from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.locate import prepare
 from rrcache.compiler.passes import build_pass
 from rrcache.compiler.variant import PassSource, Variant
@@ -86,25 +84,18 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     samplers: dict[str, list[str]] = {}
     runtime: dict[str, list[str]] = {}
     forms: dict[str, str] = {}
-    user_vertex = vertex
     for name in ALGORITHMS[algorithm]:
         built = build_pass(loc, name, filter)
-        iface = interface(built.unit)
-        vertex = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), user_vertex)
-        fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
-        passes[name] = PassSource(vertex, fragment, line_map)
-        vertex_names = (user_vertex.uniform_names(built.spec.lookup) if user_vertex is not None
-                        else vertex_uniforms(vertex))
-        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_names))
-        samplers[name] = list(iface["sampler"])
-        runtime[name] = runtime_uniforms(built.runtime_glsl)
+        out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, vertex)
+        passes[name] = PassSource(out.vertex, out.fragment, out.line_map)
+        uniforms[name], samplers[name], runtime[name] = out.uniforms, out.samplers, out.runtime
         forms[name] = built.form
     return Variant(
         algorithm=algorithm, node_id=node_id if not isinstance(node_id, A.Node) else None,
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
-        vertex_path=getattr(user_vertex, "path", None))
+        vertex_path=getattr(vertex, "path", None))
 
 
 from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)

@@ -57,6 +57,7 @@ import copy
 from dataclasses import dataclass
 from typing import Any, Optional
 
+from rrcache.deep import deep
 from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.legacy import to_core
@@ -67,9 +68,7 @@ from rrcache.glsl.writes import written_roots
 from rrcache.analysis.unroll import fold_copy
 from rrcache.analysis.estimators import Estimator, EstimatorTable, display_name, find_estimators
 from rrcache.glsl.ast import main_function, walk
-from rrcache.compiler.emit import (
-    fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
-)
+from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.outputs import cache_init, cache_writes, float_lit, set_color_output
 from rrcache.compiler.passes import PASS_SPECS, PassUnit, runtime_snippets
 from rrcache.compiler.prune import prune
@@ -455,6 +454,7 @@ def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinea
     return PassUnit(name, unit, runtime, spec, "amortize")
 
 
+@deep
 def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-pass", samples: int = 4,
                        blend: float = 0.6, filter: str = "bilinear", payload_dtype: str = "f4",
                        phase: str = "frame", history: str = "blend", vertex=None) -> Variant:
@@ -510,15 +510,9 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         for k in phases:
             built = build_pass(loc, name, samples, filter, "pixel" if phase == "pixel" else k, history)
             key = name if k == 0 else f"{name}@{k}"
-            iface = interface(built.unit)
-            vertex_text = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), vertex)
-            fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
-            passes[key] = PassSource(vertex_text, fragment, line_map)
-            vertex_names = (vertex.uniform_names(built.spec.lookup) if vertex is not None
-                            else vertex_uniforms(vertex_text))
-            uniforms[key] = sorted(set(iface["uniform"]) | set(vertex_names))
-            samplers[key] = list(iface["sampler"])
-            runtime[key] = runtime_uniforms(built.runtime_glsl)
+            out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, vertex)
+            passes[key] = PassSource(out.vertex, out.fragment, out.line_map)
+            uniforms[key], samplers[key], runtime[key] = out.uniforms, out.samplers, out.runtime
             forms[key] = built.form
     text = display_name(est.text)
     loop_loc: Optional[SourceLoc] = est.loop.loc if est.loop is not None else None

@@ -20,6 +20,7 @@ True
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from typing import Optional
 
 from rrcache.errors import SourceLoc
@@ -104,3 +105,28 @@ def vertex_uniforms(vertex_text: str) -> list[str]:
 def runtime_uniforms(runtime_glsl: str) -> list[str]:
     """The ``rr_`` uniforms and samplers the runtime sets, as declared in its snippets."""
     return _UNIFORM_LINE.findall(runtime_glsl)
+
+
+@dataclass
+class EmittedPass:
+    """One pass as text: its vertex and fragment shaders (``line_map`` maps the fragment's lines
+    to the original shader), the uniforms and samplers the application binds (the vertex
+    shader's per-object ones included) and the ``rr_`` uniforms the runtime sets."""
+
+    vertex: str
+    fragment: str
+    line_map: list
+    uniforms: list
+    samplers: list
+    runtime: list
+
+
+def emit_pass(unit: A.TranslationUnit, runtime_glsl: str, prev_clip: bool, user=None) -> EmittedPass:
+    """Print a built pass (its ``unit`` and the runtime snippets it uses) with its vertex shader:
+    generated, or the user's (``user``) with the cache's additions."""
+    iface = interface(unit)
+    vertex = vertex_shader(iface["in"], prev_clip, input_locations(unit), user)
+    fragment, line_map = fragment_shader(unit, runtime_glsl)
+    vertex_names = user.uniform_names(prev_clip) if user is not None else vertex_uniforms(vertex)
+    return EmittedPass(vertex, fragment, line_map, sorted(set(iface["uniform"]) | set(vertex_names)),
+                       list(iface["sampler"]), runtime_uniforms(runtime_glsl))

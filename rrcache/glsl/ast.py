@@ -51,16 +51,8 @@ class Node:
         return children(self)
 
     def walk(self) -> Iterator["Node"]:
-        """This node and all its descendants, pre-order (iterative: a chain of 100,000 binary
-        operators walks without recursion)."""
-        stack = [self]
-        pop, extend = stack.pop, stack.extend
-        while stack:
-            node = pop()
-            yield node
-            kids = list(node.children())
-            kids.reverse()
-            extend(kids)
+        """This node and all its descendants, pre-order (:func:`walk`)."""
+        return walk(self)
 
 
 # ----------------------------------------------------------------------------- types, qualifiers

@@ -357,6 +357,15 @@ _SPECS: list[tuple[str, str, str]] = [
         vec2 textureQueryLod(sampler1DArrayShadow, float)
         vec2 textureQueryLod(sampler2DArrayShadow, vec2)
         vec2 textureQueryLod(samplerCubeArrayShadow, vec3)
+        vec2 textureQueryLOD(gsampler1D, float)  vec2 textureQueryLOD(gsampler2D, vec2)
+        vec2 textureQueryLOD(gsampler3D, vec3)  vec2 textureQueryLOD(gsamplerCube, vec3)
+        vec2 textureQueryLOD(gsampler1DArray, float)  vec2 textureQueryLOD(gsampler2DArray, vec2)
+        vec2 textureQueryLOD(gsamplerCubeArray, vec3)
+        vec2 textureQueryLOD(sampler1DShadow, float)  vec2 textureQueryLOD(sampler2DShadow, vec2)
+        vec2 textureQueryLOD(samplerCubeShadow, vec3)
+        vec2 textureQueryLOD(sampler1DArrayShadow, float)
+        vec2 textureQueryLOD(sampler2DArrayShadow, vec2)
+        vec2 textureQueryLOD(samplerCubeArrayShadow, vec3)
     """),
     # Rectangle textures have no mipmaps: implicit lookups on them take no derivatives.
     ("texture", "", """

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 #: extension -> what the front-end knows of it
 DESKTOP: dict[str, str] = {
-    "GL_ARB_texture_query_lod": "textureQueryLod",
+    "GL_ARB_texture_query_lod": "textureQueryLOD (the extension's name), textureQueryLod",
     "GL_ARB_texture_query_levels": "textureQueryLevels",
     "GL_ARB_texture_gather": "textureGather",
     "GL_ARB_texture_rectangle": "sampler2DRect and its lookups",

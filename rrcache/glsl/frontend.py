@@ -158,7 +158,7 @@ def check_size(unit: A.TranslationUnit, filename: str) -> None:
         raise GLSLError(f"the shader has {count:,} syntax nodes after preprocessing, more than the analysis "
                         f"budget of {budget.analysis_nodes:,}", SourceLoc(filename, 1, 1),
                         "raise it with 'rrcache --max-ast-nodes N ...' if the machine has the memory "
-                        "(analysis takes roughly 10 KB per node)")
+                        "(analysis took about 2 KB per node here)")
     if deepest > budget.expression_depth:
         loc = getattr(deepest_node, "loc", None) or SourceLoc(filename, 1, 1)
         raise GLSLError(f"an expression is nested {deepest:,} levels deep, more than the "

@@ -54,6 +54,12 @@ class Symbol:
         return f"Symbol({self.name!r}, {self.type}, {self.kind!r})"
 
 
+def _same_redeclaration(prev: Symbol, sym: Symbol) -> bool:
+    """Whether ``sym`` redeclares the already redeclared built-in ``prev`` word for word."""
+    return (isinstance(prev.decl, A.VariableDecl) and isinstance(sym.decl, A.VariableDecl)
+            and prev.decl.type == sym.decl.type)
+
+
 @dataclass(eq=False)
 class UserFunction:
     """One user-function signature: its prototype and/or definition."""
@@ -265,11 +271,13 @@ class _Checker:
         builtin = BUILTIN_VARIABLES.get(sym.name)
         prev = self.scope.vars.get(sym.name) if builtin is not None else None
         if builtin is not None and self.scope.is_global and (
-                prev is None or (prev.kind == "builtin" and prev.type == sym.type
-                                 and sym.name not in ("gl_FragCoord", "gl_FragDepth"))):
+                prev is None or (prev.kind == "builtin" and prev.type == sym.type and (
+                    sym.name not in ("gl_FragCoord", "gl_FragDepth")
+                    or _same_redeclaration(prev, sym)))):
             # Redeclaring a built-in (layout(origin_upper_left) in vec4 gl_FragCoord;); a
             # compatibility input may be redeclared again to add an interpolation qualifier
-            # (in vec4 gl_Color; flat in vec4 gl_Color;), gl_FragCoord/gl_FragDepth only once.
+            # (in vec4 gl_Color; flat in vec4 gl_Color;); gl_FragCoord/gl_FragDepth again only
+            # with the same qualifiers (4.60 §7.1.2: all their redeclarations must agree).
             sym.kind, sym.read_only = "builtin", builtin.read_only
         elif self._sizes_unsized_array(sym):
             # float u[][7]; ... float u[5][7];  -- an unsized array redeclared with its size:

@@ -33,6 +33,12 @@ from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
 from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
 
+def _unreliable() -> float:
+    from rrcache.harness.timing import UNRELIABLE_NOISE
+
+    return UNRELIABLE_NOISE
+
+
 #: the largest finite 16-bit float: payload values beyond it would be stored as ±inf
 HALF_MAX = 65504.0
 
@@ -71,8 +77,10 @@ class CachedRenderer:
                  period=DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
                  depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
-                 ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None):
+                 ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
+                 color_format: str = "rgba32f"):
         self.ctx = ctx or get_context()
+        self.color_format = color_format
         self.variant = variant
         self.session = session
         self.size = tuple(int(v) for v in (resolution or session.resolution))
@@ -98,7 +106,7 @@ class CachedRenderer:
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
                 refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
-                clear_color=session_background(session),
+                clear_color=session_background(session), color_format=color_format,
                 blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
                 phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1))
             if window is not None:
@@ -189,7 +197,8 @@ class CachedRenderer:
         payload = self.runtime.read_payload() if self.keep_payload else None
         return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload, cpu_ms)
 
-    def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None) -> float:
+    def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None,
+                      stages: Optional[dict] = None) -> float:
         """The cached pipeline's best case: frame ``index`` shown again and again with nothing
         moving and no refresh, so every covered pixel hits after the first showing. Returns the
         median ms of the ``repeats`` hitting frames (the speed-up limit's denominator). The cache
@@ -198,7 +207,11 @@ class CachedRenderer:
         Each frame is read back as :meth:`render_frame` does, and ``between()`` (if given) runs
         before each frame: :func:`compare` renders the original between two cached frames, and
         a limit measured back to back, with the CPU caches warm from the frame before, came out
-        ~25% faster than the same all-hit frame measured that way (Marble, 640×480)."""
+        ~25% faster than the same all-hit frame measured that way (Marble, 640×480).
+
+        ``stages`` (a dict; diagnostics) gets, per timed frame, the ms of each stage of the frame
+        (``clear``, each pass, ``queries``: the runtime waits for the GPU after each) and of the
+        read-back (``read-back``); the frame time is then that of the staged frame."""
         index = check_frame_index(self.session, index)
         if self._check_half:  # decide the payload precision first, on an untimed frame
             self.render_frame(index)
@@ -211,15 +224,28 @@ class CachedRenderer:
             for i in range(repeats + 2):
                 if between is not None:
                     between()
+                marks: list = []
+
+                def mark(stage):
+                    self.ctx.finish()
+                    marks.append((stage, time.perf_counter()))
+
                 self.ctx.finish()
                 start = time.perf_counter()
                 self.drawer.render_shadow_map()
-                stats = self.runtime.frame(self.drawer.draw)
+                stats = self.runtime.frame(self.drawer.draw, mark=mark if stages is not None else None)
                 self.ctx.finish()
-                if i >= 2:
-                    times.append((time.perf_counter() - start) * 1000.0)
+                end = time.perf_counter()
                 self.runtime.read_color()
                 self.runtime.read_depth()
+                if i >= 2:
+                    times.append((end - start) * 1000.0)
+                    if stages is not None:
+                        last = start
+                        for stage, at in marks:
+                            stages.setdefault(stage, []).append((at - last) * 1000.0)
+                            last = at
+                        stages.setdefault("read-back", []).append((time.perf_counter() - end) * 1000.0)
             self.last_static_stats = stats
         finally:
             self.runtime.period = saved
@@ -266,6 +292,7 @@ class Comparison:
     resolution: tuple[int, int] = (0, 0)
     skip_first: int = 1  # frames left out of the summary: the first one has no cache
     payload_dtype: str = "f4"  # the cache precision used (f4 when an f2 request did not fit)
+    color_format: str = "rgba32f"  # the colour target both drew into
 
     def _steady(self) -> list[FrameComparison]:
         steady = self.frames[self.skip_first:]
@@ -310,6 +337,27 @@ class Comparison:
     def speedup(self) -> float:
         return self.original_ms_per_frame / self.ms_per_frame if self.ms_per_frame > 0 else float("nan")
 
+    @property
+    def _float(self) -> bool:
+        return self.color_format != "rgba8"
+
+    @property
+    def speedup_interval(self) -> tuple[float, float]:
+        """A 95% bootstrap interval of :attr:`speedup` over the steady frame pairs
+        (:func:`rrcache.harness.timing.ratio_interval`)."""
+        from rrcache.harness.timing import ratio_interval
+
+        steady = self._steady()
+        return ratio_interval([f.original_ms for f in steady], [f.ms for f in steady])
+
+    @property
+    def noise(self) -> float:
+        """The relative noise of the original's frame times in this run
+        (:func:`rrcache.harness.timing.frame_noise`)."""
+        from rrcache.harness.timing import frame_noise
+
+        return frame_noise([f.original_ms for f in self._steady()])
+
     def summary(self) -> dict:
         """The figures ``rrcache render --node ... --json`` prints."""
         return {
@@ -318,10 +366,17 @@ class Comparison:
             "original_ms_per_frame": self.original_ms_per_frame, "speedup": self.speedup,
             # pixels with NaN/Inf (variant and original), and covered pixels the error left out
             # because either image was not finite there: summed over the summary's frames
-            "nonfinite_pixels": sum(f.nonfinite for f in self._steady()),
-            "original_nonfinite_pixels": sum(f.original_nonfinite for f in self._steady()),
+            # (None in an 8-bit target, where a NaN or an infinity cannot be told from a colour)
+            "nonfinite_pixels": sum(f.nonfinite for f in self._steady()) if self._float else None,
+            "original_nonfinite_pixels": sum(f.original_nonfinite for f in self._steady()) if self._float else None,
             "error_left_out_pixels": sum(f.left_out for f in self._steady()),
             "payload_dtype": self.payload_dtype,
+            "color_format": self.color_format,
+            # how far the speed-up can be trusted: a 95% interval over frame pairs, the noise of
+            # the original's frame times, and whether it was too noisy to rely on
+            "speedup_ci95": list(self.speedup_interval),
+            "noise": self.noise,
+            "reliable": self.noise <= _unreliable(),
         }
 
 
@@ -329,15 +384,19 @@ def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_P
             resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
             depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
-            window: Optional[tuple[int, int, int, int]] = None) -> Comparison:
+            window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f") -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
     is called per frame (for progress bars and writing images). ``window``: both render only
-    that rectangle of the frame (errors and times are then the window's)."""
+    that rectangle of the frame (errors and times are then the window's). ``color_format``: the
+    colour target both draw into (:mod:`rrcache.gl.formats`; ``rgba8`` as an application draws,
+    the error then being what it displays)."""
     result = Comparison()
-    with Renderer(prepared, session, resolution, window=window) as original, \
+    result.color_format = color_format
+    with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
             CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
-                           depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window) as cached:
+                           depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window,
+                           color_format=color_format) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:

@@ -18,6 +18,7 @@ object, culling back faces unless the object is ``double_sided``.
 ...                                   prepared.source))
 >>> drawer = SceneDrawer(ctx, session, prepared, (32, 24), scope)
 >>> _ = drawer.add_program(program)
+>>> scope.own(ctx.simple_framebuffer((32, 24))).use()   # a target to draw into
 >>> drawer.set_frame(10); drawer.draw(program)
 >>> scope.release()
 """

@@ -2,7 +2,7 @@
 
 :class:`Renderer` compiles the shader with the generated vertex shader, checks that the session
 supplies every uniform and sampler the program uses, uploads meshes and textures once, and then
-renders frames into an RGBA32F colour target plus a depth texture: depth test on, back faces
+renders frames into a colour target (RGBA32F by default; ``color_format``) plus a depth texture: depth test on, back faces
 drawn, cleared to the session background. Per frame it returns a :class:`FrameResult`: the image
 (H×W×4 float32, row 0 = top), the covered pixels (where geometry was drawn: depth written), the
 samples that passed the depth test (an occlusion query: shaded fragments, overdraw included) and
@@ -28,6 +28,7 @@ import numpy as np
 from rrcache.errors import SessionError
 from rrcache.gl.context import get_context
 from rrcache import watchdog
+from rrcache.gl.formats import ERROR_FORMAT, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
@@ -86,7 +87,9 @@ class Renderer:
     """Renders frames of ``session`` through ``prepared`` at ``resolution`` (default: the session's).
 
     Back faces are culled for every object the session does not mark ``double_sided`` (pass
-    ``cull_back_faces`` to override). Holds GL objects until :meth:`release` (or the end of a
+    ``cull_back_faces`` to override). ``color_format`` (:mod:`rrcache.gl.formats`) is the colour
+    target's format: ``rgba32f`` (the default, exact) for error runs, ``rgba8`` to time frames as
+    an application draws them; images are float32 either way. Holds GL objects until :meth:`release` (or the end of a
     ``with`` block). ``notes`` lists what
     the session supplies that the shader does not use. ``window`` = (x, y, w, h) (pixels, origin
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
@@ -104,9 +107,11 @@ class Renderer:
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
                  cull_back_faces: Optional[bool] = None, ctx: Optional[moderngl.Context] = None,
-                 window: Optional[tuple[int, int, int, int]] = None):
+                 window: Optional[tuple[int, int, int, int]] = None, color_format: str = ERROR_FORMAT):
         self.ctx = ctx or get_context()
         self.prepared = prepared
+        self.color_format = color_format
+        self._color_dtype = color_dtype(color_format)
         self.session = session
         self.size = tuple(int(v) for v in (resolution or session.resolution))
         self._asked_size = resolution is not None
@@ -137,7 +142,7 @@ class Renderer:
         self.notes = self.drawer.notes
         w, h = self.size
         with target_guard(self.size, where):
-            self._color = self._scope.own(ctx.texture((w, h), 4, dtype="f4"))
+            self._color = self._scope.own(ctx.texture((w, h), 4, dtype=self._color_dtype))
             self._depth = self._scope.own(ctx.depth_texture((w, h)))
             self.fbo = self._scope.own(ctx.framebuffer([self._color], self._depth))
         self.fbo.scissor = self.window
@@ -148,11 +153,11 @@ class Renderer:
     def _check_frame(self, index: int) -> int:
         return check_frame_index(self.session, index)
 
-    def _draw(self, index: int) -> tuple[float, int]:
-        ms, samples, self._cpu_ms = self._draw_timed(index)
+    def _draw(self, index: int, stages: Optional[dict] = None) -> tuple[float, int]:
+        ms, samples, self._cpu_ms = self._draw_timed(index, stages)
         return ms, samples
 
-    def _draw_timed(self, index: int) -> tuple[float, int, float]:
+    def _draw_timed(self, index: int, stages: Optional[dict] = None) -> tuple[float, int, float]:
         ctx = self.ctx
         self.drawer.set_frame(index)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -169,27 +174,40 @@ class Renderer:
             self.fbo.use()
             self.fbo.viewport = (0, 0, *self.size)
         self.fbo.clear(*background, depth=1.0)
+        if stages is not None:
+            ctx.finish()
+            cleared = time.perf_counter()
         with self._query:
             self.drawer.draw(self.program)
         ctx.finish()
-        ms = (time.perf_counter() - start) * 1000.0
+        end = time.perf_counter()
         cpu_ms = (time.process_time() - cpu_start) * 1000.0
-        return ms, int(self._query.samples), cpu_ms
+        samples = int(self._query.samples)
+        if stages is not None:
+            stages.setdefault("clear", []).append((cleared - start) * 1000.0)
+            stages.setdefault("draw", []).append((end - cleared) * 1000.0)
+            stages.setdefault("queries", []).append((time.perf_counter() - end) * 1000.0)
+        return (end - start) * 1000.0, samples, cpu_ms
 
-    def render_frame(self, index: int) -> FrameResult:
+    def render_frame(self, index: int, stages: Optional[dict] = None) -> FrameResult:
         """Render frame ``index`` (an int in ``0..session.frames-1``) and read it back.
 
         The first call draws once untimed (llvmpipe compiles the shader on its first draw).
+        ``stages`` (a dict; diagnostics) gets the ms of the clear, the draw, the query result
+        and the read-back of this frame, the GPU waited for after each.
         """
         index = self._check_frame(index)
         with watchdog.frame(f"frame {index} of the original"):
             if not self._warm:
                 self._draw(index)
                 self._warm = True
-            ms, samples = self._draw(index)
+            ms, samples = self._draw(index, stages)
+        read = time.perf_counter()
         w, h = self.size
-        image = crop_rows(np.frombuffer(self._color.read(), dtype=np.float32).reshape(h, w, 4), self.window).copy()
+        image = crop_rows(texture_floats(self._color.read(), self._color_dtype, (h, w, 4)), self.window).copy()
         depth = crop_rows(np.frombuffer(self._depth.read(), dtype=np.float32).reshape(h, w), self.window)
+        if stages is not None:
+            stages.setdefault("read-back", []).append((time.perf_counter() - read) * 1000.0)
         mask = depth < 1.0
         return FrameResult(index, image, int(mask.sum()), ms, mask, samples, self._cpu_ms)
 
@@ -252,13 +270,15 @@ def as_prepared(shader, session, defines=None) -> PreparedShader:
 
 
 def render(shader, session, frames=None, resolution=None, defines=None,
-           progress: Optional[Callable[[FrameResult], None]] = None, keep_images: bool = True) -> RenderResult:
+           progress: Optional[Callable[[FrameResult], None]] = None, keep_images: bool = True,
+           color_format: str = ERROR_FORMAT) -> RenderResult:
     """Render ``frames`` of ``session`` (None: all, an int: the first n, or a list of indices).
 
     ``shader`` is a :class:`PreparedShader`, a front-end ``Shader`` or a path; ``progress`` is
     called with each :class:`FrameResult` as it is done. With ``keep_images=False`` frames are
     streamed: ``progress`` sees each image, and the result keeps only the per-frame figures
     (``image`` and ``mask`` are None), so a session of a million frames runs in constant memory.
+    ``color_format``: the colour target (:mod:`rrcache.gl.formats`).
 
     >>> from rrcache.session import load_session
     >>> result = render("shaders/glslviewer_basic.glsl", load_session("sessions/marble.json"),
@@ -269,7 +289,7 @@ def render(shader, session, frames=None, resolution=None, defines=None,
     prepared = as_prepared(shader, session, defines)
     indices = frame_indices(session, frames)
     results = []
-    with Renderer(prepared, session, resolution) as renderer:
+    with Renderer(prepared, session, resolution, color_format=color_format) as renderer:
         for result in renderer.frames(indices):
             if progress is not None:
                 progress(result)

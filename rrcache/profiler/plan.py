@@ -67,19 +67,21 @@ class Plan:
     #: as a fraction of the original's
     algorithm: Optional[str] = None
     algorithm_times: Optional[dict] = None
+    #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON), once measured
+    ceiling: Optional[dict] = None
 
     def to_json(self) -> dict:
         return {"error_window": list(self.error_window) if self.error_window else None,
                 "timing_window": list(self.timing_window) if self.timing_window else None,
                 "original_ms": self.original_ms, "algorithm": self.algorithm,
-                "algorithm_times": self.algorithm_times}
+                "algorithm_times": self.algorithm_times, "ceiling": self.ceiling}
 
     @classmethod
     def from_json(cls, data: dict) -> "Plan":
         ew, tw = data.get("error_window"), data.get("timing_window")
         return cls(tuple(int(v) for v in ew) if ew else None, tuple(int(v) for v in tw) if tw else None,
                    float(data.get("original_ms", float("nan"))), data.get("algorithm"),
-                   data.get("algorithm_times"))
+                   data.get("algorithm_times"), data.get("ceiling"))
 
 
 def fraction_for(original_ms: float, target_ms: float, cap: float, floor: float = MIN_FRACTION) -> float:

@@ -26,10 +26,12 @@ from typing import Mapping, Optional
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
+from rrcache.harness.timing import UNRELIABLE_NOISE
 from rrcache.profiler.train import ProgressFn, TrainingResult, train
 from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
+from rrcache.selection import Selection
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -151,7 +153,10 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         untrained=list(result.untrained), budget_stopped=result.budget_stopped,
         mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,
         hit_fit=_fit_json(hit), overhead_ms=result.overhead_ms, original_ms=result.original_ms,
-        pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts))
+        pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts),
+        ceiling=result.ceiling.to_json() if result.ceiling is not None else None,
+        verdict=_verdict(result.ceiling) if result.stopped else None,
+        timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE)
     prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
     prof.path = out
     return prof
@@ -167,8 +172,20 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
         return choices
     from rrcache.profiler.validate import validate
 
-    return validate(work, session, settings, store, choices, progress,
-                    window=result.plan.timing_window if result.plan is not None else None)
+    measured = validate(work, session, settings, store, choices, progress,
+                        window=result.plan.timing_window if result.plan is not None else None,
+                        candidates=prof.front_candidates)
+    # the counts were taken before validation: count the validations now
+    prof.counts = dict(prof.counts, validations=store.counts()["validations"])
+    return measured
+
+
+def _verdict(ceiling) -> dict:
+    """What profile.json says when the ceiling stopped the profile before training."""
+    return {"choice": "original", "ceiling": ceiling.speedup, "min_gain": ceiling.min_gain,
+            "answer": f"keep the original shader: no cached variant can reach {ceiling.min_gain:.2f}× here "
+                      f"(ceiling {ceiling.speedup:.2f}×)",
+            "reason": ceiling.reason(), "changes": ceiling.changes()}
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
@@ -191,6 +208,9 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out
+    if prof.verdict is not None:  # stopped before training: nothing to plot or report
+        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
+        plots = False
     if plots:
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots

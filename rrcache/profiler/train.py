@@ -54,6 +54,8 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
+from rrcache.model.ceiling import Ceiling
+from rrcache.profiler.ceiling import measure_ceiling
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                     shader_inputs, signature)
 from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
@@ -62,6 +64,8 @@ from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERRO
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
 
+#: a ceiling below ``min_gain`` but within this factor of it is measured a second time
+CEILING_RECHECK = 1.3
 #: the resolution of the overhead measurement
 OVERHEAD_SIZE = (8, 8)
 PSNR_CAP = 100.0
@@ -92,10 +96,10 @@ class _Meter:
         if self.progress is not None:
             self.progress(ProgressEvent(stage, self.done, self.total, detail))
 
-    def shrink(self, by: int) -> None:
+    def shrink(self, by: int, stage: str = "train", detail: str = "budget spent") -> None:
         self.total = max(self.done, self.total - by)
         if self.progress is not None:
-            self.progress(ProgressEvent("train", self.done, self.total, "budget spent"))
+            self.progress(ProgressEvent(stage, self.done, self.total, detail))
 
     def grow(self, by: int) -> None:
         self.total += by
@@ -126,6 +130,12 @@ class TrainingResult:
     budget_stopped: bool = False
     notes: dict = field(default_factory=dict)
     plan: Optional[Plan] = None
+    #: the measured ceiling (:mod:`rrcache.profiler.ceiling`), and whether it stopped the profile
+    #: before training (nothing can reach ``settings.min_gain``)
+    ceiling: Optional[Ceiling] = None
+    stopped: bool = False
+    #: the relative noise of the original's repeated timings (:func:`_original_noise`)
+    noise: float = 0.0
 
 
 def training_order(work: ShaderWork, session, settings: TrainingSettings) -> TrainingOrder:
@@ -232,7 +242,7 @@ def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node
     for algorithm in AUTO_CANDIDATES:
         variant = variant_for(work, node_id, algorithm)
         with CachedRenderer(variant, session, work.prepared, full, period=period, window=window,
-                            **settings.cache_options()) as cached:
+                            color_format=settings.timing_format, **settings.cache_options()) as cached:
             frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
         fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
     return min(fractions, key=fractions.get), fractions
@@ -278,18 +288,24 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     need_refs = any(todo_error.values())
     need_ref_timing = not store.reference_timing()
     need_overhead = store.overhead() is None
-    plan_total = ((len(train_frames) if need_refs else 0) + (len(timing) if need_ref_timing else 0)
-                  + sum(len(v) * len(train_frames) for v in todo_error.values())
-                  + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
-                  + (len(timing) if need_overhead else 0))
-    meter = _Meter(progress, plan_total)
+
+    def training_total() -> int:
+        return ((len(train_frames) if need_refs else 0)
+                + sum(len(v) * len(train_frames) for v in todo_error.values())
+                + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
+                + (len(timing) if need_overhead else 0))
+
+    # the training is planned once the ceiling has said whether it happens, and for which nodes
+    meter = _Meter(progress, len(timing) if need_ref_timing else 0)
     budget_stopped = False
     notes = dict(order.skipped)
 
     original: Optional[Renderer] = None
     timed_original: Optional[Renderer] = None
+    ceiling: Optional[Ceiling] = None
+    fmt = settings.timing_format
     try:
-        original = Renderer(work.prepared, session, full)
+        original = Renderer(work.prepared, session, full, color_format=fmt)
         if need_ref_timing:
             rows = []
             for index in timing:
@@ -306,8 +322,36 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             plan = Plan.from_json(stored_plan)
         if plan.timing_window is not None:
             original.release()
-            original = Renderer(work.prepared, session, full, window=plan.timing_window)
+            original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt)
         timed_original = original
+        if order.nodes and len(timing) > 0:
+            ceiling = _ceiling(work, session, settings, store, plan, order.nodes[0], timing, meter)
+            if settings.min_gain > 0 and not ceiling.reaches:
+                # nothing can pay: answer now, before any training
+                if plan.algorithm is None:
+                    plan.algorithm = ceiling.algorithm if settings.algorithm == "auto" else settings.algorithm
+                    store.set_plan(plan.to_json())
+                meter.shrink(meter.total - meter.done, "ceiling", f"{ceiling.speedup:.2f}× < {settings.min_gain:.2f}×: stop")
+                notes.update({n.id: f"not trained: the ceiling ({ceiling.speedup:.2f}×) is below --min-gain "
+                                    f"{settings.min_gain:.2f}×" for n in order.nodes})
+                result = TrainingResult(order=ids + [i for i in _skipped_ids(work, order)], trained=[],
+                                        untrained=ids + _skipped_ids(work, order), notes=notes, plan=plan,
+                                        ceiling=ceiling, stopped=True)
+                fit_models(store, settings, result)
+                result.counts = store.counts()
+                result.wall_s = clock() - start
+                result.spent_s = store.spent_s()
+                return result
+            pruned = _prune(work, order, ceiling, settings)
+            for nid, why in pruned.items():
+                notes[nid] = why
+                todo_error[nid], todo_timing[nid] = [], []
+            order.nodes = [n for n in order.nodes if n.id not in pruned]
+            order.skipped.update(pruned)
+            ids = [n.id for n in order.nodes]
+            if pruned and progress is not None:
+                progress(ProgressEvent("ceiling", meter.done, meter.total, f"{len(pruned)} nodes cannot pay"))
+        meter.grow(training_total())
         if plan.algorithm is None:
             if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
                 meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
@@ -350,13 +394,15 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             if todo_timing[nid]:
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, full, period=todo_timing[nid][0],
-                                    window=plan.timing_window, **settings.cache_options()) as cached:
+                                    window=plan.timing_window, color_format=fmt, **settings.cache_options()) as cached:
                     compile_s = clock() - built
                     for period in todo_timing[nid]:
                         t0 = clock()
                         frames = _timing_run(cached, timed_original, nid, period, timing, meter)
                         store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
                         compile_s = 0.0
+            _plan_within_budget(meter, store, settings, order.nodes, node, todo_error, todo_timing,
+                                len(train_frames), len(timing))
     finally:
         if original is not None:
             original.release()
@@ -368,10 +414,10 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     if trained and need_overhead:
         _measure_overhead(work, session, settings, store, trained[0], timing, meter, plan.algorithm)
 
-    skipped_ids = [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
+    skipped_ids = _skipped_ids(work, order)
     result = TrainingResult(order=ids + skipped_ids, trained=trained,
                             untrained=[i for i in ids + skipped_ids if i not in trained],
-                            budget_stopped=budget_stopped, notes=notes, plan=plan)
+                            budget_stopped=budget_stopped, notes=notes, plan=plan, ceiling=ceiling)
     fit_models(store, settings, result)
     result.counts = store.counts()
     result.wall_s = clock() - start
@@ -379,11 +425,75 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     return result
 
 
+def _plan_within_budget(meter: _Meter, store: ProfileStore, settings: TrainingSettings, nodes, last, todo_error,
+                        todo_timing, n_frames: int, n_timing: int) -> None:
+    """After each trained node, plan only the nodes the budget is expected to reach (at the mean
+    seconds per node stored so far), so that the progress's total and ETA are those of the run
+    that will happen, not of every node in the order."""
+    done_nodes = sum(1 for n in nodes if _node_complete(store, n.id, settings))
+    spent = store.spent_s()
+    if not done_nodes or spent <= 0:
+        return
+    per_node_s = spent / done_nodes
+    index = [n.id for n in nodes].index(last.id)
+    rest = [n.id for n in nodes[index + 1:] if todo_error[n.id] or todo_timing[n.id]]
+    fit = max(0, int((settings.budget_s - spent) / per_node_s) + 1) if per_node_s > 0 else len(rest)
+    per_node = len(settings.periods) * n_frames + len(settings.timing_periods) * 3 * n_timing
+    planned = sum(len(todo_error[n]) * n_frames + len(todo_timing[n]) * 3 * n_timing for n in rest)
+    expected = min(len(rest), fit) * per_node
+    tail = n_timing if store.overhead() is None else 0  # the overhead measurement still to come
+    meter.total = max(meter.done, meter.done + min(planned, expected) + tail)
+
+
+def _skipped_ids(work: ShaderWork, order: TrainingOrder) -> list[str]:
+    return [n.id for n in sorted(work.table.nodes, key=lambda n: -n.cost) if n.id in order.skipped]
+
+
+def _ceiling(work, session, settings: TrainingSettings, store: ProfileStore, plan: Plan, node, timing, meter) -> Ceiling:
+    """The plan's ceiling, measured once (kept in the store's plan; ``min_gain`` is the settings')."""
+    if plan.ceiling is not None:
+        ceiling = Ceiling.from_json(plan.ceiling)
+        ceiling.min_gain = settings.min_gain
+        return ceiling
+    ref = store.reference_timing()
+    pixels = float(np.mean([c for _, _, c in ref])) if ref else 0.0
+    algorithms = AUTO_CANDIDATES if settings.algorithm == "auto" else (settings.algorithm,)
+    meter.grow(2 * len(algorithms))
+    ceiling = measure_ceiling(work, session, settings, node, algorithms, timing, pixels, plan.timing_window,
+                              step=lambda detail: meter.step("ceiling", detail))
+    if settings.min_gain > 0 and ceiling.speedup < settings.min_gain <= ceiling.speedup * CEILING_RECHECK:
+        # near the line a loaded machine decides: measure again and keep the higher ceiling, so
+        # that noise does not stop a profile that could pay
+        meter.grow(2 * len(algorithms))
+        again = measure_ceiling(work, session, settings, node, algorithms, timing, pixels, plan.timing_window,
+                                step=lambda detail: meter.step("ceiling", f"again: {detail}"))
+        again.wall_s += ceiling.wall_s
+        ceiling = max(ceiling, again, key=lambda c: c.speedup)
+    plan.ceiling = ceiling.to_json()
+    store.set_plan(plan.to_json())
+    return ceiling
+
+
+def _prune(work: ShaderWork, order: TrainingOrder, ceiling: Ceiling, settings: TrainingSettings) -> dict[str, str]:
+    """{node id: reason} of the nodes to train whose best case (:meth:`Ceiling.node_speedup` from
+    their share of the costliest node's static cost) is below ``settings.min_gain``."""
+    if settings.min_gain <= 0 or not order.nodes:
+        return {}
+    top = max(n.cost for n in work.table.nodes) or 1
+    out = {}
+    for n in order.nodes[1:]:  # the measured node itself is bounded by the ceiling, which reaches
+        best = ceiling.node_speedup(n.cost / top)
+        if best < settings.min_gain:
+            out[n.id] = (f"its best case ({best:.2f}× with every pixel hitting, from its {n.cost / top:.0%} "
+                         f"of the static cost and the measured ceiling) is below --min-gain {settings.min_gain:.2f}×")
+    return out
+
+
 def _measure_overhead(work, session, settings, store, node_id, timing, meter, algorithm: str) -> None:
     variant = variant_for(work, node_id, algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
-                        **settings.cache_options()) as cached:
+                        color_format=settings.timing_format, **settings.cache_options()) as cached:
         for index in timing:
             cached.reset()
             cached.render_frame(index - 1)
@@ -401,6 +511,25 @@ def _typical_originals(store: ProfileStore, nodes, settings: TrainingSettings) -
                 for f in frames:
                     samples.setdefault(f.frame, []).append(f.original_ms)
     return {frame: float(statistics.median(v)) for frame, v in samples.items()}
+
+
+def _original_noise(store: ProfileStore, nodes, settings: TrainingSettings) -> float:
+    """The noise of the training's timings: every timing run renders the original on the same
+    timing frames, so per frame the spread of its times (1.4826 × MAD / median) is the machine's
+    noise; the median over the frames (0 when nothing was timed twice)."""
+    samples: dict[int, list[float]] = {}
+    for nid in nodes:
+        for period, frames in store.timing_frames(nid).items():
+            if period in settings.timing_periods:
+                for f in frames:
+                    samples.setdefault(f.frame, []).append(f.original_ms)
+    spreads = []
+    for values in samples.values():
+        if len(values) > 2:
+            med = float(np.median(values))
+            if med > 0:
+                spreads.append(1.4826 * float(np.median(np.abs(np.asarray(values) - med))) / med)
+    return float(np.median(spreads)) if spreads else 0.0
 
 
 def fit_models(store: ProfileStore, settings: TrainingSettings, result: TrainingResult) -> None:
@@ -422,6 +551,7 @@ def fit_models(store: ProfileStore, settings: TrainingSettings, result: Training
     if ref_timing:
         result.pixels = float(np.mean([c for _, _, c in ref_timing]))
     typical = _typical_originals(store, result.trained, settings)
+    result.noise = _original_noise(store, result.trained, settings)
     # timed in a window, the original's timing-run times are the window's, not a frame's
     windowed = result.plan is not None and result.plan.timing_window is not None
     periods, rates = [], []

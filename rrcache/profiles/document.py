@@ -151,6 +151,15 @@ class Profile:
     shader_files: list[dict] = field(default_factory=list)
     vertex: Optional[str] = None  # the user's vertex shader file, or None (generated)
     vertex_hash: Optional[str] = None
+    #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON; :attr:`measured_ceiling`)
+    ceiling: Optional[dict] = None
+    #: when the ceiling stopped the profile before training: ``choice`` ("original"), ``ceiling``,
+    #: ``min_gain``, ``answer``, ``reason``, ``changes``
+    verdict: Optional[dict] = None
+    #: the relative noise of the original's repeated timing-run times (1.4826 × MAD / median, the
+    #: median over the timing frames) and whether it was low enough to rely on (≤ 10%)
+    timing_noise: Optional[float] = _range(None, minimum=0)
+    timing_reliable: bool = True
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):
@@ -190,12 +199,22 @@ class Profile:
         return errors, perfs, _fit_from_json(HitRateFit, self.hit_fit, f"{self._where}: hit_fit")
 
     @property
+    def measured_ceiling(self):
+        """The measured :class:`~rrcache.model.ceiling.Ceiling` (None when not measured)."""
+        from rrcache.model.ceiling import Ceiling
+
+        return Ceiling.from_json(self.ceiling)
+
+    @property
     def table(self):
         """The ``rrcache.model.ModelTable`` of the trained nodes (built once)."""
         if self._table is None:
             from rrcache.model import ModelTable
 
             errors, perfs, hit = self.fits()
+            if self.verdict is not None:
+                raise RRCacheError(f"no node was trained: {self.verdict['answer']}", self._where,
+                                   hint="; ".join(self.verdict["changes"]))
             if hit is None or not errors:
                 raise RRCacheError("this profile has no trained node", self._where,
                                    hint="run 'rrcache profile' with a larger --budget")
@@ -219,21 +238,106 @@ class Profile:
         if not math.isfinite(level) or level < 0:
             raise RRCacheError(f"{max_error!r} is not an error threshold", "--max-error",
                                hint="give a mean RGB L2 error >= 0, e.g. 0.01 (profile.json lists the e1..e4 levels)")
+        if self.verdict is not None:  # the ceiling answered before training: the original
+            return Selection.original(float(self.original_ms), algorithm=self.algorithm, max_error=level)
         return self.adopt(model_select(self.table, level), max_error=level)
 
     def threshold_selections(self, labels=LABELS) -> list[Selection]:
-        """The choices at ``len(labels)`` error thresholds spread like the paper's ε1…ε4
-        (:func:`rrcache.model.thresholds`), labelled, predicted only."""
+        """The labelled choices at the profile's levels (``settings.levels``), predicted only:
+        ``psnr`` (the default): predicted PSNR ≥ 45, 40, 35, 30 dB against the original
+        (:data:`rrcache.model.psnr.DEFAULT_LEVELS_DB`; :meth:`select_psnr`); ``relative``: the
+        paper's ε1…ε4, error thresholds spread over the errors seen (:func:`rrcache.model.thresholds`)."""
         from rrcache.model import select as model_select, thresholds
+        from rrcache.model.psnr import DEFAULT_LEVELS_DB
 
+        if self.settings.levels == "psnr":
+            return [self.select_psnr(db).replace(label=label) for label, db in zip(labels, DEFAULT_LEVELS_DB)]
         levels = [float(t) for t in thresholds(self.table, len(labels))]
         return [self.adopt(model_select(self.table, level), label=label, max_error=level)
                 for label, level in zip(labels, levels)]
 
+    def psnr_fits(self) -> list:
+        """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
+        training runs), in the order of :attr:`trained_nodes`."""
+        from rrcache.model.psnr import fit_psnr
+
+        return [fit_psnr(n.errors, n.psnrs) for n in self.trained_nodes]
+
+    def select_psnr(self, min_psnr: float) -> Selection:
+        """The choice predicted fastest whose predicted PSNR against the original is ≥
+        ``min_psnr`` dB (:func:`rrcache.model.psnr.select_min_psnr`), from the models only; its
+        ``max_error`` is the largest error its node may have at that PSNR."""
+        from rrcache.model.psnr import select_min_psnr
+
+        try:
+            level = float(min_psnr)
+        except (TypeError, ValueError):
+            level = float("nan")
+        if not math.isfinite(level):
+            raise RRCacheError(f"{min_psnr!r} is not a PSNR", "--min-psnr", hint="give decibels, e.g. 40")
+        if self.verdict is not None:
+            return Selection.original(float(self.original_ms), algorithm=self.algorithm, min_psnr=level,
+                                      max_error=0.0, exact=True, predicted_psnr_uncertainty=0.0)
+        fits = self.psnr_fits()
+        choice = select_min_psnr(self.table, fits, level)
+        bound = 0.0
+        if choice.parts:
+            bound = max(fits[self.table.node_ids.index(choice.node)].max_error(level), 0.0)
+        return self.adopt(choice, min_psnr=level, max_error=bound)
+
     def adopt(self, choice: Selection, **changes) -> Selection:
         """``choice`` (from the models) as this profile runs it: its algorithm, the nodes'
-        expressions, and ``changes`` (label, max_error …)."""
-        return choice.with_texts(self.texts()).replace(algorithm=self.algorithm, **changes)
+        expressions, the predictions' uncertainty (:meth:`predictions`) and ``changes`` (label,
+        max_error …)."""
+        chosen = choice.with_texts(self.texts()).replace(algorithm=self.algorithm, **changes)
+        return chosen.replace(**self.predictions(chosen))
+
+    def predictions(self, choice: Selection) -> dict:
+        """The predicted PSNR of ``choice`` with its uncertainty (the node's PSNR fit residual),
+        the predicted speed-up's range (the node's performance fit residual on the predicted
+        frame time), ``exact`` (the original's image: PSNR ∞, kept as null) and ``visible_artifacts``
+        (predicted PSNR below 30 dB)."""
+        from rrcache.model.psnr import VISIBLE_DB, predicted_psnr
+
+        if not choice.parts or not choice.predicted_error > 0:  # exact: PSNR ∞ (null in JSON)
+            return {"predicted_psnr": None, "predicted_psnr_uncertainty": 0.0, "exact": True,
+                    "visible_artifacts": False,
+                    "predicted_speedup_range": (choice.predicted_speedup, choice.predicted_speedup)}
+        trained = [n.id for n in self.trained_nodes]
+        i = trained.index(choice.node)
+        value, spread = predicted_psnr(self.psnr_fits()[i], choice.predicted_error)
+        rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
+        ms = float(choice.predicted_ms)
+        # no range when the residual reaches the predicted time itself (no finite upper bound)
+        span = (self.original_ms / (ms + rms), self.original_ms / (ms - rms)) if ms - rms > 0 else ()
+        return {"predicted_psnr": value if math.isfinite(value) else None,
+                "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
+                "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
+
+    def front_candidates(self, choice: Selection) -> list[Selection]:
+        """The options that could stand in for ``choice`` at its level when it measures slower
+        than the original: the predicted Pareto front's points admissible at the level (error ≤
+        ``max_error``, or predicted PSNR ≥ ``min_psnr``) and predicted faster than the original,
+        fastest first, ``choice`` itself left out."""
+        from rrcache.model import pareto_front
+
+        fits = self.psnr_fits() if choice.min_psnr is not None else None
+        ids = [n.id for n in self.trained_nodes]
+        out = []
+        for point in pareto_front(self.table):
+            if point.node is None or not point.predicted_ms < self.original_ms or point.period < 2:
+                continue
+            if fits is not None:
+                ok = fits[ids.index(point.node)].predict(point.predicted_error) >= choice.min_psnr
+            else:
+                ok = point.predicted_error <= (choice.max_error or 0.0)
+            if not ok:
+                continue
+            option = self.table.option(ids.index(point.node) * self.table.max_period + point.period - 1)
+            if option.key == choice.key:
+                continue
+            out.append(self.adopt(option, label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr))
+        return sorted(out, key=lambda s: s.predicted_ms)
 
     def write_variant(self, choice: Selection, out_dir) -> list[str]:
         """Write the shader files of ``choice`` into ``out_dir``: the variant's passes and
@@ -243,10 +347,11 @@ class Profile:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         if not choice.parts:
+            note = (self.verdict["answer"] if self.verdict is not None else
+                    choice.fallback or "no cached variant is predicted to beat the original at this error")
             path = out / "manifest.json"
             path.write_text(json.dumps({"rrcache_selection": 1, "node": None, "shader": self.shader,
-                                        "note": "no cached variant is predicted to beat the original at this error"},
-                                       indent=2) + "\n")
+                                        "note": note}, indent=2) + "\n")
             return [str(path)]
         from rrcache.pipeline import load_for_session, variant_for_selection
         from rrcache.session import load_session
@@ -287,7 +392,9 @@ class Profile:
             raise RRCacheError(f"profile version {version!r}; this rrcache reads {PROFILE_VERSION}", file,
                                hint="run 'rrcache profile' again with this rrcache")
         body = {k: v for k, v in data.items() if k != "rrcache_profile"}
-        return _read_dataclass(cls, body, "", file)
+        prof = _read_dataclass(cls, body, "", file)
+        _check_models(prof, file)
+        return prof
 
     def __repr__(self) -> str:
         ms = f"original {self.original_ms:.2f} ms" if isinstance(self.original_ms, float) else "no timing"
@@ -374,6 +481,43 @@ def _read(value, tp, path: str, file: str, meta):
     raise TypeError(f"no reader for {tp!r}")  # a shape declared with a type this module cannot check
 
 
+#: the numbers of the fitted models' dictionaries (``error_fit``, ``perf_fit``, ``hit_fit``) the
+#: selection computes with: each must be a finite number in its range
+_MODEL_NUMBERS = {
+    "error_fit": {"alpha": (0, None), "lam": (0, None)},
+    "perf_fit": {"t_hit": (0, None), "t_miss": (0, None), "t_overhead": (0, None)},
+    "hit_fit": {"mu": (0, 1)},
+}
+#: what a trained node must carry (null only for a node that was not trained)
+_TRAINED_NUMBERS = ("alpha", "lam", "t_hit", "t_miss")
+
+
+def _check_models(prof: "Profile", file: str) -> None:
+    """The checks the field types cannot say: a trained node has its α, λ, t_hit and t_miss, and
+    the fitted models' numbers (what :meth:`Profile.fits` rebuilds the models from) are finite and
+    in range: a NaN, infinite, negative or null one is refused with its key path."""
+    def check(data, kind, at):
+        for key, (low, high) in _MODEL_NUMBERS[kind].items():
+            if key not in data:
+                continue
+            value = data[key]
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or not _in_range(value, {"minimum": low, "maximum": high}):
+                raise _fail(file, f"{at}.{key}", "must be a finite number" + _bounds({"minimum": low, "maximum": high}))
+
+    for i, node in enumerate(prof.nodes):
+        if node.trained:
+            for name in _TRAINED_NUMBERS:
+                if getattr(node, name) is None:
+                    raise _fail(file, f"nodes[{i}].{name}", "must be a finite number >= 0 for a trained node")
+            for kind in ("error_fit", "perf_fit"):
+                if not getattr(node, kind):
+                    raise _fail(file, f"nodes[{i}].{kind}", "is missing for a trained node")
+                check(getattr(node, kind), kind, f"nodes[{i}].{kind}")
+    if prof.hit_fit:
+        check(prof.hit_fit, "hit_fit", "hit_fit")
+
+
 def _in_range(value, meta) -> bool:
     low, high = meta.get("minimum"), meta.get("maximum")
     return (low is None or value >= low) and (high is None or value <= high)
@@ -450,6 +594,9 @@ def load_profile(path) -> Profile:
         data = json.loads(file.read_text(encoding="utf-8"), parse_constant=_no_constant)
     except (OSError, UnicodeDecodeError, ValueError) as err:
         raise RRCacheError(f"cannot read the profile ({err})", str(file), hint="run 'rrcache profile' again") from None
+    except RecursionError:  # JSON nested thousands deep: no profile looks like that
+        raise RRCacheError("cannot read the profile (its JSON is nested too deeply)", str(file),
+                           hint="run 'rrcache profile' again") from None
     prof = Profile.from_json(data, str(file))
     prof.path = file.parent
     return prof

@@ -33,6 +33,7 @@ from dataclasses import asdict, dataclass, fields, replace
 from typing import Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH,
                              REFRESH_MODES)
 
@@ -48,7 +49,9 @@ DEFAULT_TIMING_PERIODS = (2, 8, 50)
 #: consecutive frames of the error runs when the session has that many
 DEFAULT_TRAINING_FRAMES = 64
 #: the fields that do not change a measurement (left out of the store key)
-UNKEYED = ("budget_s", "validate", "min_saving")
+UNKEYED = ("budget_s", "validate", "min_saving", "min_gain", "levels")
+#: how the four selection levels are chosen
+LEVEL_KINDS = ("psnr", "relative")
 
 
 def _fail(field_name: str, message: str, hint: str) -> RRCacheError:
@@ -94,6 +97,16 @@ class TrainingSettings:
     - ``validate``: render the four selections against the original after training.
     - ``min_saving``: nodes whose static cost is below this share of the costliest node's are
       not trained (:mod:`rrcache.profiler.order`).
+    - ``min_gain``: the least speed-up worth having: when the measured ceiling
+      (:mod:`rrcache.profiler.ceiling`) is below it the profile stops before training and answers
+      "the original"; nodes whose best case is below it are not trained. 0 measures the ceiling
+      but neither stops nor prunes.
+    - ``timing_format``: the colour target of every timed run, the original's and the variants'
+      alike (``rgba8`` as applications draw; ``rgba16f``, ``rgba32f``); error runs always draw
+      into ``rgba32f``.
+    - ``levels``: the four selection levels e1..e4: ``psnr`` (predicted PSNR against the original
+      ≥ 45, 40, 35, 30 dB) or ``relative`` (the paper's error thresholds, fractions of the
+      largest error seen).
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -110,6 +123,9 @@ class TrainingSettings:
     budget_s: float = 360.0
     validate: bool = True
     min_saving: float = 0.1
+    min_gain: float = 1.1
+    timing_format: str = "rgba8"
+    levels: str = "psnr"
 
     def cache_options(self) -> dict:
         """The cache's run-time parameters besides the period, as the keyword arguments of
@@ -160,6 +176,15 @@ class TrainingSettings:
                 or not 0 <= self.min_saving < 1:
             raise _fail("min_saving", f"{self.min_saving!r} is not a share in [0, 1)", "the default is 0.1")
         object.__setattr__(self, "min_saving", float(self.min_saving))
+        if isinstance(self.min_gain, bool) or not isinstance(self.min_gain, (int, float)) \
+                or not 0 <= self.min_gain < 100:
+            raise _fail("min_gain", f"{self.min_gain!r} is not a speed-up in [0, 100)", "the default is 1.1")
+        object.__setattr__(self, "min_gain", float(self.min_gain))
+        if self.levels not in LEVEL_KINDS:
+            raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
+        if self.timing_format not in COLOR_FORMATS:
+            raise _fail("timing_format", f"unknown colour format {self.timing_format!r}",
+                        f"one of {', '.join(COLOR_FORMATS)}")
         if isinstance(self.budget_s, bool) or not isinstance(self.budget_s, (int, float)) \
                 or not 0 < self.budget_s < float("inf"):
             raise _fail("budget_s", f"{self.budget_s!r} is not a positive, finite number of seconds", "e.g. 480")

@@ -335,7 +335,8 @@ class ProfileStore:
         try:
             conn = sqlite3.connect(str(path), isolation_level=None)
         except sqlite3.Error as err:
-            raise _refuse(path, f"cannot create the profile store: {err}", "check that the folder is writable") from None
+            raise _refuse(path, f"cannot create the profile store: {err}",
+                          "free disk space or make the folder writable, then run the same command again") from None
         store = cls(path, conn)
         store._create(key)
         return store
@@ -381,7 +382,8 @@ class ProfileStore:
         except sqlite3.Error as err:
             if conn.in_transaction:
                 conn.execute("ROLLBACK")
-            raise _refuse(self.path, f"cannot create the profile store: {err}", "check that the folder is writable") from None
+            raise _refuse(self.path, f"cannot create the profile store: {err}",
+                          "free disk space or make the folder writable, then run the same command again") from None
 
     def _check(self, key: StoreKey) -> None:
         path = self.path
@@ -506,7 +508,9 @@ class ProfileStore:
                       f"VALUES ({', '.join('?' * len(_VALIDATION_COLUMNS))})",
                       (sel.label, sel.max_error, json.dumps(parts_to_json(sel.parts)), sel.algorithm,
                        sel.predicted_error, sel.predicted_ms, sel.predicted_speedup, sel.measured_error,
-                       sel.measured_psnr, sel.measured_ms, sel.measured_original_ms, sel.measured_speedup,
+                       # an exact image (PSNR ∞, null in the document) is stored at the cap
+                       sel.measured_psnr if sel.measured_psnr is not None else 100.0, sel.measured_ms,
+                       sel.measured_original_ms, sel.measured_speedup,
                        sel.hit_rate, sel.frames))])
 
     # ------------------------------------------------------------------ readers

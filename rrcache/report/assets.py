@@ -39,6 +39,7 @@ td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
 #details h3 { margin: 0 0 6px; font-size: 15px; }
 #details code, .src code { font: 12px/1.35 ui-monospace, "DejaVu Sans Mono", Menlo, monospace; }
 .muted { color: var(--muted); }
+.warn { color: #b3261e; font-weight: 600; }
 .src { background: #fff; border: 1px solid var(--line); border-radius: 6px; padding: 6px 0; overflow-x: auto;
        max-height: 520px; overflow-y: auto; }
 .src div { white-space: pre; padding: 0 10px 0 0; }

@@ -133,8 +133,14 @@ def _multi_selection(sel) -> str:
              + "</table>")
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
-            f"<h3>{_e(sel.label)}: error ≤ {_f(sel.max_error)}</h3><p>{what}{files}</p>{table}"
+            f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
+
+
+def _level(sel) -> str:
+    if sel.min_psnr is not None:
+        return f"PSNR ≥ {sel.min_psnr:g} dB (predicted)"
+    return f"error ≤ {_f(sel.max_error)}"
 
 
 def _selection(prof, sel, shots: FrameShots) -> str:
@@ -142,11 +148,27 @@ def _selection(prof, sel, shots: FrameShots) -> str:
         return _multi_selection(sel)
     images = shots.images(sel.node, sel.period)
     what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
-            if sel.node else "keep the original shader (nothing is predicted faster within this error)")
+            if sel.node else "keep the original shader (nothing is predicted faster at this level)")
+    if sel.fallback:
+        what += f'<br><span class="warn">measured slowdown, fell back: {_e(sel.fallback)}</span>'
+    if sel.visible_artifacts:
+        what += '<br><span class="warn">below 30 dB PSNR: visible artifacts (a choice, not a default)</span>'
+    exact = sel.exact or not sel.parts
+    predicted_psnr = ("∞ (exact)" if exact else
+                      "–" if sel.predicted_psnr is None else
+                      f"{sel.predicted_psnr:.1f} ± {sel.predicted_psnr_uncertainty or 0:.1f} dB")
+    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else _f(sel.measured_psnr, 3, " dB"))
+    speedup = _x(sel.measured_speedup)
+    if len(sel.speedups) > 1:
+        lo, hi = sel.speedup_range
+        speedup += f" ({lo:.2f}–{hi:.2f}, {len(sel.speedups)} repeats)"
+    predicted_speedup = _x(sel.predicted_speedup)
+    if sel.parts and len(sel.predicted_speedup_range) == 2:
+        predicted_speedup += f" ({sel.predicted_speedup_range[0]:.2f}–{sel.predicted_speedup_range[1]:.2f})"
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
-            ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
-            ("PSNR", "", _f(sel.measured_psnr, 3, " dB")),
+            ("speed-up", predicted_speedup, speedup),
+            ("PSNR", predicted_psnr, measured_psnr),
             ("hit rate", "", _f(sel.hit_rate, 3))]
     table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
              + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
@@ -166,7 +188,7 @@ def _selection(prof, sel, shots: FrameShots) -> str:
                      "frames of the session" if sel.node else ""))
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(sel.node or "")}">'
-            f"<h3>{_e(sel.label)}: error ≤ {_f(sel.max_error)}</h3><p>{what}{files}</p>{table}"
+            f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
             f'<div class="shots">{"".join(figures)}</div></div>')
 

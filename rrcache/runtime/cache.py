@@ -56,6 +56,7 @@ import numpy as np
 from rrcache.budgets import MAX_RUNTIME_PERIOD, check_period
 from rrcache.errors import RRCacheError
 from rrcache.gl.context import bind_default_framebuffer
+from rrcache.gl.formats import bytes_per_texel, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
@@ -106,7 +107,8 @@ class CacheRuntime:
     ``programs`` maps the pass names of ``algorithm`` (see :data:`ALGORITHMS`) to linked
     programs. ``size`` is (width, height). ``period`` (Δn), ``block`` (k), ``refresh`` and
     ``depth_epsilon`` can be changed between frames (they are uniforms or small textures).
-    ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
+    ``color_format`` (``rgba8``, ``rgba16f``, ``rgba32f``; :mod:`rrcache.gl.formats`) is the
+    format of the colour target the variant draws into. ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
     the application's culling state alone (the draw callback may set it per object).
     ``period`` given as a list or tuple (one Δn per node, with ``payload_components`` one count
     per node) makes the cache of a multi-node variant, a
@@ -150,6 +152,7 @@ class CacheRuntime:
         cull_back_faces: Optional[bool] = None,
         blend: float = 0.0,
         phase_cycle: int = 1,
+        color_format: str = "rgba32f",
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -163,6 +166,8 @@ class CacheRuntime:
         if block not in BLOCK_SIZES:
             raise ValueError(f"block must be one of {BLOCK_SIZES}, not {block}")
         self.ctx = ctx
+        self.color_format = color_format
+        self._color_dtype = color_dtype(color_format)
         self.programs = programs
         self.algorithm = algorithm
         self.payload_dtype = payload_dtype
@@ -236,7 +241,7 @@ class CacheRuntime:
         self.size = (w, h)
         with target_guard((w, h), "cache size"):
             self.depth = ctx.depth_texture((w, h))
-            self.color = ctx.texture((w, h), 4, dtype="f4")
+            self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
             self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
             self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
             for tex in self._payload + self._invdepth:
@@ -286,11 +291,15 @@ class CacheRuntime:
         """Memory per pixel of the cache's targets (depth, colour, two payloads, two inverse
         depths) plus the colour and depth read back (41): what :meth:`resize` checks first."""
         payload = self.payload_components * (4 if self.payload_dtype == "f4" else 2)
-        return 4 + 16 + 2 * payload + 2 * 4 + 41
+        return 4 + bytes_per_texel(self.color_format) + 2 * payload + 2 * 4 + 41
 
     def reset(self) -> None:
-        """Forget the cache: the next frame misses everywhere (as after a camera cut)."""
+        """Forget the cache: the next frame misses everywhere (as after a camera cut), and the
+        clock starts again at 0, so a run after a reset refreshes the same pixels on the same
+        frames whatever ran before it (a profile resumed after a kill measures what an
+        uninterrupted one does)."""
         self._valid = False
+        self.clock = 0
 
     def _release_targets(self) -> None:
         # moderngl re-binds the current framebuffer whenever it creates a new one: if the bound
@@ -340,13 +349,17 @@ class CacheRuntime:
         with query:
             draw(program, pass_name)
 
-    def frame(self, draw: DrawCallback, count: bool = True, after_first_pass: Optional[Callable[[], None]] = None) -> FrameStats:
+    def frame(self, draw: DrawCallback, count: bool = True, after_first_pass: Optional[Callable[[], None]] = None,
+              mark: Optional[Callable[[str], None]] = None) -> FrameStats:
         """Render one frame with the cache and advance the clock.
 
         ``after_first_pass`` (diagnostics only; it breaks timing) runs after the reprojection
-        pass, e.g. to read the hit map.
+        pass, e.g. to read the hit map. ``mark(stage)`` (diagnostics: the per-pass breakdown of
+        ``rrcache bench-cache``) is called after the clears (``"clear"``), after each pass (its
+        name) and after the query results are read (``"queries"``); it may wait for the GPU.
         """
         ctx = self.ctx
+        mark = mark or (lambda _stage: None)
         ctx.enable(moderngl.DEPTH_TEST)
         if self.cull_back_faces is True:
             ctx.enable(moderngl.CULL_FACE)
@@ -366,31 +379,40 @@ class CacheRuntime:
         # the refresh rule's uniforms, once per frame for every pass
         self._refresh_values = refresh_uniforms(self.size, self._block, self._refresh_mode, self.seed,
                                                 self._period, self.clock)
+        mark("clear")
         covered = misses = None
         if self.algorithm == "three-pass":
             self._run("reproject", draw)
+            mark("reproject")
             if after_first_pass:
                 after_first_pass()
                 cache_fbo.use()
             self._run("payload", draw, first)
+            mark("payload")
             self._out_fbo.depth_mask = False
             self._out_fbo.use()
             ctx.depth_func = "=="
             self._run("shade", draw, second)
+            mark("shade")
             self._out_fbo.depth_mask = True
             if count:
                 misses, covered = int(first.samples), int(second.samples)
         elif self.algorithm == "two-pass":
             self._run("hit", draw, first)
+            mark("hit")
             if after_first_pass:
                 after_first_pass()
                 cache_fbo.use()
             self._run("miss", draw, second)
+            mark("miss")
             if count:
                 misses = int(second.samples)
                 covered = int(first.samples) + misses
         else:
             self._run("single", draw)
+            mark("single")
+        if count:
+            mark("queries")
         ctx.depth_func = "<"
         stats = FrameStats(self.clock, covered, misses)
         self._index = 1 - self._index
@@ -402,8 +424,7 @@ class CacheRuntime:
 
     def _read(self, tex: moderngl.Texture, components: int) -> np.ndarray:
         w, h = self.size
-        data = np.frombuffer(tex.read(), dtype=np.float32 if tex.dtype == "f4" else np.float16)
-        return crop_rows(data.reshape(h, w, components), self.window).astype(np.float32)
+        return crop_rows(texture_floats(tex.read(), tex.dtype, (h, w, components)), self.window).astype(np.float32)
 
     def read_color(self) -> np.ndarray:
         """The last frame's colour, float32 (height, width, 4), row 0 = top of the image (only

@@ -88,31 +88,14 @@ def read_image(path: str) -> np.ndarray:
     return np.ascontiguousarray(data)
 
 
-def split_cube_strip(image: np.ndarray) -> np.ndarray:
-    """A 6:1 horizontal or 1:6 vertical strip (or a cross, :func:`split_cube_cross`) → 6×S×S×C
-    faces.
+def cube_face_size(width: int, height: int) -> int:
+    """The face size of a single-file cube map of ``width``×``height`` pixels (a strip or a
+    cross, as :func:`split_cube_strip` reads it), from the header alone; ImageLoadError otherwise.
 
-    >>> split_cube_strip(np.zeros((2, 12, 3), np.float32)).shape
-    (6, 2, 2, 3)
+    >>> cube_face_size(8, 6)
+    2
     """
-    h, w = image.shape[:2]
-    if w == 6 * h:
-        return np.ascontiguousarray(np.stack([image[:, k * h:(k + 1) * h] for k in range(6)]))
-    if h == 6 * w:
-        return np.ascontiguousarray(np.stack([image[k * w:(k + 1) * w] for k in range(6)]))
-    if (w * 3 == h * 4 and w % 4 == 0) or (w * 4 == h * 3 and w % 3 == 0):
-        return split_cube_cross(image)
-    raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip or a 4:3 or 3:4 cross of "
-                         f"square faces, got {w}×{h}")
-
-
-def cube_face_size(w: int, h: int) -> int:
-    """The face size of a single-file cube map of ``w``×``h`` pixels (a strip or a cross, as
-    :func:`split_cube_strip` reads it), from the image's header alone.
-
-    >>> cube_face_size(12, 2), cube_face_size(8, 6), cube_face_size(6, 8)
-    (2, 2, 2)
-    """
+    w, h = int(width), int(height)
     if w == 6 * h or h == 6 * w:
         return min(w, h)
     if w * 3 == h * 4 and w % 4 == 0:
@@ -121,6 +104,22 @@ def cube_face_size(w: int, h: int) -> int:
         return w // 3
     raise ImageLoadError(f"a single-file cube map must be a 6:1 or 1:6 strip or a 4:3 or 3:4 cross of "
                          f"square faces, got {w}×{h}")
+
+
+def split_cube_strip(image: np.ndarray) -> np.ndarray:
+    """A 6:1 horizontal or 1:6 vertical strip (or a cross, :func:`split_cube_cross`) → 6×S×S×C
+    faces.
+
+    >>> split_cube_strip(np.zeros((2, 12, 3), np.float32)).shape
+    (6, 2, 2, 3)
+    """
+    h, w = image.shape[:2]
+    cube_face_size(w, h)  # refuses any other shape
+    if w == 6 * h:
+        return np.ascontiguousarray(np.stack([image[:, k * h:(k + 1) * h] for k in range(6)]))
+    if h == 6 * w:
+        return np.ascontiguousarray(np.stack([image[k * w:(k + 1) * w] for k in range(6)]))
+    return split_cube_cross(image)
 
 
 def split_cube_cross(image: np.ndarray) -> np.ndarray:

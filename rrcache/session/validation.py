@@ -62,6 +62,11 @@ def _show(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+def _got(value: Any) -> str:
+    """``string 'wide'``, ``integer 3``; just ``null`` for null."""
+    return "null" if value is None else f"{_kind(value)} {_show(value)}"
+
+
 def _kind(value: Any) -> str:
     for name, typ in (("boolean", bool), ("integer", int), ("number", float), ("string", str),
                       ("array", list), ("object", dict)):
@@ -116,7 +121,7 @@ def _convert(err: ValidationError, file: str, prefix: str) -> SessionError:
     if v in ("oneOf", "anyOf"):
         choice = _only_required(err.validator_value)
         if choice is not None and not isinstance(inst, dict):
-            return SessionError(f"expected an object, got {_kind(inst)} {_show(inst)}", file, where or None, None)
+            return SessionError(f"expected an object, got {_got(inst)}", file, where or None, None)
         if choice is not None:
             present = [k for k in choice if k in inst]
             names = " or ".join(repr(k) for k in choice)
@@ -131,7 +136,7 @@ def _convert(err: ValidationError, file: str, prefix: str) -> SessionError:
                     if e.validator == "type" and isinstance(e.validator_value, str)}))
         if not desc:
             return SessionError(err.message, file, where or None, None)
-        return SessionError(f"expected {desc}, got {_kind(inst)} {_show(inst)}", file, where or None, None)
+        return SessionError(f"expected {desc}, got {_got(inst)}", file, where or None, None)
     if v == "additionalProperties" and isinstance(inst, dict):
         known = set(sch.get("properties", {}))
         patterns = list(sch.get("patternProperties", {}))
@@ -151,7 +156,7 @@ def _convert(err: ValidationError, file: str, prefix: str) -> SessionError:
     if v == "type":
         want = err.validator_value
         want = " or ".join(_TYPE_NAMES.get(w, w) for w in ([want] if isinstance(want, str) else want))
-        return SessionError(f"expected {want}, got {_kind(inst)} {_show(inst)}", file, where or None, None)
+        return SessionError(f"expected {want}, got {_got(inst)}", file, where or None, None)
     if v in ("enum", "const"):
         options = err.validator_value if v == "enum" else [err.validator_value]
         hint = None

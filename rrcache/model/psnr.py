@@ -1,0 +1,143 @@
+"""The PSNR model: a cached variant's PSNR against the original, predicted from its error model.
+
+The error model (:mod:`rrcache.model.error`) predicts the mean RGB L2 error ε̂ of a node at any
+refresh period; users read image quality in PSNR (dB). The two are measured together in every
+training run (the run's mean error and its mean per-frame PSNR), so per node the rule is fitted
+to them:
+
+    PSNR̂(node, Δn) = a + b · log10 ε̂(node, Δn)
+
+by least squares over the node's training runs (a and b per node). For a fixed shape of the
+error's distribution PSNR = const − 20·log10(RMS) and the RMS is proportional to the mean error,
+so b = −20; measured slopes are shallower (about −16 on the demo scene: longer periods spread
+the error over more pixels, which raises the mean more than the RMS), hence b is fitted, bounded
+to [−40, −5]. With fewer than two distinct errors b = −20 through the mean point. Error 0 (Δn =
+1, or a node whose cached value never changes) predicts an exact image (PSNR ∞). ``rms`` is the
+fit's residual (dB) over its training runs, floored at :data:`MIN_UNCERTAINTY_DB`: the
+uncertainty shown beside a predicted PSNR.
+
+>>> fit = fit_psnr([0.01, 0.0311, 0.0688, 0.1037], [40.5, 32.3, 26.8, 24.3])
+>>> round(fit.b, 1), round(float(fit.predict(0.05)), 1), fit.quality
+(-16.0, 29.2, 'ok')
+>>> float(fit.predict(0.0))
+inf
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+#: the physically expected slope (PSNR of an RMS proportional to the mean error), and the bounds
+SLOPE = -20.0
+SLOPE_BOUNDS = (-40.0, -5.0)
+#: the least uncertainty shown beside a predicted PSNR (dB)
+MIN_UNCERTAINTY_DB = 0.25
+#: the PSNR the harness caps a per-frame PSNR at (identical frames): such runs carry no slope
+PSNR_CAP = 100.0
+#: below this PSNR a selection shows visible artifacts (dB)
+VISIBLE_DB = 30.0
+#: the default quality levels (dB), e1 to e4
+DEFAULT_LEVELS_DB = (45.0, 40.0, 35.0, 30.0)
+
+
+@dataclass(frozen=True)
+class PsnrFit:
+    """``a``, ``b`` of PSNR̂ = a + b·log10 ε̂; ``rms`` the residual (dB), ``n`` the runs used,
+    ``quality`` ``ok``, ``fixed_slope`` (b = −20: fewer than two distinct errors) or
+    ``no_data``."""
+
+    a: float
+    b: float
+    rms: float
+    n: int
+    quality: str
+
+    def predict(self, errors):
+        """PSNR̂ (dB) at ``errors`` (inf where the error is 0; nan without data)."""
+        e = np.asarray(errors, dtype=np.float64)
+        if self.quality == "no_data":
+            return np.full(e.shape, np.nan) if e.ndim else float("nan")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = np.where(e > 0, self.a + self.b * np.log10(np.where(e > 0, e, 1.0)), np.inf)
+        return out if e.ndim else float(out)
+
+    def max_error(self, min_psnr: float) -> float:
+        """The largest error whose predicted PSNR is ≥ ``min_psnr``."""
+        if self.quality == "no_data":
+            return 0.0
+        return float(10.0 ** ((min_psnr - self.a) / self.b))
+
+    @property
+    def uncertainty(self) -> float:
+        return max(self.rms, MIN_UNCERTAINTY_DB)
+
+
+def fit_psnr(errors, psnrs) -> PsnrFit:
+    """Fit the rule of the module docstring to one node's training runs (mean errors and mean
+    PSNRs); runs with error ≤ 0, a capped PSNR or non-finite values are left out."""
+    e = np.asarray(errors, dtype=np.float64)
+    p = np.asarray(psnrs, dtype=np.float64)
+    keep = np.isfinite(e) & np.isfinite(p) & (e > 0) & (p < PSNR_CAP)
+    e, p = e[keep], p[keep]
+    if e.size == 0:
+        return PsnrFit(float("nan"), SLOPE, float("nan"), 0, "no_data")
+    x = np.log10(e)
+    if np.ptp(x) < 1e-6 or e.size < 2:
+        a = float(np.mean(p - SLOPE * x))
+        return PsnrFit(a, SLOPE, _rms(p - (a + SLOPE * x)), int(e.size), "fixed_slope")
+    b, a = np.polyfit(x, p, 1)
+    b = float(min(max(b, SLOPE_BOUNDS[0]), SLOPE_BOUNDS[1]))
+    a = float(np.mean(p - b * x))
+    return PsnrFit(a, b, _rms(p - (a + b * x)), int(e.size), "ok")
+
+
+def _rms(r: np.ndarray) -> float:
+    return float(math.sqrt(float(np.mean(r * r)))) if r.size else float("nan")
+
+
+def psnr_grid(table, fits) -> np.ndarray:
+    """PSNR̂ over a :class:`~rrcache.model.selection.ModelTable`'s error grid (N × P), one
+    :class:`PsnrFit` per node in table order (None: unknown, -inf)."""
+    out = np.full(table.E.shape, -np.inf)
+    for i, fit in enumerate(fits):
+        if fit is not None and fit.quality != "no_data":
+            out[i] = fit.predict(np.where(np.isfinite(table.E[i]), table.E[i], np.nan))
+    return np.where(np.isnan(out), -np.inf, out)
+
+
+def select_min_psnr(table, fits, min_psnr: float):
+    """The option predicted fastest with PSNR̂ ≥ ``min_psnr`` (what
+    :func:`rrcache.model.select` returns; the original when nothing admissible is faster)."""
+    grid = psnr_grid(table, fits).ravel()
+    cand = np.where(grid >= float(min_psnr), table._t_fast, np.inf)
+    if cand.size == 0:
+        return table.original()
+    idx = int(np.argmin(cand))
+    if not math.isfinite(cand[idx]):
+        return table.original()
+    return table.option(idx)
+
+
+def predicted_psnr(fit: Optional[PsnrFit], error: float) -> tuple[float, float]:
+    """(PSNR̂, ± uncertainty) of ``error`` under ``fit`` (inf, 0 for the exact original)."""
+    if error is None or not error > 0:
+        return math.inf, 0.0
+    if fit is None or fit.quality == "no_data":
+        return float("nan"), float("nan")
+    return float(fit.predict(error)), fit.uncertainty
+
+
+def psnr_text(value: Optional[float], digits: int = 1) -> str:
+    """How a PSNR is shown: '∞ (exact)' for an identical image, '–' when unknown.
+
+    >>> psnr_text(float("inf")), psnr_text(41.234), psnr_text(None)
+    ('∞ (exact)', '41.2', '–')
+    """
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "–"
+    if math.isinf(value) or value >= PSNR_CAP:
+        return "∞ (exact)"
+    return f"{value:.{digits}f}"
