@@ -11,9 +11,7 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from rrcache.deep import deep
-from rrcache.compiler.emit import (
-    fragment_shader, input_locations, interface, runtime_uniforms, vertex_shader, vertex_uniforms,
-)
+from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.multi_locate import prepare_nodes
 from rrcache.compiler.multi_passes import build_multi_pass, has_discard, node_order
 from rrcache.compiler.multi_variant import MultiVariant
@@ -57,10 +55,11 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
                   if "one-pass" in getattr(_table_entry(analysed, node_id), "invalid", {})}
     passes, uniforms, samplers, runtime, forms = {}, {}, {}, {}, {}
     user_vertex = vertex
-    # three-pass: one pass per node after a cheap copy pass (llvmpipe runs both sides of a branch
-    # in lock-step, so one pass 2 over the union would pay every node wherever any node misses);
-    # a shader that can discard keeps the one pass 2 over the union
-    # (and so does a node that needs derivatives: they are undefined after a non-uniform discard)
+    # three-pass: two passes per node (hit_j: copy where node j hits; node_j: compute where it
+    # misses, culled by the depth test), since llvmpipe runs both sides of a branch and the rest of
+    # a shader after a discard in lock-step; a shader that can discard keeps one pass 2 over the
+    # union (the hit passes could not reproduce its discards), and so does a node that needs
+    # derivatives (undefined after a non-uniform discard)
     layout = ("per-node" if algorithm == "three-pass" and not has_discard(loc) and not derivative
               else "union")
     if layout == "per-node":
@@ -70,15 +69,9 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
         steps = [(name, name) for name in ALGORITHMS[algorithm]]
     for name, kind in steps:
         built = build_multi_pass(loc, kind, filter, derivative)
-        iface = interface(built.unit)
-        vertex_src = vertex_shader(iface["in"], built.spec.lookup, input_locations(built.unit), user_vertex)
-        fragment, line_map = fragment_shader(built.unit, built.runtime_glsl)
-        passes[name] = PassSource(vertex_src, fragment, line_map)
-        vertex_names = (user_vertex.uniform_names(built.spec.lookup) if user_vertex is not None
-                        else vertex_uniforms(vertex_src))
-        uniforms[name] = sorted(set(iface["uniform"]) | set(vertex_names))
-        samplers[name] = list(iface["sampler"])
-        runtime[name] = runtime_uniforms(built.runtime_glsl)
+        out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, user_vertex)
+        passes[name] = PassSource(out.vertex, out.fragment, out.line_map)
+        uniforms[name], samplers[name], runtime[name] = out.uniforms, out.samplers, out.runtime
         forms[name] = built.form
     ids = [i if isinstance(i, (int, str)) else None for i in node_ids]
     nodes = [{
