@@ -220,8 +220,11 @@ def test_sigint_exits_130_and_keeps_the_store(tmp_path, stability_case):
                           "rrcache profile, SIGINT after 2 stored error runs, then resumed")
     shader, session = write_scene(tmp_path)
     out = tmp_path / "out"
-    # every node trained (--min-saving 0): enough work that the signal lands before the end
-    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS, "--min-saving", "0")
+    # every node trained (--min-saving 0) at 16 periods: enough work that the signal lands before
+    # the end (with the three periods of CLI_SETTINGS the whole profile took 2.7 s on a quiet
+    # machine and the signal once arrived after it had finished)
+    settings = [*CLI_SETTINGS, "--min-saving", "0", "--periods", "2,3,4,5,6,7,8,10,12,14,16,20,24,28,32,40"]
+    proc = _spawn("profile", shader, session, "--out", out, *settings)
     _wait_for_runs(proc, out / "profile.sqlite", 2)
     proc.send_signal(signal.SIGINT)
     _, stderr = proc.communicate(timeout=60)
@@ -236,6 +239,6 @@ def test_sigint_exits_130_and_keeps_the_store(tmp_path, stability_case):
         for run in store.error_runs():  # every stored run is complete
             assert len(store.error_frames(run.node, run.period)) == run.frames == 12
     assert not (out / "profile.json").exists()
-    resumed = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--min-saving", "0", "--no-validate")
+    resumed = rrcache("profile", shader, session, "--out", out, *settings, "--no-validate")
     case.observe(stored_at_interrupt=stored, resumed_skipping=f"computed; {stored} error and" in resumed.stdout)
     assert f"computed; {stored} error and" in resumed.stdout
