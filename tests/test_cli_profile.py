@@ -42,9 +42,16 @@ def rrcache(*args, check=True, **kw):
     return proc
 
 
+def default_sigint() -> None:
+    """In the child before exec: SIGINT back to its default. A test run started in the
+    background by a non-interactive shell inherits SIGINT ignored, and Python then installs no
+    KeyboardInterrupt handler, so the signal the test sends would do nothing."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _spawn(*args):
     return subprocess.Popen([sys.executable, *ENTRY, *map(str, args)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=_env())
+                            stderr=subprocess.PIPE, text=True, env=_env(), preexec_fn=default_sigint)
 
 
 def _stored_runs(path) -> int:
