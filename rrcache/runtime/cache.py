@@ -317,6 +317,22 @@ class CacheRuntime:
 
     # ------------------------------------------------------------------ the frame
 
+    def _begin_frame(self) -> None:
+        """The state every frame starts from: depth test on, faces culled as asked, this frame's
+        colour cleared and its depth cleared to the far plane."""
+        ctx = self.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        if self.cull_back_faces is True:
+            ctx.enable(moderngl.CULL_FACE)
+        elif self.cull_back_faces is False:
+            ctx.disable(moderngl.CULL_FACE)
+        self._color_only_fbo.use()
+        self._color_only_fbo.clear(*self.clear_color)
+        clear_fbo = self._clear_fbos[self._index]
+        clear_fbo.depth_mask = True
+        clear_fbo.use()
+        clear_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+
     def _set(self, program: moderngl.Program, name: str, value) -> None:
         if name in program:
             program[name].value = value
@@ -360,17 +376,7 @@ class CacheRuntime:
         """
         ctx = self.ctx
         mark = mark or (lambda _stage: None)
-        ctx.enable(moderngl.DEPTH_TEST)
-        if self.cull_back_faces is True:
-            ctx.enable(moderngl.CULL_FACE)
-        elif self.cull_back_faces is False:
-            ctx.disable(moderngl.CULL_FACE)
-        self._color_only_fbo.use()
-        self._color_only_fbo.clear(*self.clear_color)
-        clear_fbo = self._clear_fbos[self._index]
-        clear_fbo.depth_mask = True
-        clear_fbo.use()
-        clear_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self._begin_frame()
         cache_fbo = self._cache_fbos[self._index]
         cache_fbo.depth_mask = True
         cache_fbo.use()

@@ -185,22 +185,11 @@ class MultiCacheRuntime(CacheRuntime):
         ``after_first_pass`` runs after the first node's ``hit`` pass."""
         if not (self.algorithm == "three-pass" and self.node_passes):
             return super().frame(draw, count, after_first_pass)
-        import moderngl as _mgl
 
         from rrcache.runtime.cache import FrameStats
 
         ctx = self.ctx
-        ctx.enable(_mgl.DEPTH_TEST)
-        if self.cull_back_faces is True:
-            ctx.enable(_mgl.CULL_FACE)
-        elif self.cull_back_faces is False:
-            ctx.disable(_mgl.CULL_FACE)
-        self._color_only_fbo.use()
-        self._color_only_fbo.clear(*self.clear_color)
-        clear_fbo = self._clear_fbos[self._index]
-        clear_fbo.depth_mask = True
-        clear_fbo.use()
-        clear_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self._begin_frame()
         ctx.depth_func = "<"
         queries = self._node_queries if count else [None] * len(self.node_passes)
         for n, name in enumerate(self.node_passes):
