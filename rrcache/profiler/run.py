@@ -78,6 +78,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             store.begin_run()
             result = train(work, session, resolved, store, progress)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+            # amortized sampling: the estimators' models, on the same front as the nodes
+            from rrcache.profiler.amortize import train_estimators
+            prof.estimators = train_estimators(work, session, resolved, store, result, progress)
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             _write_outputs(prof, out, work, plots)
             store.end_run("done")

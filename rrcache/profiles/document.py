@@ -34,8 +34,9 @@ from typing import Any, Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json
+from rrcache.profiles.amortize import EstimatorProfile
 from rrcache.profiles.settings import TrainingSettings
-from rrcache.selection import Selection, parts_from_json
+from rrcache.selection import AmortizedLoop, Selection, parts_from_json
 
 #: the version of the document's shape; a document of another version is refused
 PROFILE_VERSION = 2
@@ -160,6 +161,9 @@ class Profile:
     #: median over the timing frames) and whether it was low enough to rely on (≤ 10%)
     timing_noise: Optional[float] = _range(None, minimum=0)
     timing_reliable: bool = True
+    #: the shader's estimators and their amortized-sampling models (:mod:`rrcache.profiles.amortize`;
+    #: absent in documents written before amortization was profiled: none)
+    estimators: list[EstimatorProfile] = field(default_factory=list)
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):
@@ -240,7 +244,7 @@ class Profile:
                                hint="give a mean RGB L2 error >= 0, e.g. 0.01 (profile.json lists the e1..e4 levels)")
         if self.verdict is not None:  # the ceiling answered before training: the original
             return Selection.original(float(self.original_ms), algorithm=self.algorithm, max_error=level)
-        return self.adopt(model_select(self.table, level), max_error=level)
+        return self.adopt(self._rival(model_select(self.table, level), max_error=level), max_error=level)
 
     def threshold_selections(self, labels=LABELS) -> list[Selection]:
         """The labelled choices at the profile's levels (``settings.levels``), predicted only:
@@ -253,8 +257,8 @@ class Profile:
         if self.settings.levels == "psnr":
             return [self.select_psnr(db).replace(label=label) for label, db in zip(labels, DEFAULT_LEVELS_DB)]
         levels = [float(t) for t in thresholds(self.table, len(labels))]
-        return [self.adopt(model_select(self.table, level), label=label, max_error=level)
-                for label, level in zip(labels, levels)]
+        return [self.adopt(self._rival(model_select(self.table, level), max_error=level), label=label,
+                           max_error=level) for label, level in zip(labels, levels)]
 
     def psnr_fits(self) -> list:
         """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
@@ -280,6 +284,9 @@ class Profile:
                                       max_error=0.0, exact=True, predicted_psnr_uncertainty=0.0)
         fits = self.psnr_fits()
         choice = select_min_psnr(self.table, fits, level)
+        rival = self._rival(choice, min_psnr=level)
+        if rival is not choice:  # an amortized estimator is predicted faster at this level
+            return self.adopt(rival, min_psnr=level, max_error=max(self._estimator_psnr(rival).max_error(level), 0.0))
         bound = 0.0
         if choice.parts:
             bound = max(fits[self.table.node_ids.index(choice.node)].max_error(level), 0.0)
@@ -303,10 +310,15 @@ class Profile:
             return {"predicted_psnr": None, "predicted_psnr_uncertainty": 0.0, "exact": True,
                     "visible_artifacts": False,
                     "predicted_speedup_range": (choice.predicted_speedup, choice.predicted_speedup)}
-        trained = [n.id for n in self.trained_nodes]
-        i = trained.index(choice.node)
-        value, spread = predicted_psnr(self.psnr_fits()[i], choice.predicted_error)
-        rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
+        if isinstance(choice.parts[0], AmortizedLoop):
+            est = self.estimator(choice.parts[0].estimator)
+            value, spread = predicted_psnr(self._estimator_psnr(choice), choice.predicted_error)
+            rms = float(est.time_fit.get("rms") or 0.0)
+        else:
+            trained = [n.id for n in self.trained_nodes]
+            i = trained.index(choice.node)
+            value, spread = predicted_psnr(self.psnr_fits()[i], choice.predicted_error)
+            rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
         ms = float(choice.predicted_ms)
         # no range when the residual reaches the predicted time itself (no finite upper bound)
         span = (self.original_ms / (ms + rms), self.original_ms / (ms - rms)) if ms - rms > 0 else ()
@@ -320,6 +332,7 @@ class Profile:
         ``max_error``, or predicted PSNR ≥ ``min_psnr``) and predicted faster than the original,
         fastest first, ``choice`` itself left out."""
         from rrcache.model import pareto_front
+        from rrcache.model.amortize import front as amortized_front
 
         fits = self.psnr_fits() if choice.min_psnr is not None else None
         ids = [n.id for n in self.trained_nodes]
@@ -337,7 +350,51 @@ class Profile:
             if option.key == choice.key:
                 continue
             out.append(self.adopt(option, label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr))
+        out += [self.adopt(option, label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr)
+                for option in amortized_front(self._admissible(max_error=choice.max_error if fits is None else None,
+                                                               min_psnr=choice.min_psnr))
+                if option.key != choice.key]
         return sorted(out, key=lambda s: s.predicted_ms)
+
+    # ------------------------------------------------------------------ amortized sampling
+    def estimator(self, estimator_id: str) -> EstimatorProfile:
+        for e in self.estimators:
+            if e.id == estimator_id:
+                return e
+        raise RRCacheError(f"no estimator '{estimator_id}' in this profile", self._where,
+                           hint="the profile lists its estimators in profile.json")
+
+    def amortized_options(self) -> list[Selection]:
+        """Every (estimator, m, λ) the trained estimators' models predict
+        (:meth:`rrcache.model.amortize.AmortizeModel.options`), on the same error-against-time
+        axes as the cached nodes' options."""
+        if not self.original_ms:
+            return []
+        out = []
+        for est in self.estimators:
+            model = est.model()
+            if model is not None:
+                out.extend(model.options(float(self.original_ms)))
+        return out
+
+    def _admissible(self, max_error=None, min_psnr=None) -> list[Selection]:
+        from rrcache.model.amortize import admissible
+
+        if max_error is None and min_psnr is None:
+            return []
+        return admissible(self.amortized_options(), float(self.original_ms or 0.0), max_error, min_psnr)
+
+    def _rival(self, choice: Selection, max_error=None, min_psnr=None) -> Selection:
+        """``choice`` (the nodes' best at a level), or the amortized option predicted faster
+        than it at the same level."""
+        options = self._admissible(max_error, min_psnr)
+        if options and options[0].predicted_ms < choice.predicted_ms:
+            return options[0]
+        return choice
+
+    def _estimator_psnr(self, choice: Selection):
+        model = self.estimator(choice.parts[0].estimator).model()
+        return model.psnr if model is not None else None
 
     def write_variant(self, choice: Selection, out_dir) -> list[str]:
         """Write the shader files of ``choice`` into ``out_dir``: the variant's passes and

@@ -1,0 +1,222 @@
+"""Training amortized sampling: the error and timing runs of each estimator, and its models
+(Nehab et al. 2007 §6; the models are :mod:`rrcache.model.amortize`).
+
+:func:`train_estimators` runs after the nodes are trained (:mod:`rrcache.profiler.train`), in
+the same windows (:mod:`rrcache.profiler.plan`) and with the same algorithm:
+
+1. **Error runs.** Per estimator and per trained m (:func:`rrcache.model.amortize.training_samples`:
+   for 16 terms m = 1, 4, 8) one compiled variant serves every blend (λ is the runtime's
+   ``blend``): the training frames are rendered in order from an empty cache at each λ of
+   :data:`~rrcache.model.amortize.TRAIN_BLENDS` and compared with the original (the error window
+   at full pixel density), as a node's error runs are at each Δn; a run's error is the mean over
+   the frames after the first.
+2. **Timing.** Each trained m at the session's full resolution on the timing frames: the original
+   renders frame f, the variant f − 1 (untimed, from an empty cache) and f timed; each variant
+   time is taken relative to the original's beside it and scaled by the original's typical
+   frame time, so machine load cancels.
+3. **Fits.** The error model by nlopt over every error run, the time per evaluated term by least
+   squares through each timed m's median relative frame time.
+
+The estimators are trained costliest (most terms) first; the first always, the others while the
+training budget (``settings.budget_s``, node runs included) lasts. Every run is stored as it
+completes (:mod:`rrcache.profiles.amortize`) and skipped when a profile is resumed.
+"""
+from __future__ import annotations
+
+import statistics
+import time
+from typing import Optional
+
+import numpy as np
+
+from rrcache.errors import RRCacheError
+from rrcache.harness.cached import CachedRenderer
+from rrcache.harness.metrics import mean_l2, psnr
+from rrcache.harness.renderer import Renderer
+from rrcache.model.amortize import TRAIN_BLENDS, fit_amortized_error, fit_amortized_time, training_samples
+from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn, timing_frame_indices
+from rrcache.profiles import amortize as data
+from rrcache.profiles.amortize import EstimatorProfile
+from rrcache.runtime import DEFAULT_PERIOD
+
+
+def _record(est) -> EstimatorProfile:
+    return EstimatorProfile(est.id, est.line, est.column, int(est.samples), est.text)
+
+
+def train_estimators(work, session, settings, store, result, progress: Optional[ProgressFn] = None,
+                     clock=time.perf_counter) -> list[EstimatorProfile]:
+    """Train every estimator of ``work`` the budget allows (module docstring) and return their
+    records, trained or with a ``note`` saying why not. ``result`` is the nodes'
+    :class:`~rrcache.profiler.train.TrainingResult` (its plan, algorithm and original time)."""
+    from rrcache.analysis.estimators import find_estimators
+
+    try:
+        table = find_estimators(work.shader)
+    except RRCacheError:
+        return []
+    found = sorted(table.estimators, key=lambda e: -int(e.samples))
+    records = [_record(e) for e in found]
+    if not records:
+        return []
+    plan = result.plan
+    if plan is None or plan.algorithm is None or result.stopped or not result.original_ms > 0:
+        for r in records:
+            r.note = "not trained: the profile stopped before training (see its verdict)"
+        return records
+    algorithm = plan.algorithm
+    frames = list(range(settings.frames))
+    timing = timing_frame_indices(session.frames, settings.timing_frames)
+    full = tuple(int(v) for v in session.resolution)
+    state = {"done": 0, "total": 0}
+
+    def step(detail: str, n: int = 1) -> None:
+        state["done"] += n
+        state["total"] = max(state["total"], state["done"])
+        if progress is not None:
+            progress(ProgressEvent("amortize", state["done"], state["total"], detail))
+
+    refs = None
+    for k, (est, rec) in enumerate(zip(found, records)):
+        if est.samples < 2:
+            rec.note = "not trained: a loop of one term has nothing to amortize"
+            continue
+        if est.components > 4:
+            rec.note = f"not trained: its accumulators need {est.components} payload components (at most 4)"
+            continue
+        spent = store.spent_s() + data.spent_s(store)
+        started = bool(data.rows(store, est.id, "error") or data.rows(store, est.id, "timing"))
+        if k > 0 and not started and spent >= settings.budget_s:
+            rec.note = "not reached within the training budget (--budget)"
+            continue
+        ms_list = training_samples(est.samples)
+        state["total"] += len(ms_list) * (len(TRAIN_BLENDS) * len(frames) + 3 * len(timing))
+        try:
+            if refs is None and _missing_errors(store, est.id, ms_list):
+                refs = _references(work, session, settings, plan, frames, step)
+            _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock)
+            _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock)
+        except RRCacheError as err:  # a variant that does not compile or run: say why, go on
+            rec.note = f"not trained: {err}"
+            continue
+        _fit(rec, store, result.original_ms)
+    return records
+
+
+def _missing_errors(store, eid: str, ms_list) -> bool:
+    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, eid, "error")}
+    return any((m, round(lam, 6)) not in have for m in ms_list for lam in TRAIN_BLENDS)
+
+
+def _references(work, session, settings, plan, frames, step) -> list:
+    refs = []
+    with Renderer(work.prepared, session, settings.resolution, window=plan.error_window) as renderer:
+        for index in frames:
+            refs.append(renderer.render_frame(index))
+            step(f"reference frame {index}")
+    return refs
+
+
+def _variant(work, est, algorithm: str, m: int):
+    from rrcache.compiler.amortize import instance_amortized
+
+    return instance_amortized(work.shader, est.id, algorithm, samples=m, blend=0.0, vertex=work.vertex)
+
+
+def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock) -> None:
+    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error")}
+    for m in ms_list:
+        todo = [lam for lam in TRAIN_BLENDS if (m, round(lam, 6)) not in have]
+        if not todo:
+            continue
+        built = clock()
+        with CachedRenderer(_variant(work, est, algorithm, m), session, work.prepared, settings.resolution,
+                            period=DEFAULT_PERIOD, window=plan.error_window, **settings.cache_options()) as cached:
+            extra = clock() - built
+            for lam in todo:
+                start = clock()
+                cached.runtime.blend = float(lam)
+                cached.reset()
+                errs, psnrs, hits, misses = [], [], 0, 0
+                for i, ref in enumerate(refs):
+                    got = cached.render_frame(ref.index)
+                    step(f"{est.id} m={m} λ={lam:g}")
+                    if i == 0:
+                        continue  # the first frame has no cache
+                    errs.append(float(mean_l2(got.image, ref.image, ref.mask)[0]))
+                    psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
+                    hits += int(got.hits or 0)
+                    misses += int(got.misses or 0)
+                errs = errs or [0.0]
+                psnrs = psnrs or [PSNR_CAP]
+                rate = hits / (hits + misses) if hits + misses else 0.0
+                wall = clock() - start + extra
+                extra = 0.0
+                data.add_rows(store, [(est.id, "error", int(m), float(lam), -1, float(np.mean(errs)),
+                                       float(np.mean(psnrs)), rate, hits, misses, 0.0, 0.0, wall)])
+
+
+def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock) -> None:
+    have = {r["samples"] for r in data.rows(store, est.id, "timing")}
+    todo = [m for m in ms_list if m not in have]
+    if not todo or not timing:
+        return
+    fmt = settings.timing_format
+    with Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt) as original:
+        for m in todo:
+            start = clock()
+            with CachedRenderer(_variant(work, est, algorithm, m), session, work.prepared, full,
+                                period=DEFAULT_PERIOD, window=plan.timing_window, color_format=fmt,
+                                **settings.cache_options()) as cached:
+                # (the renderer's first frame draws every phase program once, untimed: a phase's
+                # first draw compiles it, 100-300 ms on a 1 ms shader)
+                out = []
+                for index in timing:
+                    ref = original.render_frame(index)
+                    cached.reset()
+                    cached.render_frame(index - 1)
+                    got = cached.render_frame(index)
+                    out.append((index, got, ref.ms))
+                    step(f"{est.id} m={m} timing", 3)
+            wall = (clock() - start) / max(1, len(out))
+            data.add_rows(store, [(est.id, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0, int(got.hits or 0),
+                                   int(got.misses or 0), float(got.ms), float(ref_ms), wall)
+                                  for index, got, ref_ms in out])
+
+
+def _fit(rec: EstimatorProfile, store, original_ms: float) -> None:
+    """The models of ``rec`` from its stored runs (module docstring, step 3)."""
+    errors = data.rows(store, rec.id, "error")
+    timed = data.rows(store, rec.id, "timing")
+    if not errors or not timed:
+        rec.note = "not trained: runs missing"
+        return
+    rec.run_samples = [int(r["samples"]) for r in errors]
+    rec.run_blends = [float(r["blend"]) for r in errors]
+    rec.errors = [float(r["mean_error"]) for r in errors]
+    rec.psnrs = [float(r["psnr"]) for r in errors]
+    rec.hit_rates = [float(r["hit_rate"]) for r in errors]
+    ef = fit_amortized_error(rec.run_samples, rec.run_blends, rec.errors, rec.samples)
+    # every variant frame relative to the original beside it, on the original's typical time
+    hits, covered = 0, 0
+    by_m: dict[int, list] = {}
+    for r in timed:
+        if r["original_ms"] <= 0:
+            continue
+        rel = float(r["ms"]) / float(r["original_ms"]) * float(original_ms)
+        n = int(r["hits"]) * int(r["samples"]) + int(r["misses"]) * rec.samples
+        hits += int(r["hits"])
+        covered += int(r["hits"]) + int(r["misses"])
+        by_m.setdefault(int(r["samples"]), []).append((rel, float(n)))
+    rec.timed_samples = sorted(by_m)
+    rec.timed_ms = [float(statistics.median(v[0] for v in by_m[m])) for m in rec.timed_samples]
+    rec.timed_evaluated = [float(statistics.median(v[1] for v in by_m[m])) for m in rec.timed_samples]
+    # the line through each m's median (a loaded machine's outlier frames do not pull it)
+    tf = fit_amortized_time(rec.timed_evaluated, rec.timed_ms)
+    rec.error_fit = {"a": ef.a, "b": ef.b, "total": ef.total, "r2": ef.r2, "rms": ef.rms, "n": ef.n,
+                     "quality": ef.quality}
+    rec.time_fit = {"fixed_ms": tf.fixed_ms, "t_sample": tf.t_sample, "rms": tf.rms, "n": tf.n, "quality": tf.quality}
+    rec.hit_rate = hits / covered if covered else 0.0
+    rec.pixels = covered / max(1, len(timed))
+    rec.trained = True
+    rec.note = None
