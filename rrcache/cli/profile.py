@@ -269,9 +269,14 @@ def _table(prof) -> Table:
         else:
             table.add_column(name, justify="right")
     for s in prof.selections:
-        node = "(original)" if s.node is None else f"{s.node}: {s.text}"
+        if s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
+            part = s.parts[0]
+            node, period = f"{part.estimator} m={part.samples}/{prof.estimator(part.estimator).samples} " \
+                           f"λ={part.blend:g}: {part.text or ''}", None
+        else:
+            node, period = ("(original)" if s.node is None else f"{s.node}: {s.text}"), s.period
         if s.fallback:
             node = "↩ " + node
-        table.add_row(f"{s.label} {_level(s)}", node, _fmt(s.period, "d"), _predicted_speedup(s), _speedup(s),
+        table.add_row(f"{s.label} {_level(s)}", node, _fmt(period, "d"), _predicted_speedup(s), _speedup(s),
                       _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
     return table

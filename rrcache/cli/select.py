@@ -10,7 +10,9 @@ PSNR against the original of at least that many dB (the PSNR model of :mod:`rrca
 ``--max-error`` for a mean RGB L2 error. ``--json`` prints ``{"node", "period",
 "predicted_error", "predicted_ms", "predicted_speedup", "predicted_speedup_range",
 "predicted_psnr", "predicted_psnr_uncertainty", "exact", "visible_artifacts"}`` (node null: the
-original shader is the best choice; PSNR null with ``exact`` true: the original's image);
+original shader is the best choice; PSNR null with ``exact`` true: the original's image; an
+amortized estimator adds ``"kind": "amortize", "estimator", "samples", "of", "blend"`` with node
+null);
 ``--out`` writes the chosen variant's shader files.
 """
 from __future__ import annotations
@@ -43,6 +45,18 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
     written = prof.write_variant(choice, out_dir) if out_dir else []
     level = f"error {max_error:g}" if max_error is not None else f"PSNR ≥ {min_psnr:g} dB"
     if as_json:
+        if choice.kind == "amortize":  # amortized sampling: the estimator, m and λ
+            part = choice.parts[0]
+            data = {"node": None, "period": None, "kind": "amortize", "estimator": part.estimator,
+                    "samples": part.samples, "of": prof.estimator(part.estimator).samples, "blend": part.blend,
+                    "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
+                    "predicted_speedup": float(choice.predicted_speedup),
+                    "predicted_speedup_range": list(choice.predicted_speedup_range),
+                    "predicted_psnr": choice.predicted_psnr,
+                    "predicted_psnr_uncertainty": choice.predicted_psnr_uncertainty,
+                    "exact": choice.exact, "visible_artifacts": choice.visible_artifacts}
+            click.echo(json.dumps(finite_json(data)))
+            return
         if choice.multi:  # several nodes: "n12+n40" and one period each
             data = {"node": "+".join(choice.nodes), "period": list(choice.periods), "nodes": list(choice.nodes),
                     "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
@@ -57,7 +71,14 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
                 "exact": choice.exact, "visible_artifacts": choice.visible_artifacts}
         click.echo(json.dumps(finite_json(data)))
         return
-    if choice.multi:
+    if choice.kind == "amortize":
+        part = choice.parts[0]
+        click.echo(f"amortize {part.estimator} ({part.text}): {part.samples} of "
+                   f"{prof.estimator(part.estimator).samples} terms per frame, blend λ = {part.blend:g}: predicted "
+                   f"error {choice.predicted_error:.4g}, PSNR {psnr_text(choice.predicted_psnr)} ± "
+                   f"{choice.predicted_psnr_uncertainty or 0:.1f} dB, {choice.predicted_ms:.3f} ms per frame, "
+                   f"{choice.predicted_speedup:.2f}× the original")
+    elif choice.multi:
         texts = "; ".join(prof.node(n).text for n in choice.nodes)
         click.echo(f"cache {choice.describe()} ({texts}): predicted error {choice.predicted_error:.4g}, "
                    f"{choice.predicted_ms:.3f} ms per frame, {choice.predicted_speedup:.2f}× the original")

@@ -121,8 +121,13 @@ def _source(prof, lines: list[str]) -> str:
 def _multi_selection(sel) -> str:
     """A selection of several nodes: what each caches at which period and its figures (its frames
     are not rendered here: the report's images show one cached node)."""
-    what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
-                                 + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
+    if sel.kind == "amortize":
+        p = sel.parts[0]
+        what = (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples} of its terms per frame, blended "
+                f"with the reprojected estimate by λ = {p.blend:g}" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
+    else:
+        what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
+                                     + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
@@ -132,9 +137,10 @@ def _multi_selection(sel) -> str:
              + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
              + "</table>")
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
+    why = "amortized sampling" if sel.kind == "amortize" else "several nodes"
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
-            '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
+            f'<p class="muted">{why}: no frames are shown for this choice</p></div>')
 
 
 def _level(sel) -> str:
@@ -144,7 +150,7 @@ def _level(sel) -> str:
 
 
 def _selection(prof, sel, shots: FrameShots) -> str:
-    if sel.multi:
+    if sel.multi or sel.kind == "amortize":
         return _multi_selection(sel)
     images = shots.images(sel.node, sel.period)
     what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
@@ -219,6 +225,28 @@ def _settings(prof) -> str:
     return "<table>" + "".join(f"<tr><th>{_e(k)}</th><td><code>{_e(v)}</code></td></tr>" for k, v in rows) + "</table>"
 
 
+def _estimators(prof) -> str:
+    """The shader's estimators (amortized sampling): N, the error and time fits, and the best
+    option at each trained m (the options are on the tradeoff plot with the nodes)."""
+    if not prof.estimators:
+        return ""
+    rows = []
+    for est in prof.estimators:
+        ef, tf = est.error_fit or {}, est.time_fit or {}
+        fit = (f"a = {_f(ef.get('a'))}, b = {_f(ef.get('b'))}, R² = {_f(ef.get('r2'), 3)}" if est.trained else
+               _e(est.note or "not trained"))
+        per = _f(float(tf.get("t_sample") or 0.0) * 1e6, 3) if est.trained else "–"
+        rows.append(f"<tr><td>{_e(est.id)}</td><td class=num>{est.line}</td><td class=num>{est.samples}</td>"
+                    f"<td><code>{_e(est.text)}</code></td><td>{fit}</td><td class=num>{per}</td></tr>")
+    return ("<h2>Amortized sampling</h2><p class=\"muted\">Loops that sum independent terms, evaluated at m of "
+            "their N terms per frame and blended with the reprojected estimate by λ; error against the "
+            "original ε = a·sqrt(s(m)(1−λ)/(1+λ)) + b·sqrt(λ/(1−λ)), s(m) = (N−m)/(m(N−1)); time per evaluated "
+            "term (per frame, over every evaluated term) from timed frames. Their options compete with the "
+            "cached nodes at every level.</p><table><tr><th>estimator</th><th class=num>line</th>"
+            "<th class=num>N</th><th>loop</th><th>error model</th><th class=num>ms per 1e6 terms</th></tr>"
+            + "".join(rows) + "</table>")
+
+
 def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
     """The report page of ``prof`` as a string (renders the selections' frames)."""
     shots = shots or FrameShots(prof, work)
@@ -248,6 +276,7 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         '<p class="muted">The four error thresholds e1..e4; predicted by the models, measured by rendering '
         "the session with the chosen variant beside the original.</p>",
         "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        _estimators(prof),
         "<h2>Model validation</h2>", _plots(prof),
         "<h2>Settings and training</h2>", _settings(prof),
     ]

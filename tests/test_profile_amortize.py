@@ -1,0 +1,190 @@
+"""Amortized sampling in the profiler, end to end on a tiny scene (an icosphere, 64×64, 12 frames,
+a shader whose soft lighting sums 8 terms in a loop: estimator e1), real GL and real nlopt fits:
+
+- the estimator is trained: error runs at m = 1, 2, 4 and λ of TRAIN_BLENDS against the original,
+  timing runs at each m, the fits in profile.json (which still loads without the key);
+- fewer terms per frame cost error (at λ = 0); the nlopt fit follows the runs;
+- every level's choice is the faster of the nodes' and the estimator's best admissible option;
+- a profile whose estimator is predicted fastest selects an AmortizedLoop: `rrcache select`
+  shows and writes it, validation measures it beside the original.
+"""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rrcache.model.amortize import TRAIN_BLENDS, admissible
+from rrcache.profiler import profile
+from rrcache.profiles import TrainingSettings, load_profile
+from rrcache.selection import AmortizedLoop
+
+from test_profile import SESSION
+
+SHADER = """#version 330
+in vec4 v_position;
+in vec3 v_normal;
+in vec3 v_objectPosition;
+uniform vec3 u_light;
+uniform float u_scale;
+out vec4 fragColor;
+
+float wave(vec3 p, float f) {
+    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
+}
+
+void main() {
+    vec3 p = v_objectPosition * u_scale;
+    vec3 nrm = normalize(v_normal);
+    vec3 l = normalize(u_light - v_position.xyz);
+    float shade = 0.0;
+    for (int i = 0; i < 8; i++) {
+        vec3 d = normalize(l + 0.35 * vec3(cos(float(i) * 2.4), sin(float(i) * 2.4), 0.5 * wave(p, 1.0 + float(i))));
+        shade += max(dot(nrm, d), 0.0) * (0.6 + 0.4 * wave(p, 2.0 + 0.3 * float(i)));
+    }
+    fragColor = vec4(vec3(0.9, 0.8, 0.6) * (0.2 + 0.1 * shade), 1.0);
+}
+"""
+
+#: 64×64 at full resolution (the error runs in a window at full pixel density), a 1 s budget:
+#: the costliest node and the estimator are trained
+SETTINGS = dict(periods=(2, 4, 8), timing_frames=6, timing_periods=(2, 8), min_gain=0.0, budget_s=1.0)
+
+
+def _scene(folder):
+    folder.mkdir(parents=True, exist_ok=True)
+    shader, session = folder / "soft.frag", folder / "orbit.json"
+    shader.write_text(SHADER)
+    session.write_text(json.dumps({**SESSION, "resolution": [64, 64]}))
+    return shader, session
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("amortize")
+    shader, session = _scene(folder)
+    events = []
+    prof = profile(shader, session, folder / "out", TrainingSettings(**SETTINGS, validate=False),
+                   progress=events.append)
+    return prof, events, folder
+
+
+def test_the_estimator_is_trained_against_m_and_lambda(trained):
+    prof, events, folder = trained
+    assert [e.id for e in prof.estimators] == ["e1"]
+    est = prof.estimators[0]
+    assert est.trained and est.samples == 8 and est.note is None
+    assert sorted(set(est.run_samples)) == [1, 2, 4]
+    assert sorted(set(est.run_blends)) == sorted(TRAIN_BLENDS)
+    assert len(est.errors) == 3 * len(TRAIN_BLENDS)
+    assert all(math.isfinite(e) and e > 0 for e in est.errors)
+    at_zero = {m: e for m, lam, e in zip(est.run_samples, est.run_blends, est.errors) if lam == 0.0}
+    # fewer terms per frame, more error (no blend to hide it)
+    assert at_zero[1] > at_zero[2] > at_zero[4]
+    # the nlopt fit follows the runs
+    model = est.model()
+    predicted = model.error.predict(np.array(est.run_samples), np.array(est.run_blends))
+    assert est.error_fit["quality"] in ("ok", "poor") and est.error_fit["a"] > 0
+    assert np.corrcoef(predicted, est.errors)[0, 1] > 0.8
+    assert est.timed_samples == [1, 2, 4] and all(ms > 0 for ms in est.timed_ms)
+    # more terms evaluated at larger m
+    assert est.timed_evaluated[0] < est.timed_evaluated[1] < est.timed_evaluated[2]
+    assert 0 < est.hit_rate <= 1 and est.pixels > 100
+    assert any(e.stage == "amortize" for e in events)
+
+
+def test_profile_json_keeps_the_estimators_and_old_documents_load(trained, tmp_path):
+    prof, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    assert data["estimators"][0]["id"] == "e1" and data["estimators"][0]["trained"]
+    assert load_profile(folder / "out") == prof
+    # a document written before amortization was profiled has no "estimators": it loads, with none
+    del data["estimators"]
+    (tmp_path / "profile.json").write_text(json.dumps(data))
+    old = load_profile(tmp_path)
+    assert old.estimators == [] and old.amortized_options() == []
+    assert old.select_psnr(30).kind in ("cache", "original")
+    # a bad value in an estimator is refused with its key path
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    data["estimators"][0]["errors"][0] = -1
+    (tmp_path / "profile.json").write_text(json.dumps(data))
+    with pytest.raises(Exception, match=r"estimators\[0\]\.errors\[0\]"):
+        load_profile(tmp_path)
+
+
+def test_each_level_takes_the_faster_of_nodes_and_estimator(trained):
+    prof, _, _ = trained
+    options = prof.amortized_options()
+    assert options and all(isinstance(o.parts[0], AmortizedLoop) for o in options)
+    from rrcache.model.psnr import select_min_psnr
+
+    for db in (45.0, 40.0, 35.0, 30.0, 20.0):
+        node_choice = select_min_psnr(prof.table, prof.psnr_fits(), db)
+        best = admissible(options, prof.original_ms, min_psnr=db)
+        choice = prof.select_psnr(db)
+        if best and best[0].predicted_ms < node_choice.predicted_ms:
+            assert choice.kind == "amortize" and choice.key == best[0].key
+        else:
+            assert choice.key == node_choice.key
+
+
+@pytest.fixture(scope="module")
+def amortized_wins(trained, tmp_path_factory):
+    """The trained profile with the estimator's time per term made tiny: its options are predicted
+    far faster than the original and than any node (what a costly estimator gives at full
+    resolution), so the choice does not depend on this machine's speed."""
+    prof, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    est = data["estimators"][0]
+    est["time_fit"]["fixed_ms"] = 0.01 * data["original_ms"]
+    est["time_fit"]["t_sample"] = 1e-9
+    out = tmp_path_factory.mktemp("wins")
+    (out / "profile.json").write_text(json.dumps(data))
+    return load_profile(out), folder
+
+
+def test_select_returns_an_amortized_loop(amortized_wins, tmp_path):
+    prof, folder = amortized_wins
+    choice = prof.select(1.0)
+    assert choice.kind == "amortize" and choice.parts[0].estimator == "e1"
+    assert choice.predicted_speedup > 1 and choice.algorithm == prof.algorithm
+    # the CLI: JSON, text and the shader files of the choice
+    env_cmd = [sys.executable, "-m", "rrcache", "select", str(prof.path), "--max-error", "1"]
+    got = subprocess.run(env_cmd + ["--json"], capture_output=True, text=True)
+    assert got.returncode == 0, got.stderr
+    data = json.loads(got.stdout)
+    assert data["kind"] == "amortize" and data["estimator"] == "e1" and data["of"] == 8
+    assert data["samples"] == choice.parts[0].samples and data["blend"] == choice.parts[0].blend
+    got = subprocess.run(env_cmd + ["--out", str(tmp_path / "opt")], capture_output=True, text=True)
+    assert got.returncode == 0, got.stderr
+    assert got.stdout.startswith("amortize e1") and "terms per frame" in got.stdout
+    manifest = json.loads((tmp_path / "opt" / "manifest.json").read_text())
+    assert manifest["algorithm"] == prof.algorithm
+    # the PSNR levels choose it too, and front_candidates offers other amortized options
+    level = prof.select_psnr(20.0)
+    assert level.kind == "amortize" and level.max_error > 0
+    assert all(c.key != level.key for c in prof.front_candidates(level))
+
+
+def test_validation_measures_an_amortized_selection(amortized_wins, tmp_path):
+    from rrcache.pipeline import load_for_session
+    from rrcache.profiler.validate import validate
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.session import load_session
+
+    prof, folder = amortized_wins
+    session = load_session(folder / "orbit.json")
+    work = load_for_session(folder / "soft.frag", session)
+    settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    choice = prof.select(1.0).replace(label="e4")
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        [row] = validate(work, session, settings, store, [choice], fallback=False)
+    assert row.key == choice.key and row.frames == 6 and len(row.speedups) == 3
+    # fresh terms every frame at hits: an error against the original, but not a broken image
+    assert 0 < row.measured_error < 0.5 and math.isfinite(row.measured_psnr)
+    assert 0 < row.hit_rate < 1
