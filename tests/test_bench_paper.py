@@ -87,7 +87,7 @@ def rrcache(*args, timeout=240):
 
 # ---------------------------------------------------------------- scenes
 def test_resolve_scenes(tmp_path):
-    names = [s.name for s in resolve_scenes("marble,trashcan,chess")]
+    names = [s.name for s in resolve_scenes("marble,trashcan,chess,temple")]
     assert names == list(PAPER_SCENES)
     shader, session = write_scene(tmp_path)
     (scene,) = resolve_scenes(f"{shader}:{session}")

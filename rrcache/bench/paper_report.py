@@ -49,8 +49,10 @@ def scene_markdown(s) -> str:
         lines += ["| level | max error | node | Δn | speed-up | mean error | PSNR dB | hit rate | predicted speed-up |",
                   "|---|---|---|---|---|---|---|---|---|"]
         for r in s.selections:
-            lines.append(f"| {r.label} | {_f(r.max_error, '.4f')} | {_code(r.text if r.parts else None)} | "
-                         f"{_f(r.period, 'd')} | {_f(r.measured_speedup, '.2f')}× | {_f(r.measured_error, '.4f')} | "
+            amortized = r.kind == "amortize"  # an estimator at m samples and λ: no node, no Δn
+            what = _code(f"{r.describe()}: {r.parts[0].text}" if amortized else (r.text if r.parts else None))
+            lines.append(f"| {r.label} | {_f(r.max_error, '.4f')} | {what} | "
+                         f"{_f(None if amortized else r.period, 'd')} | {_f(r.measured_speedup, '.2f')}× | {_f(r.measured_error, '.4f')} | "
                          f"{_f(r.measured_psnr, '.1f')} | "
                          f"{_f(r.hit_rate, '.3f')} | {_f(r.predicted_speedup, '.2f')}× |")
         lines.append("")

@@ -1,4 +1,4 @@
-"""The paper's three scenes for ``rrcache bench``, and sessions scaled down for quick runs.
+"""The paper's scenes for ``rrcache bench`` (Marble, Trashcan, chess; and the temple's PCF shadows), and sessions scaled down for quick runs.
 
 :data:`PAPER_SCENES` names them (main paper §5: Marble, Trashcan, chess ambient occlusion);
 :func:`resolve_scenes` turns ``--scenes`` entries (a name, or ``SHADER:SESSION`` for any other
@@ -22,6 +22,8 @@ PAPER_SCENES = {
     "marble": ("shaders/marble.glsl", "sessions/marble.json"),
     "trashcan": ("shaders/trashcan.glsl", "sessions/trashcan.json"),
     "chess": ("shaders/ambient_occlusion.glsl", "sessions/chess.json"),
+    # the fourth scene (Nehab et al. 2007 §7.3): 16-tap PCF shadows, where amortized sampling competes
+    "temple": ("shaders/pcf_shadows.glsl", "sessions/temple.json"),
 }
 
 

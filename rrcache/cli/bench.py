@@ -1,6 +1,6 @@
-"""``rrcache bench``: the paper's three scenes end to end (see :mod:`rrcache.bench.paper`).
+"""``rrcache bench``: the paper's scenes end to end (and the temple's PCF shadows) (see :mod:`rrcache.bench.paper`).
 
-    rrcache bench                         # marble, trashcan, chess at the sessions' resolution
+    rrcache bench                         # marble, trashcan, chess, temple at the sessions' resolution
     rrcache bench --quick                 # reduced sizes and budgets: a few minutes
     rrcache bench --scenes marble,my.frag:my.json --out bench-out --json
 
@@ -22,7 +22,7 @@ from rrcache.cli.progress import Reporter, quiet_option
 
 @click.command("bench")
 @click.option("--quick", is_flag=True, help="Reduced resolution, frames, training budget and searches.")
-@click.option("--scenes", default="marble,trashcan,chess", show_default=True, metavar="LIST",
+@click.option("--scenes", default="marble,trashcan,chess,temple", show_default=True, metavar="LIST",
               help="Comma-separated scene names, or SHADER:SESSION pairs.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), default="rrcache-bench", show_default=True,
               help="Folder for bench.md, bench.json and the profiles.")
