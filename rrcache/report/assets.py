@@ -95,6 +95,7 @@ JS = r"""
   // ---- scales
   var xs = [data.original_ms], ys = [0];
   data.nodes.forEach(function (n) { n.points.forEach(function (p) { xs.push(p[1]); ys.push(p[2]); }); });
+  (data.amortized || []).forEach(function (p) { xs.push(p[0]); ys.push(p[1]); });
   var x0 = Math.min.apply(null, xs), x1 = Math.max.apply(null, xs);
   var pad = (x1 - x0) * 0.04 || x0 * 0.1 || 1;
   x0 = Math.max(0, x0 - pad); x1 += pad;
@@ -154,6 +155,15 @@ JS = r"""
         el("circle", {cx: X(p[1]), cy: Y(p[2]), r: trained ? 3.6 : 2.2, fill: n.color, "class": "pt",
                       "data-node": i, "data-point": j}, layer);
       });
+    });
+    // amortized estimators' options (m of N terms per frame, blend λ): orange crosses
+    (data.amortized || []).forEach(function (p) {
+      if (logY && p[1] <= 0) { return; }
+      var x = X(p[0]), y = Y(p[1]);
+      var mark = el("path", {d: "M" + (x - 3) + "," + (y - 3) + "L" + (x + 3) + "," + (y + 3) + "M" + (x - 3) + "," +
+                             (y + 3) + "L" + (x + 3) + "," + (y - 3), stroke: "#e07b00", "stroke-width": 1.4,
+                             "class": "amort"}, layer);
+      el("title", {}, mark).textContent = p[2] + ": error " + fmt(p[1], 3) + ", " + fmt(p[0], 3) + " ms";
     });
     el("polyline", {points: data.front.map(function (p) { return X(p[0]) + "," + Y(p[1]); }).join(" "),
                     fill: "none", stroke: "#000", "stroke-width": 2.2, "stroke-opacity": 0.45,

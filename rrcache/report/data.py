@@ -45,13 +45,22 @@ def chart_data(prof) -> dict:
         if points:
             nodes.append({"id": node_id, "text": node.text, "line": node.line, "points": points})
     front = [[float(p.predicted_ms), float(p.predicted_error), p.node, p.period] for p in pareto_front(table)]
+    options = prof.amortized_options()
+    if options:  # one front over the cached nodes and the amortized estimators
+        merged = sorted(front + [[float(o.predicted_ms), float(o.predicted_error), o.describe(), None]
+                                 for o in options], key=lambda p: (p[0], p[1]))
+        front, best = [], math.inf
+        for point in merged:
+            if point[1] < best:
+                front.append(point)
+                best = point[1]
     selections = [{"label": s.label, "node": "+".join(s.nodes) if s.multi else (s.describe() if s.kind == "amortize"
                                                                               else s.node),
                    "period": list(s.periods) if s.multi else (None if s.kind == "amortize" else s.period),
                    "what": s.describe(),
                    "ms": _num(s.predicted_ms), "error": _num(s.predicted_error)} for s in prof.selections]
     # the amortized estimators' options (estimator, m, λ) on the same axes
-    amortized = [[float(o.predicted_ms), float(o.predicted_error), o.describe()] for o in prof.amortized_options()]
+    amortized = [[float(o.predicted_ms), float(o.predicted_error), o.describe()] for o in options]
     return {"nodes": nodes, "front": front, "original_ms": float(prof.original_ms), "selections": selections,
             "amortized": amortized}
 

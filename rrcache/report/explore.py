@@ -147,7 +147,7 @@ def selections_figure(prof, shots: FrameShots):
     fig, axes = plt.subplots(len(prof.selections), len(names), figsize=(2.4 * len(names), 2.2 * len(prof.selections)),
                              dpi=100, squeeze=False)
     for row, sel in zip(axes, prof.selections):
-        if sel.multi:  # several nodes: no frames (the shots render one cached node)
+        if sel.multi or sel.kind == "amortize":  # no frames (the shots render one cached node)
             for ax in row:
                 ax.axis("off")
             row[0].text(-0.08, 0.5, f"{sel.label}: {sel.describe()}", transform=row[0].transAxes, rotation=90,
@@ -171,7 +171,7 @@ def default_choice(prof) -> tuple:
     """``(node, Δn)`` worth a first look: the last selection that caches something, else the
     costliest trained node at the largest trained period."""
     for sel in reversed(prof.selections):
-        if sel.parts and not sel.multi:
+        if sel.parts and sel.kind == "cache":
             return sel.node, int(sel.period)
     node = prof.trained_nodes[0]
     return node.id, int(max(node.periods))
@@ -211,8 +211,11 @@ def selections_html(prof) -> str:
             "pred. speed-up", "meas. speed-up", "PSNR", "hit rate"]
     rows = []
     for s in prof.selections:
-        node_cell = " + ".join(s.nodes) if s.multi else (s.node or "original")
-        period_cell = " + ".join(str(p) for p in s.periods) if s.multi else (s.period or "–")
+        if s.kind == "amortize":  # an amortized estimator: m of N terms per frame, blend λ
+            node_cell, period_cell = s.describe(), "–"
+        else:
+            node_cell = " + ".join(s.nodes) if s.multi else (s.node or "original")
+            period_cell = " + ".join(str(p) for p in s.periods) if s.multi else (s.period or "–")
         cells = [s.label, _f(s.max_error), node_cell, period_cell, _f(s.predicted_error),
                  _f(s.measured_error), _f(s.predicted_ms), _f(s.measured_ms), _f(s.predicted_speedup, 3),
                  _f(s.measured_speedup, 3), _f(s.measured_psnr, 3), _f(s.hit_rate, 3)]
@@ -228,7 +231,7 @@ def measure_choice(prof, node: Optional[str], period: Optional[int], shots: Fram
     frames) and return ``{"error", "psnr", "speedup", "ms", "original_ms", "hit_rate", "frames"}``.
     A choice the profile validated is not rendered again: its stored figures are returned."""
     for sel in prof.selections:
-        if sel.multi:
+        if sel.multi or sel.kind == "amortize":
             continue
         if sel.node == node and sel.period == period and sel.measured_error is not None and (node or sel.frames):
             return {"error": sel.measured_error, "psnr": sel.measured_psnr, "speedup": sel.measured_speedup,
@@ -327,6 +330,10 @@ class Explorer:
         """Re-select for ``max_error`` and refresh the view (renders only when the choice changes)."""
         start = time.perf_counter()
         choice = self.prof.select(max_error)
+        if choice.kind == "amortize":  # the explorer shows cached nodes' frames: their best choice
+            from rrcache.model import select as model_select
+
+            choice = self.prof.adopt(model_select(self.prof.table, float(max_error)), max_error=float(max_error))
         self.select_ms = (time.perf_counter() - start) * 1000.0
         changed = self.choice is None or (choice.node, choice.period) != (self.choice.node, self.choice.period)
         self.choice = choice
