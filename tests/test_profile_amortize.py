@@ -188,3 +188,23 @@ def test_validation_measures_an_amortized_selection(amortized_wins, tmp_path):
     # fresh terms every frame at hits: an error against the original, but not a broken image
     assert 0 < row.measured_error < 0.5 and math.isfinite(row.measured_psnr)
     assert 0 < row.hit_rate < 1
+
+
+def test_the_bench_measures_the_papers_amortized_setting(trained):
+    """``rrcache bench`` measures each trained estimator at the paper's setting (N/4 terms per
+    frame, λ = 3/5) beside the original and shows it in bench.md."""
+    from rrcache.bench.paper import QUICK, SceneResult, _amortized_rows
+    from rrcache.bench.paper_report import scene_markdown
+    from rrcache.pipeline import load_for_session
+    from rrcache.session import load_session
+
+    prof, _, folder = trained
+    session = load_session(folder / "orbit.json")
+    work = load_for_session(folder / "soft.frag", session)
+    [row] = _amortized_rows(prof, work, session, list(range(6)), QUICK, None)
+    assert row.setting == "e1: 2 of 8 per frame, λ=0.6"
+    assert row.speedup > 0 and 0 < row.mean_error < 0.5 and row.ms > 0 and row.original_ms > 0
+    scene = SceneResult("soft", str(folder / "soft.frag"), str(folder / "orbit.json"), (64, 64), 6, 1, 1,
+                        amortized=[row])
+    assert "amortized sampling at the paper's setting" in scene_markdown(scene)
+    assert scene.to_json()["amortized"][0]["setting"] == row.setting

@@ -153,6 +153,8 @@ class SceneResult:
     selections: list = field(default_factory=list)
     algorithms: list = field(default_factory=list)
     equal_time: list = field(default_factory=list)
+    #: amortized sampling at the paper's setting per trained estimator (:func:`_amortized_rows`)
+    amortized: list = field(default_factory=list)
     notes: list = field(default_factory=list)
     wall_s: float = 0.0
     figure: Optional[str] = None
@@ -224,6 +226,37 @@ def _measure_selections(prof, work, session, frames, settings: BenchSettings, pr
             first.mean_error, _cap(first.psnr), float(statistics.median(r.ms_per_frame for r in runs)),
             float(statistics.median(r.original_ms_per_frame for r in runs)), float(statistics.median(speedups)),
             first.hit_rate, len(first.frames), speedups))
+    return rows
+
+
+#: the paper's amortized setting (Nehab et al. 2007 §7.3: 4 of 16 PCF samples per frame, λ = 3/5)
+PAPER_SHARE, PAPER_BLEND = 4, 0.6
+
+
+def _amortized_rows(prof, work, session, frames, settings: BenchSettings, progress) -> list[MethodRow]:
+    """Each trained estimator of the profile at the paper's setting (N/4 of its N terms per frame,
+    at least 1, blend λ = 3/5), measured beside the original as the selections are (error against
+    the original; ``rrcache bench-amortize`` measures against a many-sample reference)."""
+    from rrcache.harness.cached import compare
+    from rrcache.pipeline import variant_for_selection
+    from rrcache.selection import AmortizedLoop
+
+    rows = []
+    for est in getattr(prof, "estimators", []):
+        if not est.trained:
+            continue
+        m = max(1, est.samples // PAPER_SHARE)
+        sel = Selection((AmortizedLoop(est.id, m, PAPER_BLEND),), 0.0, float("nan"), 1.0, algorithm=prof.algorithm)
+        _say(progress, f"amortized {sel.describe()}", None, None)
+        variant, period = variant_for_selection(work, sel)
+        runs = [compare(variant, session, work.prepared, frames, period=period, **prof.settings.cache_options())
+                for _ in range(settings.repeats)]
+        first = runs[0]
+        rows.append(MethodRow("amortized sampling (Nehab 2007 §6)", f"{est.id}: {m} of {est.samples} per frame, "
+                              f"λ={PAPER_BLEND:g}", float(statistics.median(r.speedup for r in runs)),
+                              first.mean_error, _cap(first.psnr), float(statistics.median(r.ms_per_frame for r in runs)),
+                              float(statistics.median(r.original_ms_per_frame for r in runs)),
+                              steps=[r.speedup for r in runs]))
     return rows
 
 
@@ -367,6 +400,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         return result
 
     result.selections = _measure_selections(prof, work, session, frames, settings, progress)
+    try:
+        result.amortized = _amortized_rows(prof, work, session, frames, settings, progress)
+    except RRCacheError as err:
+        result.notes.append(f"amortized sampling failed: {err}")
     originals = [s.measured_original_ms for s in result.selections if s.measured_original_ms is not None]
     medium = _choose_medium(result.selections)
     if medium is None:

@@ -48,12 +48,17 @@ def write_scene_plot(scene, out) -> str:
             if _x(r.speedup) is not None:
                 ax.scatter([_x(r.speedup)], [r.mean_error], marker="*", s=120, color=colours.get(r.method, "tab:red"),
                            zorder=4, label=f"{r.method} (equal time)")
+        for r in getattr(scene, "amortized", []):
+            if _x(r.speedup) is not None:
+                ax.scatter([_x(r.speedup)], [r.mean_error], marker="P", s=70, color="darkorange", zorder=4,
+                           label=f"amortized ({r.setting})")
         if scene.limit_speedup:
             ax.axvline(1.0 / scene.limit_speedup, color="tab:blue", linestyle=":", linewidth=1,
                        label=f"cache limit ({scene.limit_speedup:.1f}×)")
         ax.set_xlabel("frame time / original frame time")
         ax.set_ylabel("mean RGB L2 error")
-        xs = [x for x in ([s[1] for s in sel] + [_x(r.speedup) for r in scene.algorithms + scene.equal_time])
+        xs = [x for x in ([s[1] for s in sel] + [_x(r.speedup) for r in scene.algorithms + scene.equal_time
+                                                  + list(getattr(scene, "amortized", []))])
               if x is not None]
         ax.set_xlim(0, 1.05 * max([1.0] + xs))
         ax.set_ylim(bottom=0)

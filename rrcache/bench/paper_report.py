@@ -56,6 +56,9 @@ def scene_markdown(s) -> str:
                          f"{_f(r.measured_psnr, '.1f')} | "
                          f"{_f(r.hit_rate, '.3f')} | {_f(r.predicted_speedup, '.2f')}× |")
         lines.append("")
+    if getattr(s, "amortized", None):
+        lines += _methods(s.amortized, "amortized sampling at the paper's setting (N/4 per frame, λ = 3/5; error "
+                                       "against the original; the profile's own amortized options compete in e1..e4)")
     if s.algorithms:
         lines += _methods(s.algorithms, f"cache algorithms on the {s.medium} node")
     if s.limit_speedup is not None:
