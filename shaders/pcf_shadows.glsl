@@ -34,15 +34,21 @@ varying vec4 v_lightCoord;
 
 const float TWO_PI = 6.28318530718;
 
+// The taps in an order whose every fourth tap (i = j*4 + k, k = 0..3) makes a disc of its own:
+// the 16 taps' sum does not depend on the order, but amortized sampling (4 of the 16 per frame,
+// the subset j*4 + k at phase k; rrcache.compiler.amortize) then evaluates four well-spread taps
+// each frame rather than four that may cluster. The order was searched to minimise the error of
+// the subsets' blended estimate (λ = 3/5) of step edges across the disc: 3.3x lower than the
+// published order's (README, "Amortized sampling").
 const vec2 POISSON[16] = vec2[16](
-    vec2(-0.94201624, -0.39906216), vec2(0.94558609, -0.76890725),
-    vec2(-0.09418410, -0.92938870), vec2(0.34495938, 0.29387760),
-    vec2(-0.91588581, 0.45771432), vec2(-0.81544232, -0.87912464),
+    vec2(-0.94201624, -0.39906216), vec2(0.53742981, -0.47373420),
+    vec2(-0.81544232, -0.87912464), vec2(-0.91588581, 0.45771432),
+    vec2(0.79197514, 0.19090188), vec2(-0.26496911, -0.41893023),
     vec2(-0.38277543, 0.27676845), vec2(0.97484398, 0.75648379),
-    vec2(0.44323325, -0.97511554), vec2(0.53742981, -0.47373420),
-    vec2(-0.26496911, -0.41893023), vec2(0.79197514, 0.19090188),
+    vec2(0.44323325, -0.97511554), vec2(0.34495938, 0.29387760),
+    vec2(0.94558609, -0.76890725), vec2(0.14383161, -0.14100790),
     vec2(-0.24188840, 0.99706507), vec2(-0.81409955, 0.91437590),
-    vec2(0.19984126, 0.78641367), vec2(0.14383161, -0.14100790));
+    vec2(0.19984126, 0.78641367), vec2(-0.09418410, -0.92938870));
 
 // A random angle per surface point (stable while the camera moves; a hash without sine).
 float rotationAngle(vec3 p) {
