@@ -208,3 +208,20 @@ def test_the_bench_measures_the_papers_amortized_setting(trained):
                         amortized=[row])
     assert "amortized sampling at the paper's setting" in scene_markdown(scene)
     assert scene.to_json()["amortized"][0]["setting"] == row.setting
+
+
+def test_the_profile_command_shows_estimators_and_an_amortized_row(amortized_wins):
+    """The CLI's summary lines and selections table with an amortized selection in them."""
+    from rich.console import Console
+
+    from rrcache.cli.profile import _estimator_lines, _table
+
+    prof, _ = amortized_wins
+    [line] = _estimator_lines(prof)
+    assert line.startswith("estimator e1 (line 18, 8 terms): amortization trained at m = 1, 2, 4")
+    assert "fastest option e1 m=1" in line
+    prof.selections = [prof.select(1.0).replace(label="e4")]
+    console = Console(record=True, width=200)
+    console.print(_table(prof))
+    text = console.export_text()
+    assert "e1 m=" in text and "/8 λ=" in text

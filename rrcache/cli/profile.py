@@ -198,6 +198,8 @@ def _summary(prof, console: Console) -> None:
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
+    for line in _estimator_lines(prof):
+        console.print(line, highlight=False)
     ceiling = prof.measured_ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
@@ -219,6 +221,26 @@ def _summary(prof, console: Console) -> None:
     if noisy:
         console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
                       f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
+
+
+def _estimator_lines(prof) -> list[str]:
+    """One line per estimator (amortized sampling): trained or why not, and its options' best
+    predicted speed-up with the PSNR there."""
+    out = []
+    for est in prof.estimators:
+        if not est.trained:
+            out.append(f"estimator {est.id} (line {est.line}, {est.samples} terms): {est.note or 'not trained'}")
+            continue
+        options = [o for o in prof.amortized_options() if o.parts[0].estimator == est.id]
+        best = max(options, key=lambda o: o.predicted_speedup, default=None)
+        fit = est.error_fit
+        text = (f"estimator {est.id} (line {est.line}, {est.samples} terms): amortization trained at m = "
+                f"{', '.join(str(m) for m in est.timed_samples)} (error fit R² {fit.get('r2', float('nan')):.2f})")
+        if best is not None:
+            text += (f"; fastest option {best.describe()} {best.predicted_speedup:.2f}× at "
+                     f"{_fmt(best.predicted_psnr, '.1f')} dB (predicted)")
+        out.append(text)
+    return out
 
 
 def _level(s) -> str:
