@@ -78,6 +78,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             store.begin_run()
             result = train(work, session, resolved, store, progress)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+            prof.sets = _sets(prof, work, session, resolved, store, progress)
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             _write_outputs(prof, out, work, plots)
             store.end_run("done")
@@ -160,6 +161,14 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
     prof.path = out
     return prof
+
+
+def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+    """The sets of several cached nodes predicted to improve the front, the few picked trained
+    (:mod:`rrcache.profiler.sets`)."""
+    from rrcache.profiler.sets import train_sets
+
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
 
 
 def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
