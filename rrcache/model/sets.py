@@ -10,7 +10,7 @@ choice between a trained set and the single-node choice (pure numpy; the measuri
 - **time**: ``T_S = T_0 + Σ_j (T_j − T_0) + M Σ_{I feeds O} γ_O · min(c_I, c_O)``. Each node adds
   its own single-node difference from the original ``T_0``: what its hits save *and* its own
   passes and overhead (a single node's frame carries the whole cached pipeline, so the sum
-  counts every node's passes; last round's rule ``h_O t_O^hit + (1 − h_O) t_I`` left out the
+  counts every node's passes, and never below the slowest member's all-hit frame; last round's rule ``h_O t_O^hit + (1 − h_O) t_I`` left out the
   second node's two passes and predicted 3.42× for a pair measured at 2.00×). When node I feeds
   node O (inside O's expression, or read by O through a variable), O's single-node saving
   already holds I's computation where O hits, so it is taken back once, for I's nearest outer
@@ -174,7 +174,9 @@ def set_prediction(table, members: list[int], periods: list[int], feeds=None,
         o = _nearest_outer(i, members, feeds)
         if o is not None:
             ms += m * g[members.index(o)] * min(c[i], c[o])
-    return err, float(ms)
+    # never below the slowest member's all-hit frame (the set runs every member's passes)
+    floor = max(table.t_overhead[i] + m * table.t_hit[i] for i in members)
+    return err, float(max(ms, floor))
 
 
 # ---------------------------------------------------------------------- the search
@@ -228,6 +230,7 @@ def _pair_grids(table, a: int, b: int, feeds, layout: str):
         ms = ms + m * ga * min(c[a], c[b])
     elif (a, b) in feeds:
         ms = ms + m * gb * min(c[a], c[b])
+    ms = np.maximum(ms, max(table.t_overhead[a] + m * table.t_hit[a], table.t_overhead[b] + m * table.t_hit[b]))
     return np.broadcast_to(err, ms.shape), ms
 
 

@@ -1,0 +1,114 @@
+"""The set rule of :mod:`rrcache.model.sets` against measured sets, and the fronts' figure.
+
+``python -m rrcache.bench.sets PROFILE SHADER SESSION --pairs 4 --out result.json`` loads a
+trained profile, predicts every pair of its trained nodes at the period pair the rule finds best
+against the single-node front (improving or not) and measures the ``--pairs`` best of them, plus any ``--set
+n1:4,n2:50``, exactly as the profiler's set stage trains a set (:class:`rrcache.profiler.sets._Runner`:
+the error over the training frames in the error window, the time on the timing frames each
+beside the original). It prints and writes predicted against measured error and time, and with
+``--plot`` draws the single-node front, the front with the measured sets and the profile's
+validated selections (:func:`rrcache.report.sets_plot.plot_fronts`).
+
+The measured pairs are not a profile's choices (the profiler trains only those predicted to
+improve the front); they test the rule where it says "no".
+"""
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import time
+from typing import Optional
+
+import numpy as np
+
+
+def _parse_set(text: str) -> tuple[list[str], list[int]]:
+    nodes, periods = [], []
+    for item in text.split(","):
+        node, _, period = item.partition(":")
+        nodes.append(node.strip())
+        periods.append(int(period))
+    return nodes, periods
+
+
+def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=time.perf_counter) -> dict:
+    """Predict and measure (see the module docstring); returns the JSON-able result."""
+    from rrcache.model.sets import SetOption, _pair_grids, _SingleFront, set_prediction
+    from rrcache.pipeline import load_for_session
+    from rrcache.profiler.sets import _Runner, feeds, layout_for
+    from rrcache.profiles import load_profile
+    from rrcache.session import load_session
+
+    prof = load_profile(profile_dir)
+    session = load_session(session_path)
+    work = load_for_session(shader, session, prof.defines, prof.include_dirs)
+    table = prof.table
+    relation = feeds(work.table, table.node_ids)
+    layout = layout_for(work, prof.algorithm, table.node_ids)
+    # each pair of trained nodes at the period pair the rule predicts best against the singles
+    single = _SingleFront(table)
+    candidates = []
+    for a, b in itertools.combinations(range(len(table.node_ids)), 2):
+        err, ms = _pair_grids(table, a, b, relation, layout)
+        gain = np.where(np.isfinite(err) & np.isfinite(ms) & (ms > 0), single.best(err) / np.where(ms > 0, ms, 1), 0)
+        i, j = np.unravel_index(int(np.argmax(gain)), gain.shape)
+        candidates.append(SetOption([table.node_ids[a], table.node_ids[b]], [int(i) + 2, int(j) + 2], layout,
+                                    float(err[i, j]), float(ms[i, j]), None, float(gain[i, j])))
+    chosen = sorted(candidates, key=lambda o: -o.gain)[:pairs]
+    for nodes, periods in extra:
+        rows = [table.node_ids.index(n) for n in nodes]
+        err, ms = set_prediction(table, rows, periods, relation, layout)
+        chosen.append(SetOption(nodes, periods, layout, err, ms, None, 0.0))
+    runner = _Runner(prof, work, session, prof.settings, None)
+    rows_out = []
+    try:
+        for o in chosen:
+            start = clock()
+            runner.train(o)
+            idx = [table.node_ids.index(n) for n in o.nodes]
+            nested = [(o.nodes[a], o.nodes[b]) for a in range(len(idx)) for b in range(len(idx))
+                      if (idx[a], idx[b]) in relation]
+            singles = [(float(table.E[i, p - 1]), float(table.T[i, p - 1])) for i, p in zip(idx, o.periods)]
+            rows_out.append({**o.to_json(), "feeds": nested, "singles_predicted": singles,
+                             "predicted_speedup": prof.original_ms / o.predicted_ms,
+                             "measured_speedup": prof.original_ms / o.trained_ms,
+                             "error_ratio": o.trained_error / o.predicted_error if o.predicted_error else None,
+                             "time_ratio": o.trained_ms / o.predicted_ms, "seconds": clock() - start})
+            print(f"{o.describe():32s} predicted {o.predicted_error:.4f} {prof.original_ms / o.predicted_ms:.2f}×  "
+                  f"measured {o.trained_error:.4f} {prof.original_ms / o.trained_ms:.2f}×  (gain {o.gain:.2f}, "
+                  f"feeds {nested})", flush=True)
+    finally:
+        runner.release()
+    return {"profile": str(profile_dir), "original_ms": prof.original_ms, "layout": layout,
+            "algorithm": prof.algorithm, "sets": rows_out,
+            "selections": [s.to_json() for s in prof.selections]}
+
+
+def plot(results: list[dict], profiles: list, path, titles=None) -> list[str]:
+    """The fronts' figure, each profile with its measured sets (as trained options)."""
+    from rrcache.model.sets import SetOption
+    from rrcache.report.sets_plot import plot_fronts
+
+    for prof, res in zip(profiles, results):
+        prof.sets = list(prof.sets) + [SetOption.from_json(r) for r in res["sets"]]
+    return plot_fronts(profiles, path, titles)
+
+
+def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measurement, run by hand
+    ap = argparse.ArgumentParser(description="the set rule against measured sets")
+    ap.add_argument("profile")
+    ap.add_argument("shader")
+    ap.add_argument("session")
+    ap.add_argument("--pairs", type=int, default=4)
+    ap.add_argument("--set", dest="sets", action="append", default=[], help="n1:4,n2:50")
+    ap.add_argument("--out", default=None)
+    a = ap.parse_args(argv)
+    result = measure(a.profile, a.shader, a.session, a.pairs, [_parse_set(s) for s in a.sets])
+    if a.out:
+        with open(a.out, "w") as f:
+            json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
