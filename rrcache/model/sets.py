@@ -10,8 +10,9 @@ choice between a trained set and the single-node choice (pure numpy; the measuri
 - **time**: ``T_S = T_0 + Σ_j (T_j − T_0) + M Σ_{I feeds O} γ_O · min(c_I, c_O)``. Each node adds
   its own single-node difference from the original ``T_0``: what its hits save *and* its own
   passes and overhead (a single node's frame carries the whole cached pipeline, so the sum
-  counts every node's passes, and never below the slowest member's all-hit frame; last round's rule ``h_O t_O^hit + (1 − h_O) t_I`` left out the
-  second node's two passes and predicted 3.42× for a pair measured at 2.00×). When node I feeds
+  counts every node's passes; never below the pipeline's fixed cost t_o). Last round's rule
+  ``h_O t_O^hit + (1 − h_O) t_I`` left out the second node's two passes and predicted 3.42× for
+  a pair measured at 2.00×. When node I feeds
   node O (inside O's expression, or read by O through a variable), O's single-node saving
   already holds I's computation where O hits, so it is taken back once, for I's nearest outer
   node in the set. With the **union layout** (two-pass, one-pass, or three-pass for a shader
@@ -53,9 +54,13 @@ import numpy as np
 
 from rrcache.selection import CachedNode, Selection
 
-#: a set is worth training when predicted at least this much faster (as a share of the time)
-#: than the single-node choice of no larger error
+#: a set *improves* the front when predicted at least this much faster (as a share of the time)
+#: than every single option of no larger error
 MIN_SET_GAIN = 0.03
+#: the profiler trains a set predicted within this share of the front (``pick``'s and the
+#: stage's margin): the time rule measured from 12% optimistic to 2.3× pessimistic over the
+#: nine pairs of docs/multinode.md, so a set just behind the predicted front may well be on it
+TRAIN_MARGIN = 0.25
 #: the distinct nodes of the single-node front a search pairs, fastest first
 MAX_FRONT_NODES = 8
 #: a node whose best option is within this share of the single-node front's time is paired too
@@ -174,9 +179,8 @@ def set_prediction(table, members: list[int], periods: list[int], feeds=None,
         o = _nearest_outer(i, members, feeds)
         if o is not None:
             ms += m * g[members.index(o)] * min(c[i], c[o])
-    # never below the slowest member's all-hit frame (the set runs every member's passes)
-    floor = max(table.t_overhead[i] + m * table.t_hit[i] for i in members)
-    return err, float(max(ms, floor))
+    # never below the cached pipeline's fixed cost
+    return err, float(max(ms, max(table.t_overhead[i] for i in members)))
 
 
 # ---------------------------------------------------------------------- the search
@@ -230,7 +234,7 @@ def _pair_grids(table, a: int, b: int, feeds, layout: str):
         ms = ms + m * ga * min(c[a], c[b])
     elif (a, b) in feeds:
         ms = ms + m * gb * min(c[a], c[b])
-    ms = np.maximum(ms, max(table.t_overhead[a] + m * table.t_hit[a], table.t_overhead[b] + m * table.t_hit[b]))
+    ms = np.maximum(ms, max(table.t_overhead[a], table.t_overhead[b]))
     return np.broadcast_to(err, ms.shape), ms
 
 

@@ -3,9 +3,9 @@ the few that can improve the front trained, within the profile's budget.
 
 After the single nodes are trained and fitted (:mod:`rrcache.profiler.train`), :func:`train_sets`
 
-1. predicts every set built from the nodes of the single-node Pareto front
-   (:func:`rrcache.model.sets.search`: pairs, and triples only from the pairs that improve the
-   front) with the combination rule of :mod:`rrcache.model.sets`, given which node feeds which
+1. predicts every set built from the nodes on or near the single-node Pareto front
+   (:func:`rrcache.model.sets.search`: pairs, and triples only from the pairs that come within
+   :data:`~rrcache.model.sets.TRAIN_MARGIN` of the front: the rule's measured error) with the combination rule of :mod:`rrcache.model.sets`, given which node feeds which
    (:func:`feeds`: inside its expression, or read through a variable) and the layout the
    profile's algorithm compiles to on this shader (:func:`layout_for`);
 2. picks at most ``max_sets`` of them (:func:`rrcache.model.sets.pick`: per level the fastest
@@ -34,7 +34,7 @@ from typing import Optional
 import numpy as np
 
 from rrcache.errors import RRCacheError
-from rrcache.model.sets import DEFAULT_MAX_SETS, SetOption, pick, search
+from rrcache.model.sets import DEFAULT_MAX_SETS, TRAIN_MARGIN, SetOption, pick, search
 from rrcache.profiler.train import PSNR_CAP, ProgressEvent
 
 #: the share of the training budget the set stage may spend even when the nodes spent it all
@@ -117,15 +117,16 @@ def _levels(prof) -> list[tuple]:
 
 
 def plan_sets(prof, work, max_sets: int = DEFAULT_MAX_SETS) -> tuple[list[SetOption], list[SetOption]]:
-    """(every set predicted to improve the front, the ones picked to train), from the
-    profile's models alone."""
+    """(every set predicted to improve the front or within :data:`~rrcache.model.sets.TRAIN_MARGIN`
+    of it, the ones picked to train), from the profile's models alone."""
     table = prof.table
     ids = table.node_ids
     layout = layout_for(work, prof.algorithm, ids)
     relation = feeds(work.table, ids)
     max_nodes = 3
-    options = search(table, prof.psnr_fits(), relation, layout, max_nodes=max_nodes)
-    return options, pick(options, _levels(prof), max_sets)
+    # within the rule's measured error of the front: a set that may be on it is worth measuring
+    options = search(table, prof.psnr_fits(), relation, layout, max_nodes=max_nodes, min_gain=-TRAIN_MARGIN)
+    return options, pick(options, _levels(prof), max_sets, min_gain=-TRAIN_MARGIN)
 
 
 def train_sets(prof, work, session, settings, store, progress=None, max_sets: int = DEFAULT_MAX_SETS,
