@@ -85,6 +85,50 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
             "selections": [s.to_json() for s in prof.selections]}
 
 
+def levels(profile_dir, shader, session_path, validation_frames: int = 8, extra_sets=()) -> dict:
+    """Per level of the profile: the single-node choice and the choice with the profile's trained
+    sets (and ``extra_sets``, trained :class:`SetOption` JSON, e.g. :func:`measure`'s), each
+    validated as the profiler validates (:func:`rrcache.profiler.validate.validate`: beside the
+    original, three timing repeats, the fallback of today) over ``validation_frames`` frames.
+    A choice both sides share is measured once."""
+    import dataclasses
+
+    import rrcache
+    from rrcache.model.sets import SetOption
+    from rrcache.pipeline import load_for_session
+    from rrcache.profiler.validate import validate
+    from rrcache.profiles import load_profile
+    from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
+    from rrcache.session import load_session
+
+    prof = load_profile(profile_dir)
+    session = load_session(session_path)
+    work = load_for_session(shader, session, prof.defines, prof.include_dirs)
+    sets = list(prof.sets) + [SetOption.from_json(d) for d in extra_sets]
+    prof.sets = []
+    single = prof.threshold_selections()
+    prof.sets = sets
+    with_sets = prof.threshold_selections()
+    settings = prof.settings
+    key = StoreKey(prof.shader_hash, prof.session_hash, settings.key_hash(), rrcache.__version__, settings.key_json())
+    from rrcache.profiler.plan import Plan
+
+    window = Plan.from_json(prof.plan).timing_window if prof.plan else None
+    quick = dataclasses.replace(settings, validation_frames=validation_frames)
+    with ProfileStore.open(prof.path / STORE_NAME, key) as store:
+        measured_single = validate(work, session, quick, store, single, window=window,
+                                   candidates=prof.front_candidates)
+        measured_sets = validate(work, session, quick, store, with_sets, window=window,
+                                 candidates=prof.front_candidates)
+    rows = []
+    for a, b in zip(measured_single, measured_sets):
+        rows.append({"label": a.label, "min_psnr": a.min_psnr, "single": a.to_json(), "with_sets": b.to_json(),
+                     "changed": a.key != b.key})
+    prof.selections = measured_sets
+    return {"profile": str(profile_dir), "validation_frames": validation_frames, "levels": rows,
+            "sets": [o.to_json() for o in sets], "original_ms": prof.original_ms}
+
+
 def plot(results: list[dict], profiles: list, path, titles=None) -> list[str]:
     """The fronts' figure, each profile with its measured sets (as trained options)."""
     from rrcache.model.sets import SetOption
@@ -103,7 +147,25 @@ def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measureme
     ap.add_argument("--pairs", type=int, default=4)
     ap.add_argument("--set", dest="sets", action="append", default=[], help="n1:4,n2:50")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--levels", action="store_true",
+                    help="validate each level's single-node choice and its choice with the trained sets instead")
+    ap.add_argument("--validation-frames", type=int, default=8)
+    ap.add_argument("--extra", default=None, help="a --out JSON of this command: its measured sets join the levels")
     a = ap.parse_args(argv)
+    if a.levels:
+        extra = json.load(open(a.extra))["sets"] if a.extra else []
+        result = levels(a.profile, a.shader, a.session, a.validation_frames, extra)
+        for row in result["levels"]:
+            for side in ("single", "with_sets"):
+                s = row[side]
+                what = " + ".join(f"{p['node']} Δn={p['period']}" for p in s["parts"]) or "original"
+                print(f"{row['label']} {side:9s} {what:34s} error {s['measured_error'] or 0:.4f} "
+                      f"PSNR {s['measured_psnr'] or float('inf'):.1f} speed-up {s['measured_speedup'] or 1:.2f}× "
+                      f"{s['speedups']}", flush=True)
+        if a.out:
+            with open(a.out, "w") as f:
+                json.dump(result, f, indent=1)
+        return
     result = measure(a.profile, a.shader, a.session, a.pairs, [_parse_set(s) for s in a.sets])
     if a.out:
         with open(a.out, "w") as f:

@@ -273,9 +273,13 @@ def _table(prof) -> Table:
         else:
             table.add_column(name, justify="right")
     for s in prof.selections:
-        node = "(original)" if s.node is None else f"{s.node}: {s.text}"
+        if s.multi:  # several nodes, each at its own period
+            node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
+        else:
+            node = "(original)" if s.node is None else f"{s.node}: {s.text}"
+            period = _fmt(s.period, "d")
         if s.fallback:
             node = "↩ " + node
-        table.add_row(f"{s.label} {_level(s)}", node, _fmt(s.period, "d"), _predicted_speedup(s), _speedup(s),
+        table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),
                       _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
     return table

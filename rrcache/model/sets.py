@@ -64,7 +64,8 @@ TRAIN_MARGIN = 0.25
 #: the distinct nodes of the single-node front a search pairs, fastest first
 MAX_FRONT_NODES = 8
 #: a node whose best option is within this share of the single-node front's time is paired too
-NEAR_FRONT = 0.10
+#: (as :data:`TRAIN_MARGIN`: the single-node models' own error reaches the sets)
+NEAR_FRONT = 0.25
 #: the sets a search keeps (spread over the front with the sets, plus each node set's best)
 MAX_OPTIONS = 48
 #: the improving pairs a third node is tried with
