@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -190,6 +192,14 @@ def test_a_pair_is_trained_kept_and_validated(tiny, gl_ctx, monkeypatch):
     if chosen.multi:
         assert chosen.periods == (8, 4) and chosen.predicted_ms == option.trained_ms
 
+    # rrcache select returns it the same way
+    proc = subprocess.run([sys.executable, "-m", "rrcache", "select", str(folder / "doc"), "--max-error", repr(level),
+                           "--json"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    answer = json.loads(proc.stdout)
+    assert (answer.get("nodes") == [albedo, wave.id]) == faster
+    assert answer["period"] == ([8, 4] if faster else alone.period)
+
     # validation as today: measured beside the original, never a measured slowdown standing
     sel = option.selection(float(prof.original_ms), label="e3", max_error=level, algorithm=prof.algorithm)
     with ProfileStore.open(store_path, key) as store:
@@ -203,6 +213,20 @@ def test_a_pair_is_trained_kept_and_validated(tiny, gl_ctx, monkeypatch):
         assert "slower than the original in every repeat" in stood.fallback and albedo in stood.fallback
     with read_store(store_path) as store:
         assert any(v.multi for v in store.validations())
+    if stood.multi:
+        # a set stands only where it measured at least the single choice it displaced
+        from rrcache.profiler.sets import keep_faster
+
+        back.path = folder / "out"
+        with ProfileStore.open(store_path, key) as store:
+            kept = keep_faster(back, work, session, dataclasses.replace(settings, validation_frames=6), store,
+                               [stood])[0]
+            single = next(v for v in store.validations() if v.label == "e3~single")
+        assert single.measured and not single.multi
+        if stood.measured_speedup >= single.measured_speedup:
+            assert kept.multi and kept.key == stood.key
+        else:
+            assert kept.key == single.key and "below the single-node choice" in kept.fallback
 
 
 def test_the_tradeoff_plot_shows_sets(tiny, tmp_path):

@@ -96,6 +96,7 @@ def levels(profile_dir, shader, session_path, validation_frames: int = 8, extra_
     import rrcache
     from rrcache.model.sets import SetOption
     from rrcache.pipeline import load_for_session
+    from rrcache.profiler.sets import keep_faster
     from rrcache.profiler.validate import validate
     from rrcache.profiles import load_profile
     from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
@@ -120,6 +121,8 @@ def levels(profile_dir, shader, session_path, validation_frames: int = 8, extra_
                                    candidates=prof.front_candidates)
         measured_sets = validate(work, session, quick, store, with_sets, window=window,
                                  candidates=prof.front_candidates)
+        # as the profiler: a set stands only where it beats the single choice it displaced
+        measured_sets = keep_faster(prof, work, session, quick, store, measured_sets, window=window)
     rows = []
     for a, b in zip(measured_single, measured_sets):
         rows.append({"label": a.label, "min_psnr": a.min_psnr, "single": a.to_json(), "with_sets": b.to_json(),
@@ -129,13 +132,27 @@ def levels(profile_dir, shader, session_path, validation_frames: int = 8, extra_
             "sets": [o.to_json() for o in sets], "original_ms": prof.original_ms}
 
 
-def plot(results: list[dict], profiles: list, path, titles=None) -> list[str]:
-    """The fronts' figure, each profile with its measured sets (as trained options)."""
+def plot(profile_dirs: list, measured: list, levels_json: list, path, titles=None) -> list[str]:
+    """The fronts' figure (:func:`rrcache.report.sets_plot.plot_fronts`): per profile its trained
+    sets, the sets :func:`measure` measured (``measured``: its JSON files) and the selections that
+    stood in :func:`levels` (``levels_json``: its JSON files; the single-node ones and those with
+    the sets)."""
     from rrcache.model.sets import SetOption
+    from rrcache.profiles import load_profile
+    from rrcache.profiles.document import _read_dataclass
     from rrcache.report.sets_plot import plot_fronts
+    from rrcache.selection import Selection
 
-    for prof, res in zip(profiles, results):
-        prof.sets = list(prof.sets) + [SetOption.from_json(r) for r in res["sets"]]
+    profiles = []
+    for folder, bench, lev in zip(profile_dirs, measured, levels_json):
+        prof = load_profile(folder)
+        known = {o.key for o in prof.sets}
+        extra = [SetOption.from_json(r) for r in json.load(open(bench))["sets"]] if bench else []
+        prof.sets = list(prof.sets) + [o for o in extra if o.key not in known]
+        rows = json.load(open(lev))["levels"] if lev else []
+        prof.selections = [_read_dataclass(Selection, r[side], "", lev) for r in rows for side in ("single", "with_sets")
+                           if side == "single" or r["changed"]]
+        profiles.append(prof)
     return plot_fronts(profiles, path, titles)
 
 
@@ -151,7 +168,15 @@ def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measureme
                     help="validate each level's single-node choice and its choice with the trained sets instead")
     ap.add_argument("--validation-frames", type=int, default=8)
     ap.add_argument("--extra", default=None, help="a --out JSON of this command: its measured sets join the levels")
+    ap.add_argument("--plot", default=None, help="draw the fronts' figure here from --figure-inputs")
+    ap.add_argument("--figure-inputs", nargs="*", default=[],
+                    help="PROFILE:MEASURED_JSON:LEVELS_JSON per panel (the positional arguments are ignored)")
     a = ap.parse_args(argv)
+    if a.plot:
+        triples = [item.split(":") for item in a.figure_inputs]
+        print(plot([t[0] for t in triples], [t[1] or None for t in triples], [t[2] or None for t in triples],
+                   a.plot))
+        return
     if a.levels:
         extra = json.load(open(a.extra))["sets"] if a.extra else []
         result = levels(a.profile, a.shader, a.session, a.validation_frames, extra)

@@ -184,6 +184,11 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
     measured = validate(work, session, settings, store, choices, progress,
                         window=result.plan.timing_window if result.plan is not None else None,
                         candidates=prof.front_candidates)
+    if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
+        from rrcache.profiler.sets import keep_faster
+
+        measured = keep_faster(prof, work, session, settings, store, measured, progress,
+                               result.plan.timing_window if result.plan is not None else None)
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured
