@@ -12,26 +12,28 @@ choice between a trained set and the single-node choice (pure numpy; the measuri
   passes and overhead (a single node's frame carries the whole cached pipeline, so the sum
   counts every node's passes; never below the pipeline's fixed cost t_o). Last round's rule
   ``h_O t_O^hit + (1 − h_O) t_I`` left out the second node's two passes and predicted 3.42× for
-  a pair measured at 2.00×. When node I feeds
-  node O (inside O's expression, or read by O through a variable), O's single-node saving
+  a pair measured at 2.00×. When node I feeds node O (inside O's expression, or read by O
+  through a variable), O's single-node saving
   already holds I's computation where O hits, so it is taken back once, for I's nearest outer
   node in the set. With the **union layout** (two-pass, one-pass, or three-pass for a shader
   that discards or a node that needs derivatives) llvmpipe's lock-step branches compute every
   node wherever any node misses: every γ_j in the sums is replaced by
   ``γ_U = Π_j γ_j``, the share of pixels where every node hits (independent refresh phases).
 - **error**: ``ε_S = Σ_j ε̂_j(Δn_j)``: each node's staleness reaches the colour at most as it does
-  alone (an upper bound, tight when the errors sit on different pixels; measured 80% of it on
-  Marble's nested pair, docs/multinode.md).
+  alone (a bound when the single models are right; measured 0.73–1.21 of it over twelve Marble
+  and Trashcan sets, above it where the single-node models under-predict short periods,
+  docs/multinode.md).
 - **PSNR**: the PSNR model of the node with the largest error share, at ``ε_S``.
 
 **The search** (:func:`search`): the nodes on or near the single-node Pareto front (within
-:data:`NEAR_FRONT` of its time at their error; at most :data:`MAX_FRONT_NODES`); every pair of them at every period pair Δn ∈ 2..P; a pair *improves*
-the front where it is predicted at least :data:`MIN_SET_GAIN` faster than every single option
-(and the original) of no larger error. Triples only where it pays: the improving pairs (the
-:data:`MAX_EXTEND` best) extended by a third front node at each period, kept where they improve
-on singles and pairs alike. :func:`pick` chooses the few to train: per level the fastest
-admissible set, when predicted faster than the level's single-node choice, then the best
-remaining by gain.
+:data:`NEAR_FRONT` of its time at their error; at most :data:`MAX_FRONT_NODES`); every pair of
+them at every period pair Δn ∈ 2..P; a pair *improves* the front where it is predicted at least
+``min_gain`` (:data:`MIN_SET_GAIN`; the profiler passes ``−TRAIN_MARGIN``) faster than every
+single option (and the original) of no larger error. Triples only where it pays: the improving
+pairs (the :data:`MAX_EXTEND` best) extended by a third such node at each period, kept where they
+improve on singles and pairs alike. :func:`pick` chooses the few to train: per level the fastest
+admissible set, when predicted faster than the level's single-node choice (by ``min_gain``),
+then the best remaining by gain.
 
 >>> import numpy as np
 >>> from rrcache.model import ModelTable
@@ -59,7 +61,8 @@ from rrcache.selection import CachedNode, Selection
 MIN_SET_GAIN = 0.03
 #: the profiler trains a set predicted within this share of the front (``pick``'s and the
 #: stage's margin): the time rule measured from 12% optimistic to 2.3× pessimistic over the
-#: nine pairs of docs/multinode.md, so a set just behind the predicted front may well be on it
+#: twelve Marble and Trashcan sets of docs/multinode.md, so a set just behind the predicted
+#: front may well be on it
 TRAIN_MARGIN = 0.25
 #: the distinct nodes of the single-node front a search pairs, fastest first
 MAX_FRONT_NODES = 8
