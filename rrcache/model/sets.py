@@ -29,7 +29,7 @@ choice between a trained set and the single-node choice (pure numpy; the measuri
 :data:`NEAR_FRONT` of its time at their error; at most :data:`MAX_FRONT_NODES`); every pair of
 them at every period pair Δn ∈ 2..P; a pair *improves* the front where it is predicted at least
 ``min_gain`` (:data:`MIN_SET_GAIN`; the profiler passes ``−TRAIN_MARGIN``) faster than every
-single option (and the original) of no larger error. Triples only where it pays: the improving
+single option (and the original) of no larger error, and faster than the original. Triples only where it pays: the improving
 pairs (the :data:`MAX_EXTEND` best) extended by a third such node at each period, kept where they
 improve on singles and pairs alike. :func:`pick` chooses the few to train: per level the fastest
 admissible set, when predicted faster than the level's single-node choice (by ``min_gain``),
@@ -256,7 +256,8 @@ def search(table, psnr_fits=None, feeds=None, layout: str = "per-node", max_node
         err, ms = _pair_grids(table, a, b, feeds, layout)
         ok = np.isfinite(err) & np.isfinite(ms)
         gain = np.where(ok, single.best(err) / np.where(ms > 0, ms, np.inf), 0.0)
-        good = gain >= 1.0 / (1.0 - min_gain)
+        # only what could be chosen: predicted faster than the original
+        good = (gain >= 1.0 / (1.0 - min_gain)) & (ms < table.original_ms)
         for i, j in zip(*np.nonzero(good)):
             found.append((float(gain[i, j]), (a, b), (int(periods[i]), int(periods[j])),
                           float(err[i, j]), float(ms[i, j])))
@@ -271,7 +272,7 @@ def search(table, psnr_fits=None, feeds=None, layout: str = "per-node", max_node
                     if not (math.isfinite(e3) and math.isfinite(t3) and t3 > 0):
                         continue
                     best = min(float(single.best([e3])[0]), pair_front.best(e3))
-                    if best / t3 >= 1.0 / (1.0 - min_gain):
+                    if best / t3 >= 1.0 / (1.0 - min_gain) and t3 < table.original_ms:
                         found.append((float(single.best([e3])[0]) / t3, tuple(members) + (c,),
                                       tuple(pers) + (int(p),), e3, t3))
     # the set points on the front of all sets (and the singles), one entry per point
