@@ -222,3 +222,4 @@ def test_a_pair_draws_into_the_timing_colour_format(gl_ctx, capsys, color_format
     summary = json.loads(capsys.readouterr().out)
     assert summary["color_format"] == color_format
     assert summary["mean_error"] == 0.0 and summary["hit_rate"] == 0.0
+    assert summary["exact"] is True and summary["psnr"] is None  # never "100 dB"
