@@ -146,9 +146,11 @@ def plot(profile_dirs: list, measured: list, levels_json: list, path, titles=Non
     profiles = []
     for folder, bench, lev in zip(profile_dirs, measured, levels_json):
         prof = load_profile(folder)
-        known = {o.key for o in prof.sets}
+        known = {o.key for o in prof.sets if o.trained}
         extra = [SetOption.from_json(r) for r in json.load(open(bench))["sets"]] if bench else []
-        prof.sets = list(prof.sets) + [o for o in extra if o.key not in known]
+        extra = [o for o in extra if o.key not in known]
+        taken = {o.key for o in extra}  # a measured set replaces its untrained prediction
+        prof.sets = [o for o in prof.sets if o.key not in taken] + extra
         rows = json.load(open(lev))["levels"] if lev else []
         prof.selections = [_read_dataclass(Selection, r[side], "", lev) for r in rows for side in ("single", "with_sets")
                            if side == "single" or r["changed"]]

@@ -20,7 +20,7 @@ choice between a trained set and the single-node choice (pure numpy; the measuri
   node wherever any node misses: every γ_j in the sums is replaced by
   ``γ_U = Π_j γ_j``, the share of pixels where every node hits (independent refresh phases).
 - **error**: ``ε_S = Σ_j ε̂_j(Δn_j)``: each node's staleness reaches the colour at most as it does
-  alone (a bound when the single models are right; measured 0.73–1.21 of it over twelve Marble
+  alone (a bound when the single models are right; measured 0.81–1.21 of it over eleven Marble
   and Trashcan sets, above it where the single-node models under-predict short periods,
   docs/multinode.md).
 - **PSNR**: the PSNR model of the node with the largest error share, at ``ε_S``.
@@ -60,8 +60,8 @@ from rrcache.selection import CachedNode, Selection
 #: than every single option of no larger error
 MIN_SET_GAIN = 0.03
 #: the profiler trains a set predicted within this share of the front (``pick``'s and the
-#: stage's margin): the time rule measured from 12% optimistic to 2.3× pessimistic over the
-#: twelve Marble and Trashcan sets of docs/multinode.md, so a set just behind the predicted
+#: stage's margin): the time rule measured from 4% optimistic to 2.2× pessimistic over the
+#: eleven Marble and Trashcan sets of docs/multinode.md, so a set just behind the predicted
 #: front may well be on it
 TRAIN_MARGIN = 0.25
 #: the distinct nodes of the single-node front a search pairs, fastest first

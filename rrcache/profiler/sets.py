@@ -285,9 +285,9 @@ def keep_faster(prof, work, session, settings, store, measured: list, progress=N
     ``<label>~single``), and the set stands only when its measured speed-up (the repeats'
     median) is at least the single choice's; otherwise the single choice stands, its
     ``fallback`` saying what the set measured. A set is chosen on its training measurement
-    against the single node's model, and on Marble one that training put at 2.23× measured
-    1.87× beside a single choice measured at 2.34×: a set must beat what it displaced where it
-    counts, in the validation."""
+    (one sample per timing frame) against the single node's model, and on Marble one that
+    training put at 2.23× measured 1.70–1.94× beside a single choice measured at 2.34–2.92×:
+    a set must beat what it displaced where it counts, in the validation."""
     if not any(s.multi for s in measured):
         return measured
     from rrcache.profiler.validate import validate
