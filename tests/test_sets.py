@@ -77,6 +77,22 @@ def test_search_finds_the_pairs_that_improve_the_front():
     assert not any(set(o.nodes) == {"a", "b"} for o in search(t, feeds={(1, 0)}))
 
 
+def test_triples_only_where_they_pay():
+    # three disjoint nodes, each saving a third of the pixel's cost: a triple beats every pair
+    t = ModelTable(["a", "b", "c"], alpha=[0.01] * 3, lam=[0.3] * 3, t_hit=[0.7] * 3, t_miss=[1.02] * 3,
+                   t_overhead=[0.0] * 3, mu=0.9, pixels=1.0, original_ms=1.0)
+    found = search(t, max_nodes=3)
+    triples = [o for o in found if len(o.nodes) == 3]
+    assert triples and {tuple(sorted(o.nodes)) for o in triples} == {("a", "b", "c")}
+    for o in triples:
+        e, ms = set_prediction(t, [0, 1, 2], [o.periods[o.nodes.index(n)] for n in "abc"])
+        assert (o.predicted_error, o.predicted_ms) == pytest.approx((e, ms))
+    assert not [o for o in search(t, max_nodes=2) if len(o.nodes) == 3]
+    # nested in a chain (a inside b inside c): each inner's saving is already in its outer's, and
+    # no pair or triple pays
+    assert search(t, feeds={(0, 1), (1, 2), (0, 2)}) == []
+
+
 def test_better_and_pick():
     opt = SetOption(["a", "b"], [10, 20], predicted_error=0.02, predicted_ms=0.3, predicted_psnr=38.0, gain=2.0)
     from rrcache.selection import Selection, CachedNode
