@@ -180,3 +180,17 @@ def test_constant_rejects_bad_values():
     with pytest.raises(RRCacheError, match="values for a vec3"):
         simplify.constant("vec3", (1.0, 2.0))
     assert simplify.constant("float", (float("nan"),)).args[0].value == 0.0
+
+
+def test_means_of_nodes_one_pass_cannot_cache():
+    """A value after an implicit-LOD lookup is not valid for one-pass; its mean comes from a
+    multi-pass variant instead of an error (the temple's PCF shader stopped the bench here)."""
+    session = load_session("tests/corpus/implicit_lod.json")
+    work = load_for_session("tests/corpus/implicit_lod.glsl", session)
+    nodes = [n for n in work.table.nodes if "one-pass" not in n.algorithms][:2]
+    assert nodes, "the corpus shader lists values after implicit-LOD lookups"
+    means = simplify.node_means(work, session, [n.id for n in nodes], [0, 1], (32, 32))
+    for node in nodes:
+        values = means[node.id]
+        assert len(values) >= 1 and all(math.isfinite(v) for v in values)
+        assert any(v != 0.0 for v in values), (node.id, values)

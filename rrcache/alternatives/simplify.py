@@ -11,8 +11,8 @@ expressions of the shader by their mean value over the session.
   ``main``: every expression that contributes to the outputs, each counted once (after
   unrolling, a loop left in the code counts one iteration).
 - :func:`node_means`: the mean of a node over the covered pixels of sample frames: the node's
-  one-pass cache variant refreshed every frame (Δn = 1) computes it at every covered pixel, and
-  the payload is read back.
+  one-pass cache variant (another algorithm where the node is not valid for one-pass) refreshed
+  every frame (Δn = 1) computes it at every covered pixel, and the payload is read back.
 - :func:`rank_candidates`: per candidate node, the error of replacing it alone (mean RGB L2
   against the original over the sample frames) and the static cost it saves; ranked by error
   per saved cost, smallest first (Pellacini's greedy criterion).
@@ -146,8 +146,12 @@ def node_means(work, session, node_ids: Sequence[str], frames: Sequence[int], re
     from rrcache.pipeline import variant_for
 
     means = {}
+    entries = {n.id: n for n in work.table.nodes}
     for node_id in node_ids:
-        variant = variant_for(work, node_id, "one-pass")
+        # one-pass computes the node at every covered pixel in one pass; a value after an
+        # implicit-LOD lookup or a derivative is valid only in the multi-pass algorithms
+        valid = getattr(entries.get(node_id), "algorithms", None) or ("one-pass",)
+        variant = variant_for(work, node_id, "one-pass" if "one-pass" in valid else valid[0])
         total = np.zeros(4)
         count = 0
         with CachedRenderer(variant, session, work.prepared, resolution, period=1, keep_payload=True) as r:
