@@ -52,3 +52,8 @@ def test_classes():
     assert classify(()) == "original" and classify((), exact_original=False) == "not measured"
     assert classify((1.0, 1.2)) == "faster" and classify((0.99, 1.01, 0.98)) == "within noise"
     assert classify((0.5,)) == "slowdown"
+
+
+def test_the_original_is_its_own_class(runs):
+    for r in rows(runs):
+        assert (r["cls"] == "original") == (r["kind"] == "original")

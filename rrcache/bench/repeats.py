@@ -66,7 +66,7 @@ def rows(folders: Iterable) -> list[dict]:
                 speedup_range=(min(speedups), max(speedups)) if speedups else None,
                 psnr=None if sel.exact else sel.measured_psnr, exact=sel.exact,
                 predicted_psnr=sel.predicted_psnr, fallback=sel.fallback,
-                cls=classify(speedups, exact_original=not sel.parts),
+                cls="original" if not sel.parts else classify(speedups, exact_original=False),
                 ceiling=(profile.ceiling or {}).get("speedup")))
     return out
 
