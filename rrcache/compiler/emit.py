@@ -127,7 +127,7 @@ def vertex_shader(inputs: dict[str, str], prev_clip: bool,
     """The vertex shader writing ``inputs`` (and ``rr_prevClip``), with an invariant
     ``gl_Position``: generated, or the user's own (``user``, a
     :class:`rrcache.harness.user_vertex.UserVertex`) with the cache's additions."""
-    return vertex_for(inputs, locs, user, prev_clip=prev_clip)
+    return vertex_for(inputs, locs, user, prev_clip=prev_clip, invariant=True)
 
 
 def vertex_uniforms(vertex_text: str) -> list[str]:

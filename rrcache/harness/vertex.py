@@ -127,11 +127,12 @@ def _convert(expr: str, size: int, pad: str, declared: int) -> str:
 
 
 def vertex_for(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None,
-               user=None, prev_clip: bool = False) -> str:
+               user=None, prev_clip: bool = False, invariant: Optional[bool] = None) -> str:
     """The vertex shader of a program whose fragment shader reads ``inputs``: the user's own
     (a :class:`rrcache.harness.user_vertex.UserVertex`, checked against ``inputs``) when given,
     else the generated one; ``prev_clip`` adds ``rr_prevClip`` and ``invariant gl_Position`` (the
-    cached variants' passes).
+    cached variants' passes); ``invariant`` adds ``invariant gl_Position`` whatever ``prev_clip``
+    (every pass of a variant needs it: the depth tests between passes compare exact depths).
 
     >>> "out vec2 v_texcoord;" in vertex_for({"v_texcoord": "vec2"})
     True
@@ -143,7 +144,7 @@ def vertex_for(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[S
     if prev_clip:
         wanted["rr_prevClip"] = "vec4"
     text = vertex_source(wanted, locs)
-    if not prev_clip:
+    if not (prev_clip if invariant is None else invariant):
         return text
     first, _, rest = text.partition("\n")
     return f"{first}\ninvariant gl_Position;\n{rest}"
