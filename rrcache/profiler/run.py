@@ -27,6 +27,7 @@ from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
+from rrcache.model.psnr import frame_spread
 from rrcache.profiler.train import ProgressFn, TrainingResult, train
 from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
@@ -132,6 +133,9 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         node.errors = [r.mean_error for r in runs]
         node.hit_rates = [r.hit_rate for r in runs]
         node.psnrs = [r.psnr for r in runs]
+        # how much each run's mean error depends on the frames it covered (the PSNR's ±)
+        node.frame_spreads = [frame_spread([f.mean_error for f in store.error_frames(nid, r.period) if not f.left_out])
+                              for r in runs]
         if node.trained:
             ef, pf = result.error_fits[nid], result.perf_fits[nid]
             node.alpha, node.lam = float(ef.alpha), float(ef.lam)
