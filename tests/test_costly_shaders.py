@@ -5,8 +5,9 @@ ambient occlusion material (``shaders/sdf_material.glsl`` with ``sessions/sdf.js
 Each session loads (a moving camera and light, 320×240, at most 150 frames); the shader compiles
 with the driver and a tiny render (64×64, two frames) is finite, not constant and covers pixels;
 the node table lists the costly value the cache is meant for (the fill lights' diffuse sum, the
-occlusion and the soft shadow), and caching it at Δn = 1 (refresh every pixel every frame)
-reproduces the original in each algorithm the table allows.
+soft shadow: above the profiler's ``min_saving``; the occlusion: listed, below it), and caching
+it at Δn = 1 (refresh every pixel every frame) reproduces the original in each algorithm the
+table allows.
 """
 from __future__ import annotations
 
@@ -29,13 +30,16 @@ SIZE = (64, 64)
 FRAMES = 2
 TOLERANCE = 1e-4
 
-# shader, session, and (function the node is inlined from, its expression) of the nodes to check
+# shader, session, and (function the node is inlined from, its expression, whether it is worth
+# training: above the profiler's default min_saving) of the nodes to check. The occlusion (six
+# taps) is not: with every pixel hitting, caching it measured 0.93x; the soft shadow (an
+# 80-step march with an early break, costed by its trip bound) measured 2.33x
 SHADERS = {
     "many_lights": ("shaders/many_lights.glsl", "sessions/lights.json",
-                    [("fillDiffuse", "FILL_INTENSITY * sum")]),
+                    [("fillDiffuse", "FILL_INTENSITY * sum", True)]),
     "sdf_material": ("shaders/sdf_material.glsl", "sessions/sdf.json",
-                     [("ambientOcclusion", "clamp(1.0 - u_aoStrength * occlusion, 0.0, 1.0)"),
-                      ("softShadow", "result * result * (3.0 - 2.0 * result)")]),
+                     [("ambientOcclusion", "clamp(1.0 - u_aoStrength * occlusion, 0.0, 1.0)", False),
+                      ("softShadow", "result * result * (3.0 - 2.0 * result)", True)]),
 }
 
 
@@ -76,10 +80,10 @@ def test_the_costly_value_is_listed_and_exact_at_period_one(gl_ctx, loaded):
     with Renderer(work.prepared, session, SIZE) as original:
         reference = [original.render_frame(i) for i in range(FRAMES)]
     top = max(n.cost for n in work.table.nodes)
-    for function, text in wanted:
+    for function, text, worth in wanted:
         node = find_node(work.table, function, text)
         # worth training: above the profiler's default min_saving (10% of the costliest node)
-        assert node.cost >= 0.1 * top, (name, node.id, node.cost, top)
+        assert (node.cost >= 0.1 * top) == worth, (name, node.id, node.cost, top)
         for algorithm in ALGORITHMS:
             if algorithm not in node.algorithms:
                 continue
