@@ -209,3 +209,17 @@ def test_three_pass_layout_per_node_unless_the_shader_discards():
                                                "if (a > 0.9) discard; fragColor = vec4(a, b, 0.0, 1.0);"), "d.frag")
     v = instance_nodes(discarding, _nodes(discarding, "+", 2), "three-pass")
     assert list(v.passes) == ["reproject", "payload", "shade"]
+
+
+@pytest.mark.parametrize("color_format", ["rgba8", "rgba16f"])
+def test_a_pair_draws_into_the_timing_colour_format(gl_ctx, capsys, color_format):
+    """The multi-node runtime draws its colour into the same format as the original it is timed
+    beside (it used to keep an rgba32f target whatever was asked: an unfair timing, and at Δn = 1
+    an error of the 8-bit rounding instead of 0)."""
+    main(["render", "tests/corpus/fragcoord_redeclared.glsl", "tests/corpus/default_session.json",
+          "--node", "n130", "--period", "1", "--node", "n310", "--period", "1", "--frames", "2",
+          "--color-format", color_format, "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["color_format"] == color_format
+    assert summary["mean_error"] == 0.0 and summary["hit_rate"] == 0.0
+    assert summary["exact"] is True and summary["psnr"] is None  # never "100 dB"

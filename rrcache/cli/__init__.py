@@ -26,6 +26,7 @@ _COMMANDS = {
     "instance": "instance",
     "bench-cache": "bench_cache",
     "bench-amortize": "bench_amortize",
+    "bench-repeats": "bench_repeats",
     "bench": "bench",
     "profile": "profile",
     "select": "select",

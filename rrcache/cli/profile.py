@@ -98,20 +98,24 @@ def _fmt(value, spec=".3g", none="–"):
                    "30 dB; relative = the paper's error thresholds (fractions of the largest error seen).")
 @click.option("--wait", is_flag=True,
               help="If another rrcache process is profiling into the same --out, wait for it (default: exit 2).")
+@click.option("--sets", "max_sets", type=click.IntRange(min=0, max=64), default=None,
+              help="Train at most this many sets of several cached nodes predicted to improve the front "
+                   "(default 3; 0: single nodes only).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
             algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, defines, quiet, vert, include_dirs):
+            wait, max_sets, defines, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
                   validate=not no_validate, validation_frames=validation_frames, levels=levels)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
-                        ("min_gain", min_gain), ("timing_format", timing_format)):
+                        ("min_gain", min_gain), ("timing_format", timing_format),
+                        ("max_sets", max_sets)):
         if value is not None:
             kwargs[name] = value
     if periods is not None:
@@ -269,9 +273,13 @@ def _table(prof) -> Table:
         else:
             table.add_column(name, justify="right")
     for s in prof.selections:
-        node = "(original)" if s.node is None else f"{s.node}: {s.text}"
+        if s.multi:  # several nodes, each at its own period
+            node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
+        else:
+            node = "(original)" if s.node is None else f"{s.node}: {s.text}"
+            period = _fmt(s.period, "d")
         if s.fallback:
             node = "↩ " + node
-        table.add_row(f"{s.label} {_level(s)}", node, _fmt(s.period, "d"), _predicted_speedup(s), _speedup(s),
+        table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),
                       _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
     return table

@@ -8,7 +8,7 @@ maps driver errors back to the user's file.
 The vertex shader is the user's own when one was given (:mod:`rrcache.harness.user_vertex`:
 ``rr_prevClip`` and ``invariant gl_Position`` added, the user's varyings passed through every
 pass), else it comes from the harness generator (:func:`rrcache.harness.vertex.
-vertex_source`), asked for exactly the varyings the fragment shader declares (plus
+vertex_for`), asked for exactly the varyings the fragment shader declares (plus
 ``rr_prevClip`` when the pass reads the previous frame's cache), with ``gl_Position`` declared
 ``invariant``: every pass must produce bit-identical depths, or the depth tests between passes
 (``<`` at hits, ``<=`` in the final pass) would fail at random pixels.
@@ -27,19 +27,59 @@ from rrcache.errors import SourceLoc
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_with_map
 from rrcache.glsl.types import OPAQUE_NAMES
-from rrcache.harness.vertex import vertex_source
+from rrcache.harness.vertex import vertex_for
 from rrcache.runtime import glsl as G
 
 _UNIFORM_LINE = re.compile(r"^\s*uniform\s+\w+\s+(\w+)\s*;", re.MULTILINE)
+
+
+_BUILTIN_REDECLARATION = re.compile(r"^\s*(layout\s*\([^)]*\)\s*)?(in|out)\s+\w+\s+gl_Frag(Coord|Depth)\s*;")
+
+
+_CURRENT_READ = re.compile(r"texelFetch\((rr_curPayload\w*), ivec2\(gl_FragCoord\.xy\), 0\)")
+
+
+def _window_convention(runtime_glsl: str, redeclarations: str) -> str:
+    """The runtime's reads of the current frame's cache at this pixel, with a user's
+    ``layout(origin_upper_left, pixel_center_integer) in vec4 gl_FragCoord;`` undone (the
+    snippets assume GL's default: origin at the bottom left, centres at +0.5). Only those reads
+    need the true texel; the other uses hash the coordinate the same way in every pass.
+
+    >>> _window_convention("texelFetch(rr_curPayload_1, ivec2(gl_FragCoord.xy), 0)",
+    ...                    "layout(origin_upper_left) in vec4 gl_FragCoord;")
+    'texelFetch(rr_curPayload_1, ivec2(gl_FragCoord.x, float(textureSize(rr_curPayload_1, 0).y) - gl_FragCoord.y), 0)'
+    """
+    upper = "origin_upper_left" in redeclarations
+    shift = " + 0.5" if "pixel_center_integer" in redeclarations else ""
+    if not upper and not shift:
+        return runtime_glsl
+
+    def read(m: re.Match) -> str:
+        name = m.group(1)
+        y = f"gl_FragCoord.y{shift}"
+        if upper:
+            y = f"float(textureSize({name}, 0).y) - " + (f"({y})" if shift else y)
+        return f"texelFetch({name}, ivec2(gl_FragCoord.x{shift}, {y}), 0)"
+
+    return _CURRENT_READ.sub(read, runtime_glsl)
 
 
 def fragment_shader(unit: A.TranslationUnit, runtime_glsl: str) -> tuple[str, list[Optional[SourceLoc]]]:
     """The fragment source and its line map."""
     text, line_map = print_with_map(unit)
     lines = text.split("\n")
+    line_map = list(line_map) + [None] * (len(lines) - len(line_map))
     head = 0
     while head < len(lines) and lines[head].startswith("#"):
         head += 1
+    # A redeclared built-in (``layout(origin_upper_left) in vec4 gl_FragCoord;``) must come
+    # before the runtime's first use of it (GLSL 4.60 §7.1.2): move it above the snippets.
+    moved = [i for i in range(head, len(lines)) if _BUILTIN_REDECLARATION.match(lines[i])]
+    for i in moved:
+        lines.insert(head, lines.pop(i))
+        line_map.insert(head, line_map.pop(i))
+        head += 1
+    runtime_glsl = _window_convention(runtime_glsl, " ".join(lines[head - len(moved):head]))
     extra = runtime_glsl.rstrip("\n").split("\n") if runtime_glsl else []
     lines[head:head] = extra
     line_map = list(line_map[:head]) + [None] * len(extra) + list(line_map[head:])
@@ -59,7 +99,8 @@ def interface(unit: A.TranslationUnit) -> dict[str, dict[str, str]]:
             quals = _qualifier_words(d)
             type_name = d.type.spec.name or (d.type.spec.struct.name if d.type.spec.struct else "struct")
             for x in d.declarators:
-                if "in" in quals or "varying" in quals:
+                if ("in" in quals or "varying" in quals) and not x.name.startswith("gl_"):
+                    # not ``layout(origin_upper_left) in vec4 gl_FragCoord;`` (a built-in)
                     found["in"][x.name] = type_name
                 elif "uniform" in quals:
                     kind = "sampler" if type_name in OPAQUE_NAMES else "uniform"
@@ -86,15 +127,7 @@ def vertex_shader(inputs: dict[str, str], prev_clip: bool,
     """The vertex shader writing ``inputs`` (and ``rr_prevClip``), with an invariant
     ``gl_Position``: generated, or the user's own (``user``, a
     :class:`rrcache.harness.user_vertex.UserVertex`) with the cache's additions."""
-    if user is not None:
-        user.check_inputs(inputs, locs)
-        return user.source(prev_clip=prev_clip)
-    wanted = dict(inputs)
-    if prev_clip:
-        wanted[G.PREV_CLIP] = "vec4"
-    text = vertex_source(wanted, locs)
-    first, _, rest = text.partition("\n")
-    return f"{first}\ninvariant gl_Position;\n{rest}"
+    return vertex_for(inputs, locs, user, prev_clip=prev_clip)
 
 
 def vertex_uniforms(vertex_text: str) -> list[str]:

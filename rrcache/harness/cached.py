@@ -308,6 +308,12 @@ class Comparison:
         return float(np.mean([min(f.psnr, 100.0) for f in self._steady()]))
 
     @property
+    def exact(self) -> bool:
+        """Every steady frame equal to the original's over its covered pixels (some covered)."""
+        steady = self._steady()
+        return any(f.covered for f in steady) and all(f.mean_error == 0.0 for f in steady)
+
+    @property
     def hits(self) -> Optional[int]:
         """Hits summed over the steady frames (None when the algorithm cannot count them:
         one-pass without ``hit_maps``)."""
@@ -362,7 +368,9 @@ class Comparison:
     def summary(self) -> dict:
         """The figures ``rrcache render --node ... --json`` prints."""
         return {
-            "mean_error": self.mean_error, "psnr": self.psnr, "hit_rate": self.hit_rate,
+            # an exact variant has no PSNR (None, null in JSON: infinite) and says so, never "100 dB"
+            "mean_error": self.mean_error, "psnr": None if self.exact else self.psnr,
+            "exact": self.exact, "hit_rate": self.hit_rate,
             "hits": self.hits, "misses": self.misses, "ms_per_frame": self.ms_per_frame,
             "original_ms_per_frame": self.original_ms_per_frame, "speedup": self.speedup,
             # pixels with NaN/Inf (variant and original), and covered pixels the error left out

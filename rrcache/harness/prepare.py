@@ -82,7 +82,9 @@ def declarations(unit) -> tuple[dict[str, Decl], dict[str, Decl]]:
             entry = Decl(type_name or "struct", d.loc or decl.loc)
             if "uniform" in quals:
                 uniforms[d.name] = entry
-            elif "in" in quals or "varying" in quals:
+            elif ("in" in quals or "varying" in quals) and not d.name.startswith("gl_"):
+                # ``layout(origin_upper_left) in vec4 gl_FragCoord;`` redeclares a built-in
+                # (names starting gl_ are reserved, GLSL 4.60 §3.7): not a varying to supply.
                 inputs[d.name] = entry
     return uniforms, inputs
 

@@ -79,6 +79,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             store.begin_run()
             result = train(work, session, resolved, store, progress)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+            prof.sets = _sets(prof, work, session, resolved, store, progress)
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             _write_outputs(prof, out, work, plots)
             store.end_run("done")
@@ -166,6 +167,14 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     return prof
 
 
+def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+    """The sets of several cached nodes predicted to improve the front, the few picked trained
+    (:mod:`rrcache.profiler.sets`)."""
+    from rrcache.profiler.sets import train_sets
+
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+
+
 def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
     (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
@@ -179,6 +188,11 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
     measured = validate(work, session, settings, store, choices, progress,
                         window=result.plan.timing_window if result.plan is not None else None,
                         candidates=prof.front_candidates)
+    if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
+        from rrcache.profiler.sets import keep_faster
+
+        measured = keep_faster(prof, work, session, settings, store, measured, progress,
+                               result.plan.timing_window if result.plan is not None else None)
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured

@@ -34,6 +34,7 @@ from typing import Any, Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json
+from rrcache.model.sets import SetOption
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.selection import Selection, parts_from_json
 
@@ -164,6 +165,10 @@ class Profile:
     #: median over the timing frames) and whether it was low enough to rely on (≤ 10%)
     timing_noise: Optional[float] = _range(None, minimum=0)
     timing_reliable: bool = True
+    #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
+    #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
+    #: was measured faster at the level
+    sets: list[SetOption] = field(default_factory=list)
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):
@@ -245,7 +250,18 @@ class Profile:
                                hint="give a mean RGB L2 error >= 0, e.g. 0.01 (profile.json lists the e1..e4 levels)")
         if self.verdict is not None:  # the ceiling answered before training: the original
             return Selection.original(float(self.original_ms), algorithm=self.algorithm, max_error=level)
-        return self.adopt(model_select(self.table, level), max_error=level)
+        return self._with_sets(self.adopt(model_select(self.table, level), max_error=level), max_error=level)
+
+    def _with_sets(self, choice: Selection, max_error=None, min_psnr=None) -> Selection:
+        """``choice``, or the trained set (:attr:`sets`) admissible at the level and measured
+        faster in training (:func:`rrcache.model.sets.better`), with the choice's level."""
+        from rrcache.model.sets import better
+
+        found = better(choice, self.sets, float(self.original_ms), max_error=max_error, min_psnr=min_psnr)
+        if found is None:
+            return choice
+        return found.selection(float(self.original_ms), label=choice.label, max_error=choice.max_error,
+                               min_psnr=choice.min_psnr, algorithm=self.algorithm).with_texts(self.texts())
 
     def threshold_selections(self, labels=LABELS) -> list[Selection]:
         """The labelled choices at the profile's levels (``settings.levels``), predicted only:
@@ -258,7 +274,8 @@ class Profile:
         if self.settings.levels == "psnr":
             return [self.select_psnr(db).replace(label=label) for label, db in zip(labels, DEFAULT_LEVELS_DB)]
         levels = [float(t) for t in thresholds(self.table, len(labels))]
-        return [self.adopt(model_select(self.table, level), label=label, max_error=level)
+        return [self._with_sets(self.adopt(model_select(self.table, level), label=label, max_error=level),
+                                max_error=level)
                 for label, level in zip(labels, levels)]
 
     def psnr_fits(self) -> list:
@@ -288,7 +305,7 @@ class Profile:
         bound = 0.0
         if choice.parts:
             bound = max(fits[self.table.node_ids.index(choice.node)].max_error(level), 0.0)
-        return self.adopt(choice, min_psnr=level, max_error=bound)
+        return self._with_sets(self.adopt(choice, min_psnr=level, max_error=bound), min_psnr=level)
 
     def adopt(self, choice: Selection, **changes) -> Selection:
         """``choice`` (from the models) as this profile runs it: its algorithm, the nodes'

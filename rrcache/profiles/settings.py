@@ -49,7 +49,7 @@ DEFAULT_TIMING_PERIODS = (2, 8, 50)
 #: consecutive frames of the error runs when the session has that many
 DEFAULT_TRAINING_FRAMES = 64
 #: the fields that do not change a measurement (left out of the store key)
-UNKEYED = ("budget_s", "validate", "min_saving", "min_gain", "levels")
+UNKEYED = ("budget_s", "validate", "min_saving", "min_gain", "levels", "max_sets")
 #: how the four selection levels are chosen
 LEVEL_KINDS = ("psnr", "relative")
 
@@ -107,6 +107,8 @@ class TrainingSettings:
     - ``levels``: the four selection levels e1..e4: ``psnr`` (predicted PSNR against the original
       ≥ 45, 40, 35, 30 dB) or ``relative`` (the paper's error thresholds, fractions of the
       largest error seen).
+    - ``max_sets``: at most this many sets of several cached nodes, each at its own period, are
+      trained after the single nodes (:mod:`rrcache.profiler.sets`); 0 trains none.
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -126,6 +128,8 @@ class TrainingSettings:
     min_gain: float = 1.1
     timing_format: str = "rgba8"
     levels: str = "psnr"
+    #: the sets of cached nodes (k >= 2) the set stage trains at most (rrcache.profiler.sets); 0: none
+    max_sets: int = 3
 
     def cache_options(self) -> dict:
         """The cache's run-time parameters besides the period, as the keyword arguments of
@@ -180,6 +184,8 @@ class TrainingSettings:
                 or not 0 <= self.min_gain < 100:
             raise _fail("min_gain", f"{self.min_gain!r} is not a speed-up in [0, 100)", "the default is 1.1")
         object.__setattr__(self, "min_gain", float(self.min_gain))
+        if isinstance(self.max_sets, bool) or not isinstance(self.max_sets, int) or not 0 <= self.max_sets <= 64:
+            raise _fail("max_sets", f"{self.max_sets!r} is not a count of sets in [0, 64]", "the default is 3; 0 trains none")
         if self.levels not in LEVEL_KINDS:
             raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
         if self.timing_format not in COLOR_FORMATS:

@@ -38,6 +38,7 @@ SCHEMA = """\
 --   session_hash, settings_json, settings_hash, created, updated (unix seconds); and, once the
 --   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profiler.plan),
 --   kept so that a resumed run renders exactly what the first one did.
+--   sets: JSON of the sets of cached nodes the set stage trained (rrcache.profiler.sets).
 CREATE TABLE meta (
     key TEXT PRIMARY KEY,
     value TEXT NOT NULL
@@ -533,6 +534,14 @@ class ProfileStore:
     def set_plan(self, plan: dict) -> None:
         """Keep the windows chosen for this store (once; later runs read :meth:`plan`)."""
         self._write([("INSERT OR REPLACE INTO meta(key, value) VALUES ('plan', ?)", (json.dumps(plan),))])
+
+    def set_meta(self, key: str, value: str) -> None:
+        """Keep a stage's own record under ``meta(key)`` (e.g. the trained sets of
+        :mod:`rrcache.profiler.sets`); :meth:`meta` reads it back."""
+        if key in ("schema_version", "rrcache_version", "shader_hash", "session_hash", "settings_hash",
+                   "settings_json", "plan", "updated"):
+            raise ValueError(f"meta key {key!r} is the store's own")
+        self._write([("INSERT OR REPLACE INTO meta(key, value) VALUES (?, ?)", (key, value))])
 
     def has_error_run(self, node: str, period: int) -> bool:
         return self.conn.execute("SELECT 1 FROM error_run WHERE node = ? AND period = ?",

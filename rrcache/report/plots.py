@@ -70,6 +70,9 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
     if front:
         ax.plot([p[1] for p in front], [p[0] for p in front], "-", color="black", lw=2.2, alpha=0.55,
                 label="Pareto front")
+    from rrcache.report.sets_plot import draw_sets
+
+    draw_sets(ax, prof)  # the sets of several nodes and the front with them (none: nothing drawn)
     if prof.original_ms:
         ax.axvline(prof.original_ms, ls="--", color="gray", label=f"original ({prof.original_ms:.2f} ms)")
     groups: dict = {}

@@ -32,6 +32,7 @@ import numpy as np
 
 from rrcache.budgets import MAX_RUNTIME_PERIOD, check_period
 from rrcache.errors import RRCacheError
+from rrcache.gl.formats import bytes_per_texel
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.runtime import glsl as G
 from rrcache.runtime.cache import CacheRuntime
@@ -116,7 +117,7 @@ class MultiCacheRuntime(CacheRuntime):
     def bytes_per_pixel(self) -> int:
         """Depth, colour, each node's two payloads and two inverse depths, and the read-back."""
         size = 4 if self.payload_dtype == "f4" else 2
-        return 4 + 16 + sum(2 * c * size + 2 * 4 for c in self.node_components) + 41
+        return 4 + bytes_per_texel(self.color_format) + sum(2 * c * size + 2 * 4 for c in self.node_components) + 41
 
     def resize(self, size) -> None:
         w, h = int(size[0]), int(size[1])
@@ -129,7 +130,7 @@ class MultiCacheRuntime(CacheRuntime):
         k = self.node_count
         with target_guard((w, h), "cache size"):
             self.depth = ctx.depth_texture((w, h))
-            self.color = ctx.texture((w, h), 4, dtype="f4")
+            self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
             self._payloads = [[ctx.texture((w, h), c, dtype=self.payload_dtype) for _ in range(2)]
                               for c in self.node_components]
             self._invdepths = [[ctx.texture((w, h), 1, dtype="f4") for _ in range(2)] for _ in range(k)]

@@ -1,0 +1,102 @@
+"""Repeated profiles of one shader side by side: did any of them ship a measured slowdown?
+
+Issue 15's check that the profiler can be trusted: profile the same shader over the same session
+several times (each a whole ``rrcache profile`` run into its own folder) and read what each one
+shipped at each level. Every shipped selection was measured by validation beside the original,
+several times (:mod:`rrcache.profiler.validate`); here each is classed by those repeats:
+
+- ``faster``: every repeat at or above 1.0× (or the original itself, 1.0× by definition);
+- ``within noise``: the median below 1.0× but some repeat at or above it (validation lets it
+  stand and shows the range);
+- ``slowdown``: every repeat below 1.0×: validation should have fallen back, so this is a
+  defect of the profiler, and :func:`slowdowns` lists it.
+
+:func:`rows` reads the folders; :func:`markdown` writes the table the README shows.
+
+>>> classify(())
+'original'
+>>> classify((0.97, 1.02, 0.99))
+'within noise'
+>>> classify((0.91, 0.95, 0.97))
+'slowdown'
+"""
+from __future__ import annotations
+
+import statistics
+from pathlib import Path
+from typing import Iterable, Optional
+
+from rrcache.profiles.document import load_profile
+
+
+def classify(speedups, exact_original: bool = True) -> str:
+    """``original`` (nothing cached), ``faster``, ``within noise`` or ``slowdown`` (see the
+    module docstring) from a selection's measured speed-up repeats."""
+    if not speedups:
+        return "original" if exact_original else "not measured"
+    if min(speedups) >= 1.0:
+        return "faster"
+    if max(speedups) >= 1.0:
+        return "within noise"
+    return "slowdown"
+
+
+def rows(folders: Iterable) -> list[dict]:
+    """One row per shipped selection of each profile folder: the scene (shader and session
+    names), the run (the folder's name), the level, what it caches, the predicted and measured
+    speed-ups (median and range of the repeats), the predicted and measured PSNR, the fallback,
+    and the class (:func:`classify`)."""
+    out = []
+    for folder in folders:
+        profile = load_profile(folder)
+        scene = f"{Path(profile.shader).stem} / {Path(profile.session).stem}"
+        verdict = profile.verdict["answer"] if profile.verdict else None
+        if not profile.selections:
+            out.append(dict(scene=scene, run=Path(folder).name, level="all", cached="the original shader",
+                            kind="original", predicted_speedup=1.0, speedup=None, speedup_range=None,
+                            psnr=None, predicted_psnr=None, fallback=verdict, cls="original",
+                            ceiling=(profile.ceiling or {}).get("speedup")))
+            continue
+        for sel in profile.selections:
+            speedups = tuple(sel.speedups) or ((sel.measured_speedup,) if sel.measured_speedup else ())
+            out.append(dict(
+                scene=scene, run=Path(folder).name, level=sel.label, min_psnr=sel.min_psnr,
+                cached=sel.describe(), kind=sel.kind, predicted_speedup=sel.predicted_speedup,
+                speedup=statistics.median(speedups) if speedups else None,
+                speedup_range=(min(speedups), max(speedups)) if speedups else None,
+                psnr=None if sel.exact else sel.measured_psnr, exact=sel.exact,
+                predicted_psnr=sel.predicted_psnr, fallback=sel.fallback,
+                cls=classify(speedups, exact_original=not sel.parts),
+                ceiling=(profile.ceiling or {}).get("speedup")))
+    return out
+
+
+def slowdowns(table: list[dict]) -> list[dict]:
+    """The rows that shipped a selection slower than the original in every repeat."""
+    return [r for r in table if r["cls"] == "slowdown"]
+
+
+def _x(value: Optional[float]) -> str:
+    return "–" if value is None else f"{value:.2f}×"
+
+
+def markdown(table: list[dict]) -> str:
+    """The rows as a Markdown table (one line per shipped selection) and a closing count."""
+    lines = ["| scene | run | level | cached | predicted | measured (range of repeats) | PSNR dB "
+             "(predicted) | class |", "|---|---|---|---|---|---|---|---|"]
+    for r in table:
+        rng = r["speedup_range"]
+        measured = _x(r["speedup"]) + (f" ({rng[0]:.2f}–{rng[1]:.2f})" if rng and rng[0] != rng[1] else "")
+        psnr = "∞ (exact)" if r.get("exact") or r["kind"] == "original" else (
+            "–" if r["psnr"] is None else f"{r['psnr']:.1f}")
+        if r.get("predicted_psnr") is not None:
+            psnr += f" ({r['predicted_psnr']:.1f})"
+        cached = r["cached"] + (f" ↩ {r['fallback']}" if r.get("fallback") else "")
+        level = r["level"] + (f" ≥{r['min_psnr']:.0f} dB" if r.get("min_psnr") else "")
+        lines.append(f"| {r['scene']} | {r['run']} | {level} | {cached} | {_x(r['predicted_speedup'])} | "
+                     f"{measured} | {psnr} | {r['cls']} |")
+    bad = slowdowns(table)
+    lines.append("")
+    lines.append(f"{len(table)} shipped selections in {len({(r['scene'], r['run']) for r in table})} profiles; "
+                 f"{len(bad)} measured slower than the original in every repeat.")
+    return "\n".join(lines)

@@ -1,0 +1,32 @@
+"""``rrcache bench-repeats PROFILE...``: what repeated profiles shipped, and whether any was slower.
+
+    rrcache profile shaders/marble.glsl sessions/marble.json --out runs/marble-r1.rrprofile
+    rrcache profile shaders/marble.glsl sessions/marble.json --out runs/marble-r2.rrprofile
+    rrcache bench-repeats runs/*.rrprofile
+
+One line per shipped selection (:mod:`rrcache.bench.repeats`); exits 1 when a profile shipped a
+selection measured slower than the original in every repeat.
+"""
+from __future__ import annotations
+
+import json
+
+import click
+
+
+@click.command("bench-repeats")
+@click.argument("profiles", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
+def command(profiles, as_json):
+    """Tabulate the shipped selections of PROFILES (folders of repeated 'rrcache profile' runs):
+    speed-ups measured beside the original (median and range of the repeats), PSNR, fallbacks,
+    and whether any shipped a measured slowdown."""
+    from rrcache.bench.repeats import markdown, rows, slowdowns
+
+    table = rows(profiles)
+    if as_json:
+        click.echo(json.dumps(table))
+    else:
+        click.echo(markdown(table))
+    if slowdowns(table):
+        raise SystemExit(1)

@@ -1,0 +1,54 @@
+"""``rrcache bench-repeats``: repeated profiles' shipped selections, read from real profile folders
+(the demo profile, made in seconds), and a slowdown among them is flagged with exit 1."""
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from rrcache.bench.repeats import classify, markdown, rows, slowdowns
+from rrcache.cli import main
+from rrcache.profiler import demo_profile
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    base = tmp_path_factory.mktemp("repeats")
+    first = demo_profile(base / "demo-r1.rrprofile").path
+    second = base / "demo-r2.rrprofile"
+    shutil.copytree(first, second)
+    return first, second
+
+
+def test_rows_read_every_shipped_selection(runs):
+    table = rows(runs)
+    assert len(table) == 2 * 4 and {r["run"] for r in table} == {"demo-r1.rrprofile", "demo-r2.rrprofile"}
+    assert [r["level"] for r in table[:4]] == ["e1", "e2", "e3", "e4"]
+    for r in table:
+        assert r["cls"] in ("original", "faster", "within noise", "slowdown")
+        if r["kind"] != "original":
+            assert r["speedup"] is not None and r["speedup_range"][0] <= r["speedup"] <= r["speedup_range"][1]
+    text = markdown(table)
+    assert text.count("\n| marbled_sphere / marbled_sphere | demo-r") == 8 and "shipped selections in 2 profiles" in text
+
+
+def test_a_shipped_slowdown_is_flagged(runs, capsys):
+    first, second = runs
+    doc = json.loads((second / "profile.json").read_text())
+    cached = [s for s in doc["selections"] if s["parts"]]
+    assert cached, "the demo profile ships at least one cached selection"
+    cached[0]["speedups"] = [0.8, 0.85, 0.9]
+    (second / "profile.json").write_text(json.dumps(doc))
+    bad = slowdowns(rows([second]))
+    assert len(bad) >= 1 and bad[0]["speedup"] == pytest.approx(0.85)
+    with pytest.raises(SystemExit) as info:
+        main(["bench-repeats", str(first), str(second)])
+    assert info.value.code == 1
+    assert "slowdown" in capsys.readouterr().out
+
+
+def test_classes():
+    assert classify(()) == "original" and classify((), exact_original=False) == "not measured"
+    assert classify((1.0, 1.2)) == "faster" and classify((0.99, 1.01, 0.98)) == "within noise"
+    assert classify((0.5,)) == "slowdown"
