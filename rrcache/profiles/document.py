@@ -165,6 +165,10 @@ class Profile:
     #: median over the timing frames) and whether it was low enough to rely on (≤ 10%)
     timing_noise: Optional[float] = _range(None, minimum=0)
     timing_reliable: bool = True
+    #: dB added to the training runs' PSNRs (measured in the error window) to predict the PSNR
+    #: of what validation measures (the frame, or the timing window): the covered fractions
+    #: differ (:func:`rrcache.model.psnr.coverage_offset_db`)
+    psnr_offset_db: float = 0.0
     #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
     #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
     #: was measured faster at the level
@@ -280,10 +284,15 @@ class Profile:
 
     def psnr_fits(self) -> list:
         """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
-        training runs), in the order of :attr:`trained_nodes`."""
+        training runs, shifted by :attr:`psnr_offset_db` to the region validation measures), in
+        the order of :attr:`trained_nodes`."""
+        import dataclasses as dc
+
         from rrcache.model.psnr import fit_psnr
 
-        return [fit_psnr(n.errors, n.psnrs) for n in self.trained_nodes]
+        fits = [fit_psnr(n.errors, n.psnrs) for n in self.trained_nodes]
+        off = float(self.psnr_offset_db or 0.0)
+        return [dc.replace(f, a=f.a + off) if off and f.quality != "no_data" else f for f in fits]
 
     def select_psnr(self, min_psnr: float) -> Selection:
         """The choice predicted fastest whose predicted PSNR against the original is ≥
