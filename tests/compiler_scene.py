@@ -128,7 +128,8 @@ def render_variant(scene: Scene, variant: Variant, frames: int, period: int):
     """Images and FrameStats of ``frames`` frames of a variant at refresh period ``period``."""
     programs = variant.build_programs(scene.ctx)
     rt = CacheRuntime(scene.ctx, programs, variant.algorithm, scene.size, period=period,
-                      payload_dtype=variant.payload_dtype)
+                      payload_dtype=variant.payload_dtype, payload_components=variant.components,
+                      depth_channel=variant.depth_channel)
     images, stats = [], []
     try:
         for frame in range(frames):

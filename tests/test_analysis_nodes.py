@@ -151,3 +151,39 @@ def test_marble_nodes_inside_the_octave_loop_are_listed(marble):
     sums = [n for n in table.nodes if n.text.startswith("sum + amplitude * abs(noise(")]
     assert len(sums) == 5                     # the partial sums of the turbulence
     assert sorted(n.cost for n in sums) == [n.cost for n in sums]
+
+
+MARCH = """#version 330
+in vec3 v_position;
+uniform vec3 u_light;
+uniform int u_steps;
+out vec4 color;
+const int STEPS = %s;
+float scene(vec3 p) { return length(p) - 1.0; }
+void main() {
+    float result = 1.0;
+    float t = 0.02;
+    for (int i = 0; i < %s; i++) {
+        float h = scene(v_position + u_light * t);
+        result = min(result, 8.0 * h / t);
+        t += clamp(h, 0.02, 0.2);
+        if (result < 0.001) break;
+    }
+    color = vec4(vec3(result), 1.0);
+}
+"""
+
+
+def _march_cost(bound: str) -> int:
+    table = cacheable_nodes(parse_shader(MARCH % ("64", bound), "march.frag"))
+    return [n for n in table.nodes if n.final][0].cost
+
+
+def test_a_rolled_loop_costs_its_trip_bound():
+    # the loop has a break, so the unroller leaves it rolled; what it computes costs one
+    # iteration per trip of its constant bound, not one in all
+    one, eight, sixty_four = _march_cost("1"), _march_cost("8"), _march_cost("STEPS")
+    assert one < eight < sixty_four
+    assert 6.0 < (sixty_four - one) / (eight - one) < 10.0       # 63 extra iterations vs 7
+    # a bound read from a uniform is unknown: one iteration, as before
+    assert _march_cost("u_steps") == one

@@ -64,3 +64,19 @@ def test_select_min_psnr():
     high = select_min_psnr(table, fits, 37.0)
     assert high.node == "n1" and fits[1].predict(high.predicted_error) >= 37.0
     assert select_min_psnr(table, fits, 200.0).node is None
+
+
+def test_profile_keeps_frame_spreads_and_widens_the_psnr_uncertainty(trained):
+    from rrcache.model.psnr import frame_spread
+
+    nodes = [n for n in trained.trained_nodes if any(e > 0 for e in n.errors)]
+    assert nodes
+    for n in nodes:
+        assert len(n.frame_spreads) == len(n.periods) and all(s >= 0 for s in n.frame_spreads)
+    assert any(s > 0 for n in nodes for s in n.frame_spreads)
+    for choice in trained.threshold_selections():
+        if choice.parts and choice.predicted_error > 0:
+            i = [n.id for n in trained.trained_nodes].index(choice.node)
+            fit = trained.psnr_fits()[i]
+            assert choice.predicted_psnr_uncertainty >= fit.uncertainty
+    assert frame_spread([0.0, 0.1, 0.1, 0.1, 0.1]) == 0.0

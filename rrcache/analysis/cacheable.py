@@ -40,7 +40,10 @@ Every expression in a value position of ``main`` is either listed or left out wi
 
 The *cost* of a node is the work a cache hit saves: the static cost
 (:mod:`rrcache.analysis.cost`) of its expression tree plus that of every definition of a local
-variable it depends on, transitively, each counted once. Every write makes a definition: a
+variable it depends on, transitively, each counted once; a definition inside a loop the unroller
+left rolled counts once per iteration of the loop's constant trip bound
+(:func:`rrcache.analysis.cost.loop_trips`; 1 when the bound is not constant), so the result of a
+64-step ray march with an early ``break`` costs 64 steps, not one. Every write makes a definition: a
 whole assignment, and also a partial one (a component ``c.rgb += ...``, a member
 ``m.albedo.rgb = ...``, an element ``a[i] = ...``, ``++``/``--``, an ``out``/``inout`` argument;
 the inliner turns calls into such assignments), whose definition reads the variable's previous
@@ -83,7 +86,7 @@ from rrcache.glsl.printer import print_expr
 from rrcache.glsl.ast import iter_exprs
 from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
 from rrcache.glsl.writes import out_qualifiers, written_roots
-from rrcache.analysis.cost import CACHE_LOOKUP_COST, op_cost
+from rrcache.analysis.cost import CACHE_LOOKUP_COST, global_constants, loop_trips, op_cost
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
@@ -388,6 +391,10 @@ class _Classifier:
         self.own: list[int] = []                  # own cost of definition k
         self.own_np = np.zeros(1024, dtype=np.int64)
         self.deriv_mask = 0                       # definitions read by differentiated arguments
+        # a definition inside a loop left rolled costs its own cost times the loop's trip bound
+        # (loop_trips; nested loops multiply): what a value after the loop saves when cached
+        self.repeat = 1
+        self.consts = global_constants(shader.unit)
         info = shader.info
         outs = list(info.outputs)
         self.output = outs[0] if outs else ("gl_FragData" if "gl_FragData" in info.used_globals
@@ -473,6 +480,7 @@ class _Classifier:
     def new_def(self, expr, uniform: bool, flags: int, own: int, mask: int, cost: int) -> _Def:
         """A new definition of own cost ``own`` reading ``mask`` (of cost ``cost``)."""
         idx = len(self.own)
+        own = own * self.repeat
         self.own.append(own)
         if idx >= self.own_np.size - 64:
             grown = np.zeros(self.own_np.size * 2, dtype=np.int64)
@@ -616,6 +624,8 @@ class _Classifier:
         if isinstance(s, A.For) and s.init is not None:
             self.stmt(s.init, ctx)
         inner = ctx.but(dynamic=True, varying=True, region=ctx.region + ((id(s), 0),))
+        outer_repeat = self.repeat
+        self.repeat = outer_repeat * loop_trips(s, self.consts)
         before = dict(self.state)
         self.clobber(s, inner)
         cond = s.cond
@@ -630,6 +640,7 @@ class _Classifier:
             self.stmt(s.body, inner)
             if isinstance(s, A.For) and s.step is not None:
                 self.top_expr(s.step, inner)
+        self.repeat = outer_repeat
         self.state = self.merge(before, self.state)
 
     # ------------------------------------------------------------------ expressions

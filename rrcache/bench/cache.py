@@ -236,14 +236,28 @@ class Breakdown:
         return "\n".join(lines)
 
 
+#: the payload layouts ``breakdown`` compares: precision, and ``f4-packed`` for the inverse depth
+#: in the payload's free channel instead of its own render target (``instance(pack_depth=True)``)
+PAYLOAD_LAYOUTS = ("f4", "f2", "f4-packed")
+
+
+def _layout_variant(work, node_id: str, algorithm: str, layout: str):
+    from rrcache.compiler import instance
+
+    if layout not in PAYLOAD_LAYOUTS:
+        raise ValueError(f"payload layout must be one of {PAYLOAD_LAYOUTS}, not {layout!r}")
+    dtype, _, packed = layout.partition("-")
+    return instance(work.table, node_id, algorithm, "bilinear", dtype, work.vertex, pack_depth=bool(packed))
+
+
 def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("three-pass", "two-pass"),
               formats=("rgba32f", "rgba8"), frames: int = 60, resolution: Optional[tuple[int, int]] = None,
               period: int = 16, repeats: int = 3, payloads=("f4",),
               progress: Optional[Callable[[str, int, int], None]] = None, vertex: Optional[str] = None,
               include_dirs=()) -> Breakdown:
     """Measure the all-hit frame stage by stage for every algorithm, colour format and payload
-    precision (see :class:`Breakdown`); the configurations take turns within each repeat. (A
-    16-bit payload is used as asked: its range is not checked here.)"""
+    layout (:data:`PAYLOAD_LAYOUTS`; see :class:`Breakdown`); the configurations take turns
+    within each repeat. (A 16-bit payload is used as asked: its range is not checked here.)"""
     from rrcache.harness.limit import all_hit_breakdown
 
     session = load_session(session_path)
@@ -253,7 +267,7 @@ def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("th
     size = tuple(resolution or session.resolution)
     out = Breakdown(shader_path, session_path, node_id, size, list(indices))
     configs = [(a, f, p) for a in algorithms for p in payloads for f in formats]
-    variants = {(a, p): variant_for(work, node_id, a, payload_dtype=p) for a in algorithms for p in payloads}
+    variants = {(a, p): _layout_variant(work, node_id, a, p) for a in algorithms for p in payloads}
     measured = {c: [] for c in configs}
     done, total = 0, len(configs) * repeats
     for repeat in range(repeats):

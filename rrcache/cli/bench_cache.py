@@ -35,7 +35,9 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 @click.option("--formats", default="rgba32f,rgba8", show_default=True,
               help="Colour formats of --breakdown, side by side.")
 @click.option("--payloads", default="f4", show_default=True,
-              help="Payload precisions of --breakdown (f4, f2), side by side.")
+              help="Payload layouts of --breakdown, side by side: f4, f2 (precision), and "
+                   "f4-packed (32-bit with the inverse depth packed into the payload's free "
+                   "channel: one render target and one fetch fewer).")
 @click.option("--algorithms", default="three-pass,two-pass", show_default=True,
               help="Algorithms of --breakdown, side by side.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
@@ -46,7 +48,7 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 def command(shader, session, node, periods, compare_period, frames, repeats, resolution, timing_format, breakdown,
             formats, payloads, algorithms, as_json, markdown, quiet, vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
-    from rrcache.bench.cache import breakdown as run_breakdown, run
+    from rrcache.bench.cache import PAYLOAD_LAYOUTS, breakdown as run_breakdown, run
 
     err = Console(stderr=True)
     try:
@@ -59,8 +61,8 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
         raise click.BadParameter(f"{formats!r}: give colour formats from {', '.join(COLOR_FORMATS)}",
                                  param_hint="--formats")
     payload_list = [p.strip() for p in payloads.split(",") if p.strip()]
-    if not payload_list or any(p not in ("f4", "f2") for p in payload_list):
-        raise click.BadParameter(f"{payloads!r}: give f4 and/or f2", param_hint="--payloads")
+    if not payload_list or any(p not in PAYLOAD_LAYOUTS for p in payload_list):
+        raise click.BadParameter(f"{payloads!r}: give some of {', '.join(PAYLOAD_LAYOUTS)}", param_hint="--payloads")
     algorithm_list = [a.strip() for a in algorithms.split(",") if a.strip()]
     if not algorithm_list or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
         raise click.BadParameter(f"{algorithms!r}: give three-pass, two-pass and/or one-pass", param_hint="--algorithms")

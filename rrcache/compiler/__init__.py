@@ -39,7 +39,7 @@ from rrcache.compiler.locate import prepare
 from rrcache.compiler.passes import build_pass
 from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
-from rrcache.runtime.glsl import FILTERS
+from rrcache.runtime.glsl import FILTERS, depth_channel_for
 
 __all__ = ["instance", "instance_nodes", "check_algorithm", "Variant", "PassSource"]
 
@@ -59,7 +59,7 @@ def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: 
 
 @deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> Variant:
+             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None, pack_depth: bool = False) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 
     ``analysed`` is what the analysis returns (a checked, inlined and unrolled shader);
@@ -70,6 +70,11 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
     :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
     be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
+    ``pack_depth``: keep the inverse depth in the payload's free channel when it has one
+    (:func:`rrcache.runtime.glsl.depth_channel_for`; the variant's ``depth_channel``, which the
+    runtime must be given); False (the default): its own render target. Packing saves a render
+    target and a fetch but measured no faster on llvmpipe (docs/profiler_trust.md §9); it is
+    there to be measured elsewhere (``rrcache bench-cache --breakdown --payloads f4,f4-packed``).
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -79,13 +84,14 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
     check_algorithm(analysed, node_id, algorithm)
     loc = prepare(analysed, node_id)
+    depth_channel = depth_channel_for(loc.components, payload_dtype) if pack_depth else None
     passes: dict[str, PassSource] = {}
     uniforms: dict[str, list[str]] = {}
     samplers: dict[str, list[str]] = {}
     runtime: dict[str, list[str]] = {}
     forms: dict[str, str] = {}
     for name in ALGORITHMS[algorithm]:
-        built = build_pass(loc, name, filter)
+        built = build_pass(loc, name, filter, depth_channel)
         out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, vertex)
         passes[name] = PassSource(out.vertex, out.fragment, out.line_map)
         uniforms[name], samplers[name], runtime[name] = out.uniforms, out.samplers, out.runtime
@@ -95,7 +101,7 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
-        vertex_path=getattr(vertex, "path", None))
+        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel)
 
 
 from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)

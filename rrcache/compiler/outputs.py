@@ -6,7 +6,8 @@
 - :func:`cache_writes` is ``rr_outPayload = <payload>; rr_outInvDepth = gl_FragCoord.w;`` and
   :func:`cache_init` the ``rr_outInvDepth = 0.0; rr_outPayload = vec4(0.0);`` put at the start
   of ``main`` so that an early ``return`` leaves an invalid cache entry (0 inverse depth: the next
-  frame misses there).
+  frame misses there). With the inverse depth packed into the payload
+  (:func:`rrcache.runtime.glsl.depth_channel_for`) both write ``rr_outPayload`` alone.
 - :func:`set_color_output` removes the shader's colour output (the variable stays, as a plain
   global that dead-code elimination then removes with every write to it) or pins it to
   ``layout(location = 0)`` for the passes that write colour beside the cache.
@@ -54,10 +55,26 @@ def cache_writes(payload: A.Expr) -> list[A.Stmt]:
             _assign(G.OUT_INVDEPTH, A.Field(A.Ident("gl_FragCoord"), "w"))]
 
 
-def cache_init() -> list[A.Stmt]:
-    """``rr_outInvDepth = 0.0; rr_outPayload = vec4(0.0);``"""
-    return [_assign(G.OUT_INVDEPTH, float_lit(0.0)),
-            _assign(G.OUT_PAYLOAD, A.Call("vec4", [float_lit(0.0)]))]
+def packed_writes(value: A.Expr, components: int) -> list[A.Stmt]:
+    """The cache writes with the inverse depth packed into the payload's channel
+    ``components`` (:func:`rrcache.runtime.glsl.depth_channel_for`):
+    ``rr_outPayload = vec4(value, gl_FragCoord.w[, 0.0…]);``
+
+    >>> from rrcache.glsl.printer import print_expr
+    >>> print_expr(packed_writes(A.Ident("v"), 1)[0].expr.value)
+    'vec4(v, gl_FragCoord.w, 0.0, 0.0)'
+    """
+    if not 1 <= components <= 3:
+        raise ValueError(f"a {components}-component value leaves no payload channel for the inverse depth")
+    rest = [float_lit(0.0) for _ in range(3 - components)]
+    return [_assign(G.OUT_PAYLOAD, A.Call("vec4", [value, A.Field(A.Ident("gl_FragCoord"), "w")] + rest))]
+
+
+def cache_init(packed: bool = False) -> list[A.Stmt]:
+    """``rr_outInvDepth = 0.0; rr_outPayload = vec4(0.0);`` (``packed``: the inverse depth is in
+    the payload, whose zero then marks the entry invalid: ``rr_outPayload = vec4(0.0);``)."""
+    init = [_assign(G.OUT_PAYLOAD, A.Call("vec4", [float_lit(0.0)]))]
+    return init if packed else [_assign(G.OUT_INVDEPTH, float_lit(0.0))] + init
 
 
 def color_outputs(unit: A.TranslationUnit) -> list[A.VariableDecl]:

@@ -23,7 +23,9 @@ pass. Where it fires in pass 1 or 2 no depth is written, and the runtime's final
 with ``==``, so that fragment is not shaded from an empty payload and the surface behind it is.
 
 Every pass that writes the cache starts ``main`` with ``rr_outInvDepth = 0.0; rr_outPayload =
-vec4(0.0);``. Then the runtime's GLSL (:mod:`rrcache.runtime.glsl`) is parsed and put in front
+vec4(0.0);``. With the inverse depth packed into the payload (``depth_channel``,
+:mod:`rrcache.runtime.glsl`) the cache writes are ``rr_outPayload = vec4(<value>,
+gl_FragCoord.w[, 0.0…]);`` and there is no ``rr_outInvDepth``. Then the runtime's GLSL (:mod:`rrcache.runtime.glsl`) is parsed and put in front
 of the unit, the whole is type-checked, dead code is eliminated
 (:mod:`rrcache.compiler.prune`: the roots are the pass's outputs and every ``discard``), and the
 runtime's declarations are taken out again: the emitter prints them verbatim.
@@ -55,7 +57,7 @@ from rrcache.glsl.rewrite import clone
 from rrcache.compiler.feeders import move_feeders
 from rrcache.compiler.hoist import declare, hoist, insert_before
 from rrcache.compiler.locate import Located, find_site
-from rrcache.compiler.outputs import cache_init, cache_writes, pack, set_color_output
+from rrcache.compiler.outputs import cache_init, cache_writes, pack, packed_writes, set_color_output
 from rrcache.compiler.prune import prune
 from rrcache.compiler.replace import (
     NODE_VAR, current_value, node_variable, previous_payload, previous_value, replace_node,
@@ -104,15 +106,16 @@ class PassUnit:
     form: str
 
 
-def runtime_snippets(spec: PassSpec, filter: str) -> str:
-    """The runtime GLSL a pass needs, in the order it is emitted."""
+def runtime_snippets(spec: PassSpec, filter: str, depth_channel: Optional[int] = None) -> str:
+    """The runtime GLSL a pass needs, in the order it is emitted (``depth_channel``: the payload
+    channel holding the inverse depth, None for its own texture)."""
     text = ""
     if spec.lookup:
-        text += G.lookup_glsl(filter)
+        text += G.lookup_glsl(filter, depth_channel)
     if spec.current:
         text += G.current_glsl()
     if spec.cache:
-        text += G.output_glsl(spec.cache_location)
+        text += G.output_glsl(spec.cache_location, depth_channel)
     return text
 
 
@@ -130,25 +133,30 @@ def _set(name: str, value: A.Expr) -> A.ExprStmt:
     return A.ExprStmt(A.Assign("=", A.Ident(name), value))
 
 
-def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
-    """The transformed (not yet checked or pruned) unit of pass ``name``, and the binding form."""
+def transform(loc: Located, name: str, depth_channel: Optional[int] = None) -> tuple[A.TranslationUnit, str]:
+    """The transformed (not yet checked or pruned) unit of pass ``name``, and the binding form
+    (``depth_channel``: the inverse depth packed into that payload channel, None: its own
+    output)."""
     if name not in PASS_SPECS:
         raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(PASS_SPECS)}")
     spec = PASS_SPECS[name]
     unit = clone(loc.unit)
     site = find_site(unit)
     n, t = loc.components, loc.type_name
+
+    def writes(value: A.Expr) -> list:
+        return cache_writes(pack(value, n)) if depth_channel is None else packed_writes(value, n)
+
     if name in ("reproject", "hit"):
         insert_before(site, [
             A.If(_miss_condition(), A.Discard()),
             declare(t, NODE_VAR, previous_value(n)),
-            *cache_writes(previous_payload()),
+            *(cache_writes(previous_payload()) if depth_channel is None else packed_writes(previous_value(n), n)),
         ])
         replace_node(site.stmt, node_variable)
         form = "replace"
     elif name in ("payload", "miss"):
-        form = hoist(site, t, clone(loc.expr),
-                     then=cache_writes(pack(node_variable(), n)))
+        form = hoist(site, t, clone(loc.expr), then=writes(node_variable()))
     elif name == "shade":
         replace_node(site.stmt, lambda: current_value(n))
         form = "replace"
@@ -156,22 +164,23 @@ def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
         miss_branch = A.Compound([_set(NODE_VAR, clone(loc.expr))])
         setter = A.If(_hit_condition(), _set(NODE_VAR, previous_value(n)), miss_branch)
         value = A.Ternary(_hit_condition(), previous_value(n), clone(loc.expr))
-        form = hoist(site, t, value, then=cache_writes(pack(node_variable(), n)), setter=setter)
+        form = hoist(site, t, value, then=writes(node_variable()), setter=setter)
         if form == "hoist":
             move_feeders(site, setter, miss_branch, main_function(unit).body)
     if spec.cache:
-        main_function(unit).body.stmts[0:0] = cache_init()
+        main_function(unit).body.stmts[0:0] = cache_init(packed=depth_channel is not None)
     set_color_output(unit, keep=spec.color, location=spec.color_location)
     return unit, form
 
 
-def build_pass(loc: Located, name: str, filter: str = "bilinear") -> PassUnit:
-    """Transform, type-check and prune pass ``name`` for the located node."""
+def build_pass(loc: Located, name: str, filter: str = "bilinear", depth_channel: Optional[int] = None) -> PassUnit:
+    """Transform, type-check and prune pass ``name`` for the located node (``depth_channel``:
+    the inverse depth packed into that payload channel; None: its own render target)."""
     spec = PASS_SPECS.get(name)
     if spec is None:
         raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(PASS_SPECS)}")
-    unit, form = transform(loc, name)
-    runtime = runtime_snippets(spec, filter)
+    unit, form = transform(loc, name, depth_channel)
+    runtime = runtime_snippets(spec, filter, depth_channel)
     snippet_decls = parse_source("#version 330 core\n" + runtime, "<rrcache runtime>").decls
     unit.decls[0:0] = snippet_decls
     try:

@@ -9,7 +9,8 @@ to the original shader), what the application must bind, and how the runtime mus
     variant = instance(analysed, node_id)            # rrcache.compiler.instance
     programs = variant.build_programs(ctx)
     rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h), period=16,
-                      payload_dtype=variant.payload_dtype)
+                      payload_dtype=variant.payload_dtype, payload_components=variant.components,
+                      depth_channel=variant.depth_channel)
     variant.write("out/", period=16)                 # the manifest records the period it ran with
 
 The refresh period and the cache's other run-time parameters are not part of a variant (the same
@@ -69,6 +70,9 @@ class Variant:
     # an amortized estimator (rrcache.compiler.amortize): {"estimator", "samples" (m), "of" (N),
     # "lambda", "phase", "cycle", "history", "accumulators"}; None for a cached node
     amortized: Optional[dict] = None
+    #: the payload channel holding the inverse depth (None: its own texture); the runtime must
+    #: be made with it (``CacheRuntime(..., depth_channel=variant.depth_channel)``)
+    depth_channel: Optional[int] = None
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -101,6 +105,7 @@ class Variant:
             "algorithm": self.algorithm,
             "filter": self.filter,
             "payload_dtype": self.payload_dtype,
+            "depth_channel": self.depth_channel,
             "default_period": DEFAULT_PERIOD,
             "period": int(period) if period is not None else DEFAULT_PERIOD,
             "passes": {

@@ -108,7 +108,8 @@ class CachedRenderer:
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
                 clear_color=session_background(session), color_format=color_format,
                 blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
-                phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1))
+                phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1),
+                depth_channel=getattr(variant, "depth_channel", None))
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:

@@ -27,6 +27,7 @@ from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
+from rrcache.model.psnr import frame_spread
 from rrcache.profiler.train import ProgressFn, TrainingResult, train
 from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
@@ -136,6 +137,9 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         node.errors = [r.mean_error for r in runs]
         node.hit_rates = [r.hit_rate for r in runs]
         node.psnrs = [r.psnr for r in runs]
+        # how much each run's mean error depends on the frames it covered (the PSNR's ±)
+        node.frame_spreads = [frame_spread([f.mean_error for f in store.error_frames(nid, r.period) if not f.left_out])
+                              for r in runs]
         if node.trained:
             ef, pf = result.error_fits[nid], result.perf_fits[nid]
             node.alpha, node.lam = float(ef.alpha), float(ef.lam)
@@ -160,7 +164,8 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts),
         ceiling=result.ceiling.to_json() if result.ceiling is not None else None,
         verdict=_verdict(result.ceiling) if result.stopped else None,
-        timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE)
+        timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE,
+        psnr_offset_db=_psnr_offset(store, settings, result))
     prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
     prof.path = out
     return prof
@@ -172,6 +177,32 @@ def _sets(prof: Profile, work, session, settings, store, progress) -> list:
     from rrcache.profiler.sets import train_sets
 
     return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+
+
+def _psnr_offset(store, settings, result: TrainingResult) -> float:
+    """The dB from the training runs' PSNRs (error window) to those of the region validation
+    measures (the timing window when there is one, else the frame):
+    :func:`rrcache.model.psnr.coverage_offset_db` of the covered fractions."""
+    import statistics
+
+    from rrcache.model.psnr import coverage_offset_db
+    from rrcache.profiler.train import _window_pixels
+
+    plan = result.plan
+    runs = [r for nid in result.trained for r in store.error_runs(nid) if r.frames > 0]
+    if plan is None or not runs:
+        return 0.0
+    width, height = settings.resolution
+    error_window = plan.error_window
+    train_area = error_window[2] * error_window[3] if error_window else width * height
+    train_covered = statistics.mean(r.covered / r.frames for r in runs)
+    if plan.timing_window is not None:
+        inside = _window_pixels(store, result.trained, settings)
+        check_covered = statistics.mean(inside.values()) if inside else 0.0
+        check_area = plan.timing_window[2] * plan.timing_window[3]
+    else:
+        check_covered, check_area = result.pixels, width * height
+    return coverage_offset_db(train_covered, train_area, check_covered, check_area)
 
 
 def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:

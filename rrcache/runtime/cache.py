@@ -108,7 +108,9 @@ class CacheRuntime:
     programs. ``size`` is (width, height). ``period`` (Δn), ``block`` (k), ``refresh`` and
     ``depth_epsilon`` can be changed between frames (they are uniforms or small textures).
     ``color_format`` (``rgba8``, ``rgba16f``, ``rgba32f``; :mod:`rrcache.gl.formats`) is the
-    format of the colour target the variant draws into. ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
+    format of the colour target the variant draws into. ``depth_channel`` is the variant's
+    (:attr:`rrcache.compiler.variant.Variant.depth_channel`): the payload channel its passes keep
+    the inverse depth in (one texture and render target fewer), None for its own texture. ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
     the application's culling state alone (the draw callback may set it per object).
     ``period`` given as a list or tuple (one Δn per node, with ``payload_components`` one count
     per node) makes the cache of a multi-node variant, a
@@ -153,6 +155,7 @@ class CacheRuntime:
         blend: float = 0.0,
         phase_cycle: int = 1,
         color_format: str = "rgba32f",
+        depth_channel: Optional[int] = None,
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -174,6 +177,11 @@ class CacheRuntime:
         if payload_components not in (1, 2, 3, 4):
             raise ValueError(f"payload_components must be 1 to 4, not {payload_components}")
         self.payload_components = int(payload_components)
+        if depth_channel is not None and (int(depth_channel) != self.payload_components or payload_dtype != "f4"):
+            raise ValueError(f"the inverse depth packs into channel {self.payload_components} of a 32-bit payload "
+                             f"(rrcache.runtime.glsl.depth_channel_for), not channel {depth_channel} of {payload_dtype}")
+        self.depth_channel = None if depth_channel is None else int(depth_channel)
+        self._check_depth_layout(programs)
         self.clear_color = clear_color
         self.cull_back_faces = cull_back_faces
         self.depth_epsilon = float(depth_epsilon)
@@ -197,6 +205,22 @@ class CacheRuntime:
         self.size = (0, 0)
         self.window: Optional[tuple[int, int, int, int]] = None
         self.resize(size)
+
+    def _check_depth_layout(self, programs) -> None:
+        """The pass that reads the previous frame's cache must read the inverse depth where this
+        runtime keeps it: a variant compiled with the inverse depth packed into the payload has
+        no ``rr_prevInvDepth`` (and a runtime made without its ``depth_channel`` would never
+        clear that channel: stale entries would hit)."""
+        first = programs.get(ALGORITHMS[self.algorithm][0])
+        if first is None or not hasattr(first, "__contains__"):
+            return
+        separate = G.PREV_INVDEPTH in first
+        if separate and self.depth_channel is not None:
+            raise ValueError("these programs read the inverse depth from its own texture: make the runtime "
+                             "without depth_channel (it must be the variant's depth_channel)")
+        if not separate and self.depth_channel is None and G.PREV_PAYLOAD in first:
+            raise ValueError("these programs keep the inverse depth in the payload: pass "
+                             "depth_channel=variant.depth_channel and payload_components=variant.components")
 
     def required_passes(self, algorithm: str, programs) -> tuple:
         """The programs ``algorithm`` needs (a multi-node runtime may run another layout)."""
@@ -242,21 +266,24 @@ class CacheRuntime:
         with target_guard((w, h), "cache size"):
             self.depth = ctx.depth_texture((w, h))
             self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
-            self._payload = [ctx.texture((w, h), self.payload_components, dtype=self.payload_dtype) for _ in range(2)]
-            self._invdepth = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
+            packed = self.depth_channel is not None
+            channels = self.payload_components + (1 if packed else 0)
+            self._payload = [ctx.texture((w, h), channels, dtype=self.payload_dtype) for _ in range(2)]
+            # packed: the inverse depth is the payload's channel depth_channel, no texture of its own
+            self._invdepth = [] if packed else [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
             for tex in self._payload + self._invdepth:
                 tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
                 tex.repeat_x = tex.repeat_y = False
+            depth_of = self._payload if packed else self._invdepth
+            cache = [[self._payload[i]] + ([] if packed else [self._invdepth[i]]) for i in range(2)]
             if self.algorithm == "three-pass":
-                self._cache_fbos = [ctx.framebuffer([self._payload[i], self._invdepth[i]], self.depth) for i in range(2)]
+                self._cache_fbos = [ctx.framebuffer(cache[i], self.depth) for i in range(2)]
             else:
-                self._cache_fbos = [
-                    ctx.framebuffer([self.color, self._payload[i], self._invdepth[i]], self.depth) for i in range(2)
-                ]
+                self._cache_fbos = [ctx.framebuffer([self.color] + cache[i], self.depth) for i in range(2)]
             # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
             # the colour to the background; the payload needs no clear (it is read only where the
-            # inverse depth says a surface was cached)
-            self._clear_fbos = [ctx.framebuffer([self._invdepth[i]], self.depth) for i in range(2)]
+            # inverse depth says a surface was cached; packed, it is cleared with it)
+            self._clear_fbos = [ctx.framebuffer([depth_of[i]], self.depth) for i in range(2)]
             self._out_fbo = ctx.framebuffer([self.color], self.depth)
             self._color_only_fbo = ctx.framebuffer([self.color])
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
@@ -290,8 +317,9 @@ class CacheRuntime:
     def bytes_per_pixel(self) -> int:
         """Memory per pixel of the cache's targets (depth, colour, two payloads, two inverse
         depths) plus the colour and depth read back (41): what :meth:`resize` checks first."""
-        payload = self.payload_components * (4 if self.payload_dtype == "f4" else 2)
-        return 4 + bytes_per_texel(self.color_format) + 2 * payload + 2 * 4 + 41
+        packed = getattr(self, "depth_channel", None) is not None
+        payload = (self.payload_components + (1 if packed else 0)) * (4 if self.payload_dtype == "f4" else 2)
+        return 4 + bytes_per_texel(self.color_format) + 2 * payload + (0 if packed else 2 * 4) + 41
 
     def reset(self) -> None:
         """Forget the cache: the next frame misses everywhere (as after a camera cut), and the
@@ -340,7 +368,8 @@ class CacheRuntime:
     def _bind_cache_uniforms(self, program: moderngl.Program) -> None:
         prev = 1 - self._index
         self._payload[prev].use(_UNIT_PREV_PAYLOAD)
-        self._invdepth[prev].use(_UNIT_PREV_INVDEPTH)
+        if self._invdepth:
+            self._invdepth[prev].use(_UNIT_PREV_INVDEPTH)
         if self.algorithm == "three-pass":
             self._payload[self._index].use(_UNIT_CUR_PAYLOAD)
         self._set(program, G.PREV_PAYLOAD, _UNIT_PREV_PAYLOAD)
@@ -446,7 +475,8 @@ class CacheRuntime:
         """The last frame's cache payload, float32 (height, width, 4; unused channels 0), row 0
         = top. Pixels where nothing was cached hold stale values: mask them with
         :meth:`read_inverse_depth` > 0."""
-        payload = self._read(self._payload[1 - self._index], self.payload_components)
+        payload = self._read(self._payload[1 - self._index], self.payload_components + (self.depth_channel is not None))
+        payload = payload[..., :self.payload_components]
         if self.payload_components < 4:
             payload = np.concatenate([payload, np.zeros(payload.shape[:2] + (4 - self.payload_components,), np.float32)], axis=-1)
         return payload
@@ -456,5 +486,7 @@ class CacheRuntime:
         ``current=True`` reads the target being written in the frame in progress (for
         ``after_first_pass`` diagnostics: after pass 1 it is non-zero exactly at the hits)."""
         index = self._index if current else 1 - self._index
+        if self.depth_channel is not None:
+            return self._read(self._payload[index], self.payload_components + 1)[..., self.depth_channel]
         return self._read(self._invdepth[index], 1)[..., 0]
 

@@ -18,12 +18,24 @@ Hit test for a fragment whose previous-frame clip position is ``rr_prevClip`` (d
 and the pixel is refreshed by the rule in :mod:`rrcache.runtime.refresh` (arithmetic on the
 block coordinates, no texture).
 
+Packed inverse depth (optional, ``instance(..., pack_depth=True)``): when the payload has a free
+channel (a float, vec2 or vec3 value in a 32-bit payload) the inverse depth can be kept in the
+payload texture's next channel (``depth_channel`` = the value's component count) instead of a
+texture of its own: one render target and one texture fetch fewer in the passes that write and
+read the cache. The values stored are the same 32-bit floats and the hits are the same (the
+images agree within 2e-4: llvmpipe filters a two- or four-channel float texture with other
+rounding). Measured on Marble's all-hit frame it was no faster on llvmpipe, so it is off by
+default. :func:`lookup_glsl` and :func:`output_glsl` take ``depth_channel`` (None: the separate
+``R32F`` texture).
+
 Payload reconstruction filters: ``nearest``, ``bilinear`` (hardware), and ``catmull-rom`` (a
 16-tap bicubic that blurs less under repeated resampling; its result is clamped to the range of
 the four bilinear neighbours so that its negative lobes cannot overshoot or pull in a value
 from across an edge).
 """
 from __future__ import annotations
+
+from typing import Optional
 
 from rrcache.runtime.refresh import REFRESH_GLSL
 
@@ -121,15 +133,26 @@ int rr_amortPhase(int period) {
 """
 
 
-def lookup_glsl(filter: str = "bilinear") -> str:
+_CHANNELS = "xyzw"
+
+
+def lookup_glsl(filter: str = "bilinear", depth_channel: Optional[int] = None) -> str:
     """Declarations and functions for a pass that reads the *previous* frame's cache:
     ``rr_hit()``, ``rr_refreshNow()`` and ``rr_previous()`` (valid after ``rr_hit()`` returned
-    true). Include it after the ``#version`` line of a fragment shader.
+    true). Include it after the ``#version`` line of a fragment shader. ``depth_channel``: the
+    payload channel holding the inverse depth (None: the texture ``rr_prevInvDepth``).
+
+    >>> "rr_prevInvDepth" in lookup_glsl(depth_channel=1), "texture(rr_prevPayload, rr_uv).y" in lookup_glsl(depth_channel=1)
+    (False, True)
     """
     if filter not in FILTERS:
         raise ValueError(f"cache filter must be one of {FILTERS}, not {filter!r}")
     body = {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM}[filter]
-    return _COMMON + body
+    common = _COMMON
+    if depth_channel is not None:
+        common = (common.replace("uniform sampler2D rr_prevInvDepth;\n", "")
+                  .replace("texture(rr_prevInvDepth, rr_uv).r", f"texture(rr_prevPayload, rr_uv).{_CHANNELS[depth_channel]}"))
+    return common + body
 
 
 def current_glsl() -> str:
@@ -138,12 +161,24 @@ def current_glsl() -> str:
     return "uniform sampler2D rr_curPayload;\n" + _CURRENT
 
 
-def output_glsl(first_location: int = 0) -> str:
-    """The cache outputs of a pass that writes the cache: payload and inverse depth."""
-    return (
-        f"layout(location = {first_location}) out vec4 rr_outPayload;\n"
-        f"layout(location = {first_location + 1}) out float rr_outInvDepth;\n"
-    )
+def output_glsl(first_location: int = 0, depth_channel: Optional[int] = None) -> str:
+    """The cache outputs of a pass that writes the cache: payload and inverse depth (with a
+    ``depth_channel``, the payload alone: the inverse depth is written into that channel)."""
+    out = f"layout(location = {first_location}) out vec4 rr_outPayload;\n"
+    if depth_channel is None:
+        out += f"layout(location = {first_location + 1}) out float rr_outInvDepth;\n"
+    return out
+
+
+def depth_channel_for(components: int, payload_dtype: str) -> Optional[int]:
+    """The payload channel the inverse depth is packed into for a value of ``components``
+    components: the next free one in a 32-bit payload, None when there is none (a vec4) or the
+    payload is 16-bit (the inverse depth needs 32 bits for the relative hit test).
+
+    >>> depth_channel_for(1, "f4"), depth_channel_for(3, "f4"), depth_channel_for(4, "f4"), depth_channel_for(1, "f2")
+    (1, 3, None, None)
+    """
+    return int(components) if int(components) < 4 and payload_dtype == "f4" else None
 
 
 def vertex_glsl() -> str:
