@@ -222,7 +222,7 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
     for f in result.frames:
         rate = "n/a" if f.hits is None else f"{f.hits / f.covered if f.covered else 0.0:.3f}"
         table.add_row(str(f.index), str(f.covered), rate, f"{f.mean_error:.5f}",
-                      psnr_text(f.psnr, unit=""), f"{f.ms:.2f}", f"{f.original_ms:.2f}")
+                      _psnr(f.psnr, unit=""), f"{f.ms:.2f}", f"{f.original_ms:.2f}")
     console.print(table)
     console.print(f"node {node}: {entry.text}", highlight=False, markup=False)
     lo, hi = summary["speedup_ci95"]
@@ -231,16 +231,19 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
               f"95% interval {lo:.2f}–{hi:.2f}")
     console.print(f"speed-up {summary['speedup']:.2f}× ({spread}; {summary['ms_per_frame']:.2f} ms vs "
                   f"{summary['original_ms_per_frame']:.2f} ms, medians), hit rate {summary['hit_rate']:.3f}, "
-                  f"mean error {summary['mean_error']:.5f}, PSNR {psnr_text(summary['psnr'])}", highlight=False)
+                  f"mean error {summary['mean_error']:.5f}, PSNR {_psnr(summary['psnr'])}", highlight=False)
     if summary["error_left_out_pixels"] or summary["nonfinite_pixels"]:
         console.print(f"NaN/Inf pixels: {summary['nonfinite_pixels']} in the variant, "
                       f"{summary['original_nonfinite_pixels']} in the original; the error leaves out "
                       f"{summary['error_left_out_pixels']} covered pixels", highlight=False)
 
 
-def psnr_text(value: Optional[float], unit: str = " dB") -> str:
-    """A PSNR for people: ``∞ (exact)`` for an image equal to the original's (None or ∞)."""
-    return "∞ (exact)" if value is None or math.isinf(value) else f"{value:.1f}{unit}"
+def _psnr(value: Optional[float], unit: str = " dB") -> str:
+    """A summary's PSNR (None: exact) as :func:`rrcache.model.psnr.psnr_text` shows it."""
+    from rrcache.model.psnr import psnr_text
+
+    text = psnr_text(math.inf if value is None else value)
+    return text if text.startswith(("∞", "–")) else text + unit
 
 
 def _render_nodes(work, loaded, nodes, entries, variant, out_dir, frame_count, resolution, as_json, opts,
@@ -286,11 +289,11 @@ def _render_nodes(work, loaded, nodes, entries, variant, out_dir, frame_count, r
     for f in result.frames:
         rate = "n/a" if f.hits is None else f"{f.hits / f.covered if f.covered else 0.0:.3f}"
         table.add_row(str(f.index), str(f.covered), rate, f"{f.mean_error:.5f}",
-                      psnr_text(f.psnr, unit=""), f"{f.ms:.2f}", f"{f.original_ms:.2f}")
+                      _psnr(f.psnr, unit=""), f"{f.ms:.2f}", f"{f.original_ms:.2f}")
     console.print(table)
     for n, e in zip(nodes, entries):
         console.print(f"node {n} ({e.type}, line {e.line}): {e.text}", highlight=False, markup=False)
     console.print(f"speed-up {summary['speedup']:.2f}× ({summary['ms_per_frame']:.2f} ms vs "
                   f"{summary['original_ms_per_frame']:.2f} ms, medians), hit rate "
-                  f"{summary['hit_rate']:.3f}, mean error {summary['mean_error']:.5f}, PSNR {psnr_text(summary['psnr'])}",
+                  f"{summary['hit_rate']:.3f}, mean error {summary['mean_error']:.5f}, PSNR {_psnr(summary['psnr'])}",
                   highlight=False)
