@@ -81,7 +81,7 @@ import numpy as np
 from rrcache.deep import deep
 from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
-from rrcache.glsl.printer import print_expr
+from rrcache.glsl.printer import memo_printer, print_expr
 
 from rrcache.glsl.ast import iter_exprs
 from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
@@ -280,12 +280,16 @@ def _bounded_texts(exprs):
             stack.append((node, True))
             stack.extend((c, False) for c in node.children() if id(c) not in size)
 
+    # each node's text is its operands' texts put together: printed once each (a node of at most
+    # _TEXT_NODES nodes has operands no larger, so the recursion is bounded)
+    pe = memo_printer()
+
     def text(e) -> str:
         n = size.get(id(e), 0)
         if n <= _TEXT_NODES:
-            return print_expr(e)
+            return pe(e)
         if isinstance(e, A.Binary) and size.get(id(e.right), _TEXT_NODES + 1) <= _TEXT_NODES:
-            return f"(... {n:,} nodes ...) {e.op} {print_expr(e.right)}"
+            return f"(... {n:,} nodes ...) {e.op} {pe(e.right)}"
         return f"(expression of {n:,} nodes)"
 
     return text

@@ -106,12 +106,22 @@ class _Template:
         if self.body is None:
             raise AssertionError(f"inlining template of {self.decl.name} used more often than it is called")
         self.uses -= 1
+        # nodes that share a location (an expression and its first operand) share its tagged
+        # copy too: locations are immutable
+        tagged: dict[int, tuple] = {}  # id(loc) -> (loc, kept alive so its id stays its own; copy)
+
+        def tag(loc):
+            pair = tagged.get(id(loc))
+            if pair is None:
+                pair = tagged[id(loc)] = (loc, with_chain(loc, site))
+            return pair[1]
+
         if self.uses > 0:
-            return clone(self.body, lambda loc: with_chain(loc, site))
+            return clone(self.body, tag)
         body, self.body = self.body, None
         for n in walk(body, decl_types=False):
             if n.loc is not None:
-                n.loc = with_chain(n.loc, site)
+                n.loc = tag(n.loc)
         return body
 
 

@@ -23,11 +23,12 @@ from __future__ import annotations
 
 import os
 import re
+from dataclasses import fields
 from typing import Optional
 
 from rrcache.glsl import ast as A
 from rrcache.glsl.ast import children, iter_exprs
-from rrcache.glsl.printer import print_expr
+from rrcache.glsl.printer import memo_printer
 
 __all__ = ["attach_source_text", "display_file"]
 
@@ -39,29 +40,46 @@ def _key(loc) -> Optional[tuple]:
     return (loc.file, loc.line, loc.col) if loc is not None else None
 
 
-def _is_temporary(e) -> bool:
-    return isinstance(e, A.Ident) and _GENERATED.match(e.name) is not None
+class _Compared(dict):
+    """``class -> which of op, name, value its nodes have`` (the attributes a match compares),
+    filled on first use; absent ones compare equal (both None)."""
+
+    def __missing__(self, cls: type) -> tuple[str, ...]:
+        names = {f.name for f in fields(cls)}
+        found = self[cls] = tuple(a for a in ("op", "name", "value")
+                                  if a in names or hasattr(cls, a))
+        return found
+
+
+_COMPARED = _Compared()
+_LITERALS = (A.IntLit, A.FloatLit, A.BoolLit)
 
 
 def _same_shape(analysed, original, depth: int = 0) -> bool:
     """Whether ``analysed`` is ``original`` with names replaced by the inliner's (renamed locals
     and parameters, hoisted call results) or the unroller's constants (compared to a bounded
     depth)."""
-    if _is_temporary(analysed):  # a renamed local or parameter, or a call's hoisted result
+    cls = analysed.__class__
+    if cls is A.Ident and analysed.name.startswith("_rr_") and _GENERATED.match(analysed.name):
+        # a renamed local or parameter, or a call's hoisted result
         return isinstance(original, (A.Ident, A.Call))
-    if isinstance(analysed, (A.IntLit, A.FloatLit, A.BoolLit)) and isinstance(original, A.Ident):
+    if isinstance(analysed, _LITERALS) and isinstance(original, A.Ident):
         return True  # an unrolled loop index or a constant argument
-    if type(analysed) is not type(original):
+    if cls is not original.__class__:
         return False
-    for attr in ("op", "name", "value"):
-        if getattr(analysed, attr, None) != getattr(original, attr, None):
+    for attr in _COMPARED[cls]:
+        if getattr(analysed, attr) != getattr(original, attr):
             return False
     if depth >= _MATCH_DEPTH:
         return True
-    a, o = list(children(analysed)), list(children(original))
-    a = [x for x in a if isinstance(x, A.Expr)]
-    o = [x for x in o if isinstance(x, A.Expr)]
-    return len(a) == len(o) and all(_same_shape(x, y, depth + 1) for x, y in zip(a, o))
+    a, o = children(analysed), children(original)  # an expression's children are expressions
+    if len(a) != len(o):
+        return False
+    depth += 1
+    for x, y in zip(a, o):
+        if not _same_shape(x, y, depth):
+            return False
+    return True
 
 
 def attach_source_text(table, original_unit: A.TranslationUnit) -> None:
@@ -75,6 +93,7 @@ def attach_source_text(table, original_unit: A.TranslationUnit) -> None:
     main_file = str(main_file) if main_file else None
     functions = {d.name for d in original_unit.decls if isinstance(d, A.FunctionDecl)}
     index: dict[tuple, list] = {}
+    printed = memo_printer()  # the original unit stays alive and unchanged meanwhile
     for e in iter_exprs(original_unit):
         k = _key(e.loc)
         if k is not None:
@@ -91,7 +110,9 @@ def attach_source_text(table, original_unit: A.TranslationUnit) -> None:
             continue
         for candidate in index.get(_key(loc), ()):
             if _same_shape(e, candidate):
-                entry.text = print_expr(candidate)
+                # the copies of one inlined or unrolled expression share its text, and a text
+                # is made of its operands' texts: each original expression is printed once
+                entry.text = printed(candidate)
                 break
         else:
             if "_rr_" in entry.text:  # made by a pass (``p *= 2.0`` → ``p * 2.0``): names as written

@@ -86,13 +86,19 @@ def print_expr(e: A.Expr, need: int = P_SEQUENCE) -> str:
     return f"({text})" if expr_precedence(e) < need else text
 
 
-def _dims(dims) -> str:
+def _dims(dims, pe=None) -> str:
+    pe = pe or print_expr
     if not dims:
         return ""
-    return "".join("[]" if d is None else f"[{print_expr(d)}]" for d in dims)
+    return "".join("[]" if d is None else f"[{pe(d)}]" for d in dims)
 
 
-def _expr(e: A.Expr) -> str:
+def _expr(e: A.Expr, pe=None) -> str:
+    """The text of ``e`` unparenthesised; its operands are printed by ``pe`` (default
+    :func:`print_expr`; :func:`memo_printer` passes its own, and then a ``Binary`` operand is
+    printed by ``pe`` instead of down the left spine, which gives the same text)."""
+    spine = pe is None
+    pe = pe or print_expr
     if isinstance(e, A.Ident):
         return e.name
     if isinstance(e, A.IntLit):
@@ -110,44 +116,67 @@ def _expr(e: A.Expr) -> str:
         tails = []
         while True:
             p = BINARY_PRECEDENCE[e.op]
-            tails.append(f" {e.op} {print_expr(e.right, p + 1)}")
+            tails.append(f" {e.op} {pe(e.right, p + 1)}")
             left = e.left
-            if isinstance(left, A.Binary) and BINARY_PRECEDENCE[left.op] >= p:
+            if spine and isinstance(left, A.Binary) and BINARY_PRECEDENCE[left.op] >= p:
                 e = left
                 continue
-            tails.append(print_expr(left, p))
+            tails.append(pe(left, p))
             break
         tails.reverse()
         return "".join(tails)
     if isinstance(e, A.Unary):
         if e.postfix:
-            return print_expr(e.operand, P_POSTFIX) + e.op
-        inner = print_expr(e.operand, P_UNARY)
+            return pe(e.operand, P_POSTFIX) + e.op
+        inner = pe(e.operand, P_UNARY)
         if e.op in ("+", "-", "++", "--") and inner[:1] in ("+", "-"):
             inner = f"({inner})"
         return e.op + inner
     if isinstance(e, A.Assign):
-        return f"{print_expr(e.target, P_TERNARY + 1)} {e.op} {print_expr(e.value, P_ASSIGN)}"
+        return f"{pe(e.target, P_TERNARY + 1)} {e.op} {pe(e.value, P_ASSIGN)}"
     if isinstance(e, A.Ternary):
-        return (f"{print_expr(e.cond, P_TERNARY + 1)} ? {print_expr(e.then, P_SEQUENCE)} : "
-                f"{print_expr(e.else_, P_ASSIGN)}")
+        return (f"{pe(e.cond, P_TERNARY + 1)} ? {pe(e.then, P_SEQUENCE)} : "
+                f"{pe(e.else_, P_ASSIGN)}")
     if isinstance(e, A.Sequence):
-        return ", ".join(print_expr(x, P_ASSIGN) for x in e.exprs)
+        return ", ".join(pe(x, P_ASSIGN) for x in e.exprs)
     if isinstance(e, A.Call):
-        args = ", ".join(print_expr(a, P_ASSIGN) for a in e.args)
-        return f"{e.name}{_dims(e.array_dims)}({args})"
+        args = ", ".join(pe(a, P_ASSIGN) for a in e.args)
+        return f"{e.name}{_dims(e.array_dims, pe)}({args})"
     if isinstance(e, (A.Field, A.Length, A.Index)):
-        obj = print_expr(e.obj, P_POSTFIX)
+        obj = pe(e.obj, P_POSTFIX)
         if isinstance(e.obj, (A.IntLit, A.FloatLit)) and not obj.startswith("("):
             obj = f"({obj})"
         if isinstance(e, A.Field):
             return f"{obj}.{e.name}"
         if isinstance(e, A.Length):
             return f"{obj}.length()"
-        return f"{obj}[{print_expr(e.index)}]"
+        return f"{obj}[{pe(e.index)}]"
     if isinstance(e, A.InitList):
-        return "{" + ", ".join(print_expr(x, P_ASSIGN) for x in e.items) + "}"
+        return "{" + ", ".join(pe(x, P_ASSIGN) for x in e.items) + "}"
     raise TypeError(f"cannot print {type(e).__name__} as an expression")
+
+
+def memo_printer():
+    """A :func:`print_expr` that remembers the text of every expression it prints (by ``id``),
+    so that printing every node of a tree, each with its operands, costs each node's own text
+    once. Only for a tree that stays alive and unchanged while the printer is used; recursive,
+    so for expressions of bounded depth (the node table's texts of at most a few hundred nodes).
+
+    >>> pe = memo_printer()
+    >>> e = A.Binary("*", A.Binary("+", A.Ident("a"), A.Ident("b")), A.Ident("c"))
+    >>> pe(e), pe(e.left), pe(e.left, P_POSTFIX)
+    ('(a + b) * c', 'a + b', '(a + b)')
+    """
+    cache: dict[int, str] = {}
+    get = cache.get
+
+    def pe(e: A.Expr, need: int = P_SEQUENCE) -> str:
+        text = get(id(e))
+        if text is None:
+            text = cache[id(e)] = _expr(e, pe)
+        return f"({text})" if expr_precedence(e) < need else text
+
+    return pe
 
 
 def _qualifiers(quals) -> str:
