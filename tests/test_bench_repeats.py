@@ -57,3 +57,14 @@ def test_classes():
 def test_the_original_is_its_own_class(runs):
     for r in rows(runs):
         assert (r["cls"] == "original") == (r["kind"] == "original")
+
+
+def test_summary_has_one_line_per_level_over_the_runs(runs, capsys):
+    from rrcache.bench.repeats import summary_markdown
+
+    table = rows(runs)
+    text = summary_markdown(table)
+    body = [line for line in text.splitlines()[2:] if line.startswith("| ")]
+    assert len(body) == 4 and all("| 2 |" in line for line in body)
+    main(["bench-repeats", "--summary", str(runs[0])])
+    assert capsys.readouterr().out.count("\n| marbled_sphere") == 4

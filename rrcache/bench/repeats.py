@@ -11,7 +11,8 @@ several times (:mod:`rrcache.profiler.validate`); here each is classed by those 
 - ``slowdown``: every repeat below 1.0×: validation should have fallen back, so this is a
   defect of the profiler, and :func:`slowdowns` lists it.
 
-:func:`rows` reads the folders; :func:`markdown` writes the table the README shows.
+:func:`rows` reads the folders; :func:`markdown` writes one line per shipped selection and
+:func:`summary_markdown` one line per scene and level over all the runs (the README's table).
 
 >>> classify(())
 'original'
@@ -100,3 +101,36 @@ def markdown(table: list[dict]) -> str:
     lines.append(f"{len(table)} shipped selections in {len({(r['scene'], r['run']) for r in table})} profiles; "
                  f"{len(bad)} measured slower than the original in every repeat.")
     return "\n".join(lines)
+
+
+def summary_markdown(table: list[dict]) -> str:
+    """One line per scene and level over every run: how many runs shipped what, the measured
+    speed-ups (lowest to highest run median, and the lowest single repeat) and the measured PSNR
+    range; the originals and fallbacks counted."""
+    groups: dict = {}
+    for r in table:
+        groups.setdefault((r["scene"], r["level"], r.get("min_psnr")), []).append(r)
+    lines = ["| scene | level | runs | shipped | measured speed-up (run medians) | lowest repeat | "
+             "PSNR dB (range) | fell back |", "|---|---|---|---|---|---|---|---|"]
+    for (scene, level, min_psnr), rs in groups.items():
+        cached = [r for r in rs if r["kind"] != "original"]
+        shipped = ", ".join(f"{k}× {n}" for n, k in _counts(r["cached"] if r["kind"] != "original"
+                                                            else "original" for r in rs))
+        medians = [r["speedup"] for r in cached if r["speedup"] is not None]
+        lows = [r["speedup_range"][0] for r in cached if r["speedup_range"]]
+        psnrs = [r["psnr"] for r in cached if r["psnr"] is not None]
+        span = lambda v, f: "–" if not v else (f(min(v)) if min(v) == max(v) else f"{f(min(v))}–{f(max(v))}")
+        speed = span(medians, lambda x: f"{x:.2f}×") if medians else "1.00× (original)"
+        psnr = span(psnrs, lambda x: f"{x:.1f}") if psnrs else "∞ (exact)"
+        label = level + (f" ≥{min_psnr:.0f} dB" if min_psnr else "")
+        lines.append(f"| {scene} | {label} | {len(rs)} | {shipped} | {speed} | "
+                     f"{'–' if not lows else f'{min(lows):.2f}×'} | {psnr} | "
+                     f"{sum(1 for r in rs if r.get('fallback'))} |")
+    return "\n".join(lines)
+
+
+def _counts(items) -> list[tuple[str, int]]:
+    out: dict = {}
+    for item in items:
+        out[item] = out.get(item, 0) + 1
+    return list(out.items())

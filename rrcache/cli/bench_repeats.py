@@ -17,16 +17,24 @@ import click
 @click.command("bench-repeats")
 @click.argument("profiles", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
-def command(profiles, as_json):
+@click.option("--summary", is_flag=True, help="One line per scene and level over all the runs.")
+def command(profiles, as_json, summary):
     """Tabulate the shipped selections of PROFILES (folders of repeated 'rrcache profile' runs):
     speed-ups measured beside the original (median and range of the repeats), PSNR, fallbacks,
     and whether any shipped a measured slowdown."""
-    from rrcache.bench.repeats import markdown, rows, slowdowns
+    from rrcache.bench.repeats import markdown, rows, slowdowns, summary_markdown
 
-    table = rows(profiles)
+    from pathlib import Path
+
+    done = [p for p in profiles if (Path(p) / "profile.json").is_file()]
+    for p in sorted(set(profiles) - set(done)):
+        click.echo(f"note: {p}: skipped, no profile.json yet (still running, or interrupted)", err=True)
+    if not done:
+        raise click.UsageError("none of the folders holds a profile.json")
+    table = rows(done)
     if as_json:
         click.echo(json.dumps(table))
     else:
-        click.echo(markdown(table))
+        click.echo(summary_markdown(table) if summary else markdown(table))
     if slowdowns(table):
         raise SystemExit(1)
