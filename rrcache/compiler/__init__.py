@@ -59,7 +59,7 @@ def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: 
 
 @deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> Variant:
+             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None, adaptive: bool = False) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 
     ``analysed`` is what the analysis returns (a checked, inlined and unrolled shader);
@@ -70,6 +70,9 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
     :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
     be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
+    ``adaptive``: the passes keep each entry's volatility and refresh by it
+    (:mod:`rrcache.runtime.adaptive`; three-pass and two-pass only); the runtime then takes a
+    ``threshold``.
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -77,6 +80,8 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
     if payload_dtype not in PAYLOAD_DTYPES:
         raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    if adaptive and algorithm == "one-pass":
+        raise ValueError("adaptive refresh runs with the three-pass and two-pass algorithms, not one-pass")
     check_algorithm(analysed, node_id, algorithm)
     loc = prepare(analysed, node_id)
     passes: dict[str, PassSource] = {}
@@ -85,8 +90,8 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     runtime: dict[str, list[str]] = {}
     forms: dict[str, str] = {}
     for name in ALGORITHMS[algorithm]:
-        built = build_pass(loc, name, filter)
-        out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, vertex)
+        built = build_pass(loc, name, filter, adaptive)
+        out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup or (adaptive and built.spec.cache), vertex)
         passes[name] = PassSource(out.vertex, out.fragment, out.line_map)
         uniforms[name], samplers[name], runtime[name] = out.uniforms, out.samplers, out.runtime
         forms[name] = built.form
@@ -95,7 +100,7 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
-        vertex_path=getattr(vertex, "path", None))
+        vertex_path=getattr(vertex, "path", None), adaptive=bool(adaptive))
 
 
 from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)

@@ -48,16 +48,23 @@ def _assign(name: str, value: A.Expr) -> A.ExprStmt:
     return A.ExprStmt(A.Assign("=", A.Ident(name), value))
 
 
-def cache_writes(payload: A.Expr) -> list[A.Stmt]:
-    """``rr_outPayload = payload; rr_outInvDepth = gl_FragCoord.w;``"""
-    return [_assign(G.OUT_PAYLOAD, payload),
-            _assign(G.OUT_INVDEPTH, A.Field(A.Ident("gl_FragCoord"), "w"))]
+def cache_writes(payload: A.Expr, state: Optional[A.Expr] = None) -> list[A.Stmt]:
+    """``rr_outPayload = payload; rr_outInvDepth = gl_FragCoord.w;`` (and ``rr_outState =
+    state;`` for an adaptive variant, :mod:`rrcache.runtime.adaptive`)"""
+    writes = [_assign(G.OUT_PAYLOAD, payload),
+              _assign(G.OUT_INVDEPTH, A.Field(A.Ident("gl_FragCoord"), "w"))]
+    if state is not None:
+        writes.append(_assign("rr_outState", state))
+    return writes
 
 
-def cache_init() -> list[A.Stmt]:
-    """``rr_outInvDepth = 0.0; rr_outPayload = vec4(0.0);``"""
-    return [_assign(G.OUT_INVDEPTH, float_lit(0.0)),
+def cache_init(adaptive: bool = False) -> list[A.Stmt]:
+    """``rr_outInvDepth = 0.0; rr_outPayload = vec4(0.0);`` (and ``rr_outState = 0.0;``)"""
+    init = [_assign(G.OUT_INVDEPTH, float_lit(0.0)),
             _assign(G.OUT_PAYLOAD, A.Call("vec4", [float_lit(0.0)]))]
+    if adaptive:
+        init.append(_assign("rr_outState", float_lit(0.0)))
+    return init
 
 
 def color_outputs(unit: A.TranslationUnit) -> list[A.VariableDecl]:

@@ -60,6 +60,7 @@ from rrcache.compiler.prune import prune
 from rrcache.compiler.replace import (
     NODE_VAR, current_value, node_variable, previous_payload, previous_value, replace_node,
 )
+from rrcache.runtime import adaptive as AD
 from rrcache.runtime import glsl as G
 
 
@@ -104,15 +105,20 @@ class PassUnit:
     form: str
 
 
-def runtime_snippets(spec: PassSpec, filter: str) -> str:
-    """The runtime GLSL a pass needs, in the order it is emitted."""
+def runtime_snippets(spec: PassSpec, filter: str, adaptive: bool = False) -> str:
+    """The runtime GLSL a pass needs, in the order it is emitted. An adaptive variant's passes
+    that write the cache all read the previous frame's too (the recomputing ones measure the
+    entry's change, :mod:`rrcache.runtime.adaptive`) and write the volatility after the inverse
+    depth."""
     text = ""
-    if spec.lookup:
-        text += G.lookup_glsl(filter)
+    if spec.lookup or (adaptive and spec.cache):
+        text += AD.lookup_glsl(G.lookup_glsl(filter)) if adaptive else G.lookup_glsl(filter)
     if spec.current:
         text += G.current_glsl()
     if spec.cache:
         text += G.output_glsl(spec.cache_location)
+        if adaptive:
+            text += AD.output_glsl(spec.cache_location + 2)
     return text
 
 
@@ -130,8 +136,13 @@ def _set(name: str, value: A.Expr) -> A.ExprStmt:
     return A.ExprStmt(A.Assign("=", A.Ident(name), value))
 
 
-def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
-    """The transformed (not yet checked or pruned) unit of pass ``name``, and the binding form."""
+def transform(loc: Located, name: str, adaptive: bool = False) -> tuple[A.TranslationUnit, str]:
+    """The transformed (not yet checked or pruned) unit of pass ``name``, and the binding form.
+    ``adaptive``: the cache writes carry the entry's volatility too
+    (:mod:`rrcache.runtime.adaptive`: the reprojected one at hits, the measured change where the
+    value is recomputed); the one-pass algorithm has no adaptive form."""
+    if adaptive and name == "single":
+        raise ValueError("adaptive refresh runs with the three-pass and two-pass algorithms, not one-pass")
     if name not in PASS_SPECS:
         raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(PASS_SPECS)}")
     spec = PASS_SPECS[name]
@@ -142,13 +153,14 @@ def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
         insert_before(site, [
             A.If(_miss_condition(), A.Discard()),
             declare(t, NODE_VAR, previous_value(n)),
-            *cache_writes(previous_payload()),
+            *cache_writes(previous_payload(), A.Ident("rr_carried") if adaptive else None),
         ])
         replace_node(site.stmt, node_variable)
         form = "replace"
     elif name in ("payload", "miss"):
+        fresh = (A.Call("rr_freshState", [pack(node_variable(), n)]) if adaptive else None)
         form = hoist(site, t, clone(loc.expr),
-                     then=cache_writes(pack(node_variable(), n)))
+                     then=cache_writes(pack(node_variable(), n), fresh))
     elif name == "shade":
         replace_node(site.stmt, lambda: current_value(n))
         form = "replace"
@@ -160,18 +172,19 @@ def transform(loc: Located, name: str) -> tuple[A.TranslationUnit, str]:
         if form == "hoist":
             move_feeders(site, setter, miss_branch, main_function(unit).body)
     if spec.cache:
-        main_function(unit).body.stmts[0:0] = cache_init()
+        main_function(unit).body.stmts[0:0] = cache_init(adaptive)
     set_color_output(unit, keep=spec.color, location=spec.color_location)
     return unit, form
 
 
-def build_pass(loc: Located, name: str, filter: str = "bilinear") -> PassUnit:
-    """Transform, type-check and prune pass ``name`` for the located node."""
+def build_pass(loc: Located, name: str, filter: str = "bilinear", adaptive: bool = False) -> PassUnit:
+    """Transform, type-check and prune pass ``name`` for the located node (``adaptive``: with
+    the adaptive refresh's volatility, :mod:`rrcache.runtime.adaptive`)."""
     spec = PASS_SPECS.get(name)
     if spec is None:
         raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(PASS_SPECS)}")
-    unit, form = transform(loc, name)
-    runtime = runtime_snippets(spec, filter)
+    unit, form = transform(loc, name, adaptive)
+    runtime = runtime_snippets(spec, filter, adaptive)
     snippet_decls = parse_source("#version 330 core\n" + runtime, "<rrcache runtime>").decls
     unit.decls[0:0] = snippet_decls
     try:

@@ -69,6 +69,8 @@ class Variant:
     # an amortized estimator (rrcache.compiler.amortize): {"estimator", "samples" (m), "of" (N),
     # "lambda", "phase", "cycle", "history", "accumulators"}; None for a cached node
     amortized: Optional[dict] = None
+    # adaptive refresh (rrcache.runtime.adaptive): the passes keep each entry's volatility
+    adaptive: bool = False
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -116,6 +118,7 @@ class Variant:
             "textures": sorted({s for names in self.samplers.values() for s in names}),
             **({"runtime": dict(runtime)} if runtime else {}),
             **({"amortized": dict(self.amortized)} if self.amortized else {}),
+            **({"adaptive": True} if self.adaptive else {}),
         }
 
     def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,
