@@ -33,6 +33,11 @@ one-pass (program ``single``): a dynamic branch in one shader.
 All passes rely on identical vertex processing to reproduce identical depths; the compiler emits
 one vertex shader for all of them.
 
+Adaptive refresh (a variant compiled with ``adaptive=True``; :mod:`rrcache.runtime.adaptive`):
+``threshold``, ``fast_period`` and ``spread`` make the runtime keep each entry's volatility in
+two more ``R32F`` targets (read: the previous frame's, unit 14; written after the inverse depth)
+and set the adaptive rule's uniforms each frame.
+
 Window: :meth:`CacheRuntime.set_window` restricts every pass (clears included) to a rectangle
 of the targets with the scissor test, at the targets' full pixel density; read-backs return
 only that rectangle. The profiler measures the error of a cache this way on part of the frame
