@@ -34,7 +34,7 @@ from rrcache.compiler import Variant, instance, instance_nodes
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
 from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
-from rrcache.selection import AmortizedLoop, CachedNode, Selection
+from rrcache.selection import AdaptiveNode, AmortizedLoop, CachedNode, Selection
 
 
 @dataclass
@@ -91,9 +91,10 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
 
 
 def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",
-                payload_dtype: str = "f4") -> Variant:
-    """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``)."""
-    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex)
+                payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
+    """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``;
+    ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule)."""
+    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex, adaptive)
 
 
 def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = "bilinear",
@@ -116,6 +117,11 @@ def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Varia
     if len(selection.parts) == 1 and isinstance(selection.parts[0], CachedNode):
         part = selection.parts[0]
         return variant_for(work, part.node, algorithm), int(part.period)
+    if len(selection.parts) == 1 and isinstance(selection.parts[0], AdaptiveNode):
+        # the runtime takes the threshold, fast period and spread from the part
+        # (rrcache.profiler.adaptive.runtime_kwargs)
+        part = selection.parts[0]
+        return variant_for(work, part.node, algorithm, adaptive=True), int(part.period)
     if selection.multi:  # several nodes, each at its own period (a list, in part order)
         return variant_for_nodes(work, list(selection.nodes), algorithm), list(selection.periods)
     if len(selection.parts) == 1 and isinstance(selection.parts[0], AmortizedLoop):

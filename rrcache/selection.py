@@ -124,8 +124,58 @@ class AmortizedLoop:
         return cls(estimator, samples, float(blend), history, phase, text)
 
 
+@dataclass(frozen=True)
+class AdaptiveNode:
+    """Part ``adaptive``: node ``node`` cached with adaptive refresh
+    (:mod:`rrcache.runtime.adaptive`): an entry whose value had changed by at least
+    ``threshold`` when last recomputed is recomputed every ``fast_period`` frames, the others
+    every ``period`` frames (the max age). ``text`` is the node's expression, for people.
+
+    >>> AdaptiveNode("n215", 100, 0.01, 8).describe()
+    'n215 adaptive ≥0.01 Δf=8 Δn=100'
+    """
+
+    KIND: ClassVar[str] = "adaptive"
+
+    node: str
+    period: int
+    threshold: float
+    fast_period: int = 4
+    spread: float = 0.0
+    text: Optional[str] = field(default=None, compare=False)
+
+    def key(self) -> tuple:
+        return (self.KIND, self.node, int(self.period), float(self.threshold), int(self.fast_period),
+                float(self.spread))
+
+    def describe(self) -> str:
+        spread = f" spread {self.spread:g}" if self.spread else ""
+        return f"{self.node} adaptive ≥{self.threshold:g} Δf={self.fast_period} Δn={self.period}{spread}"
+
+    @classmethod
+    def from_json(cls, data: dict, where: str) -> "AdaptiveNode":
+        _only(data, ("kind", "node", "period", "threshold", "fast_period", "spread", "text"), where)
+        node = data.get("node")
+        if not isinstance(node, str) or not node:
+            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
+        for key in ("period", "fast_period"):
+            value = data.get(key, 4 if key == "fast_period" else None)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise RRCacheError("must be a whole number >= 1", f"{where}.{key}")
+        for key in ("threshold", "spread"):
+            value = data.get(key, 0.0 if key == "spread" else None)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise RRCacheError("must be a finite number >= 0", f"{where}.{key}")
+        text = data.get("text")
+        if text is not None and not isinstance(text, str):
+            raise RRCacheError("must be a string or null", f"{where}.text")
+        return cls(node, data["period"], float(data["threshold"]), data.get("fast_period", 4),
+                   float(data.get("spread", 0.0)), text)
+
+
 #: part kind -> part class: the one place a new kind of choice is declared
-PART_KINDS: dict[str, type] = {CachedNode.KIND: CachedNode, AmortizedLoop.KIND: AmortizedLoop}
+PART_KINDS: dict[str, type] = {CachedNode.KIND: CachedNode, AmortizedLoop.KIND: AmortizedLoop,
+                               AdaptiveNode.KIND: AdaptiveNode}
 
 
 def _only(data: dict, keys: tuple, where: str) -> None:
@@ -238,7 +288,7 @@ class Selection:
     def _single(self) -> Optional[CachedNode]:
         if not self.parts:
             return None
-        if len(self.parts) == 1 and isinstance(self.parts[0], CachedNode):
+        if len(self.parts) == 1 and isinstance(self.parts[0], (CachedNode, AdaptiveNode)):
             return self.parts[0]
         raise RRCacheError(f"a selection of kind {self.kind!r} has no single node and period", "selection",
                            hint="read its parts")
@@ -254,6 +304,17 @@ class Selection:
         """The cached node's refresh period Δn (kind ``cache``); None for the original shader."""
         part = self._single()
         return int(part.period) if part is not None else None
+
+    @property
+    def threshold(self) -> Optional[float]:
+        """The adaptive refresh threshold (kind ``adaptive``); None for any other kind.
+
+        >>> Selection((AdaptiveNode("n1", 100, 0.02),), 0.01, 2.0, 1.5).threshold
+        0.02
+        """
+        if len(self.parts) == 1 and isinstance(self.parts[0], AdaptiveNode):
+            return float(self.parts[0].threshold)
+        return None
 
     @property
     def text(self) -> Optional[str]:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import click
 
+from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 
@@ -42,9 +43,10 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
 @include_dirs_option
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False), help="Output folder.")
+@adaptive_options
 @vert_option
 def command(shader, node, estimator, samples, blend, history, period, algorithm, filter_, payload, session, defines,
-            include_dirs, out_dir, vert):
+            include_dirs, out_dir, adaptive, fast_period, spread, vert):
     """Write the shaders of the variant of SHADER that caches --node (or amortizes --estimator),
     and a manifest."""
     from rrcache.pipeline import load_for_session, variant_for, variant_for_nodes
@@ -52,6 +54,7 @@ def command(shader, node, estimator, samples, blend, history, period, algorithm,
 
     if (not node) == (estimator is None):
         raise click.UsageError("give either --node or --estimator")
+    check_adaptive(adaptive, node, algorithm)
     loaded = load_session(session) if session else None
     work = load_for_session(shader, loaded, parse_defines(defines), include_dirs, vertex=vert)
     if estimator is not None:
@@ -78,8 +81,10 @@ def command(shader, node, estimator, samples, blend, history, period, algorithm,
         return
     node, period = node[0], periods[0]
     entry = work.node(node)
-    variant = variant_for(work, node, algorithm, filter_, payload)
-    written = variant.write(out_dir, period=period)
-    click.echo(f"{node} ({entry.type}, {shader}:{entry.line}:{entry.column}) cached with {algorithm} at Δn={period}:")
+    runtime = adaptive_kwargs({"threshold": adaptive, "fast_period": fast_period, "spread": spread})
+    variant = variant_for(work, node, algorithm, filter_, payload, adaptive=bool(runtime))
+    written = variant.write(out_dir, period=period, runtime=runtime or None)
+    click.echo(f"{node} ({entry.type}, {shader}:{entry.line}:{entry.column}) cached with {algorithm} at Δn={period}"
+               + (f", adaptive threshold {adaptive:g}, fast period {fast_period}" if runtime else "") + ":")
     for path in written:
         click.echo(f"  {path}")

@@ -41,6 +41,19 @@ def _periods(ctx, param, value):
     return parse_periods(value, param.opts[0])  # the option given: --periods or --timing-periods
 
 
+def _thresholds(ctx, param, value):
+    """``0.005,0.01`` → (0.005, 0.01): finite numbers >= 0."""
+    if value is None:
+        return None
+    try:
+        out = tuple(float(v) for v in value.split(",") if v.strip())
+    except ValueError:
+        raise click.BadParameter(f"{value!r} is not a comma-separated list of numbers (e.g. 0.005,0.01,0.02)") from None
+    if not out or any(not math.isfinite(v) or v < 0 for v in out):
+        raise click.BadParameter(f"{value!r}: give finite thresholds >= 0 (e.g. 0.005,0.01,0.02)")
+    return out
+
+
 def _seconds(ctx, param, value):
     if value is not None and not math.isfinite(value):
         raise click.BadParameter(f"{value} is not a finite number of seconds (e.g. 480)")
@@ -102,12 +115,16 @@ def _fmt(value, spec=".3g", none="–"):
               help="Train at most this many sets of several cached nodes predicted to improve the front "
                    "(default 3; 0: single nodes only).")
 @click.option("-D", "defines", multiple=True, metavar="NAME[=VALUE]", help="Define a preprocessor macro.")
+@click.option("--adaptive", "adaptive", default=None, metavar="LIST", callback=_thresholds,
+              help="After validation, measure each selection's node with adaptive refresh at these "
+                   "thresholds (e.g. 0.005,0.01,0.02) and keep it where faster at the same level "
+                   "(docs/adaptive.md).")
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
             algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, max_sets, defines, quiet, vert, include_dirs):
+            wait, max_sets, defines, adaptive, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -130,7 +147,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
             warnings.simplefilter("always")
             try:
                 prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
-                               vertex=vert, include_dirs=include_dirs, wait=wait)
+                               vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

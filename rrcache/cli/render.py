@@ -46,6 +46,7 @@ from rrcache.harness.renderer import frame_indices, render
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
+from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 
 
 @click.command("render")
@@ -81,10 +82,12 @@ from rrcache.session import load_session
 @click.option("--repeats", type=click.IntRange(min=1, max=50), default=1, show_default=True,
               help="With --node: run the side-by-side comparison this many times (the speed-up is the "
                    "median repeat, with the range).")
+@adaptive_options
 @quiet_option
 @vert_option
 def command(shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, node, period, algorithm,
-            block, refresh, filter_, payload, depth_epsilon, color_format, repeats, quiet, vert):
+            block, refresh, filter_, payload, depth_epsilon, color_format, repeats, adaptive, fast_period, spread,
+            quiet, vert):
     """Render SESSION through the fragment shader SHADER and report time and coverage per frame;
     with --node, compare the cached variant of that node with the original."""
     err_console = Console(stderr=True)
@@ -93,6 +96,7 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
         # a replay is exact (its images, its NaN/Inf counts need floats); a comparison with
         # --node is a timing: as applications draw, unless its images are written
         color_format = DEFAULT_TIMING_FORMAT if node and not out_dir else ERROR_FORMAT
+    check_adaptive(adaptive, node, algorithm)
     if node:
         periods = pair_periods(node, period, DEFAULT_PERIOD)
         if len(node) == 1:
@@ -102,7 +106,8 @@ def command(shader, session, out_dir, frame_count, resolution, as_json, defines,
         _render_cached(shader, loaded, parse_defines(defines), include_dirs, node, out_dir, frame_count, resolution, as_json,
                        dict(period=period, algorithm=algorithm, block=int(block), refresh=refresh,
                             filter=filter_, payload=payload, depth_epsilon=depth_epsilon,
-                            color_format=color_format, repeats=repeats), err_console, vert, quiet)
+                            color_format=color_format, repeats=repeats, threshold=adaptive,
+                            fast_period=fast_period, spread=spread), err_console, vert, quiet)
         return
     prepared = prepare_file(shader, loaded, parse_defines(defines), all_include_dirs(include_dirs, loaded), vertex=vert)
     indices = frame_indices(loaded, frame_count)
@@ -172,7 +177,8 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
                       err_console, quiet)
         return
     entry = work.node(node)
-    variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"])
+    adaptive = opts.get("threshold") is not None
+    variant = variant_for(work, node, opts["algorithm"], opts["filter"], opts["payload"], adaptive=adaptive)
     indices = frame_indices(loaded, frame_count)
     out = Path(out_dir) if out_dir else None
     if out is not None:
@@ -190,12 +196,14 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
                     write_image(stem.with_suffix(".png"), got.image)
                     write_image(out / f"original_{row.index:04d}.png", ref.image)
                 count["n"] += 1
-                reporter.update(f"[{repeat + 1}/{repeats}] caching {node} at Δn={opts['period']}", count["n"],
+                reporter.update(f"[{repeat + 1}/{repeats}] caching {node} at Δn={opts['period']}"
+                                + (f", adaptive {opts['threshold']:g}" if adaptive else ""), count["n"],
                                 len(indices))
 
             runs.append(compare(variant, loaded, work.prepared, indices, period=opts["period"], resolution=resolution,
                                 block=opts["block"], refresh=opts["refresh"], depth_epsilon=opts["depth_epsilon"],
-                                on_frame=done, color_format=opts["color_format"]))
+                                on_frame=done, color_format=opts["color_format"],
+                                **adaptive_kwargs(opts)))
     # the median repeat by speed-up stands for the run; the range is every repeat's
     speedups = sorted(r.speedup for r in runs)
     result = sorted(runs, key=lambda r: r.speedup)[len(runs) // 2]
@@ -212,11 +220,14 @@ def _render_cached(shader, loaded, defines, include_dirs, node, out_dir, frame_c
     if as_json:
         click.echo(json.dumps(finite_json(dict(
             frames=len(result.frames), resolution=list(result.resolution), node=node, period=opts["period"],
-            algorithm=opts["algorithm"], covered_pixels=[f.covered for f in result.frames], **summary))))
+            algorithm=opts["algorithm"], filter=opts["filter"], covered_pixels=[f.covered for f in result.frames],
+            **({"adaptive": adaptive_kwargs(opts)} if adaptive else {}), **summary))))
         return
     console = Console()
     table = Table(title=f"{work.prepared.path} caching {node} ({entry.type}, line {entry.line}) "
-                        f"at Δn={opts['period']}, {opts['algorithm']}")
+                        f"at Δn={opts['period']}, {opts['algorithm']}"
+                        + (f", adaptive threshold {opts['threshold']:g} (fast period {opts['fast_period']})"
+                           if adaptive else ""))
     for col in ("frame", "covered", "hit rate", "mean error", "PSNR dB", "ms", "original ms"):
         table.add_column(col, justify="right")
     for f in result.frames:

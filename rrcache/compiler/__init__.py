@@ -59,7 +59,8 @@ def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: 
 
 @deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None, pack_depth: bool = False) -> Variant:
+             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None, pack_depth: bool = False,
+             adaptive: bool = False) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 
     ``analysed`` is what the analysis returns (a checked, inlined and unrolled shader);
@@ -75,6 +76,9 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     runtime must be given); False (the default): its own render target. Packing saves a render
     target and a fetch but measured no faster on llvmpipe (docs/profiler_trust.md §9); it is
     there to be measured elsewhere (``rrcache bench-cache --breakdown --payloads f4,f4-packed``).
+    ``adaptive``: the passes keep each entry's volatility and refresh by it
+    (:mod:`rrcache.runtime.adaptive`; three-pass and two-pass only); the runtime then takes a
+    ``threshold``. Not with ``pack_depth``.
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -82,6 +86,10 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
     if payload_dtype not in PAYLOAD_DTYPES:
         raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    if adaptive and algorithm == "one-pass":
+        raise ValueError("adaptive refresh runs with the three-pass and two-pass algorithms, not one-pass")
+    if adaptive and pack_depth:
+        raise ValueError("adaptive refresh keeps the inverse depth in its own target: not with pack_depth")
     check_algorithm(analysed, node_id, algorithm)
     loc = prepare(analysed, node_id)
     depth_channel = depth_channel_for(loc.components, payload_dtype) if pack_depth else None
@@ -91,8 +99,8 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     runtime: dict[str, list[str]] = {}
     forms: dict[str, str] = {}
     for name in ALGORITHMS[algorithm]:
-        built = build_pass(loc, name, filter, depth_channel)
-        out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, vertex)
+        built = build_pass(loc, name, filter, depth_channel, adaptive)
+        out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup or (adaptive and built.spec.cache), vertex)
         passes[name] = PassSource(out.vertex, out.fragment, out.line_map)
         uniforms[name], samplers[name], runtime[name] = out.uniforms, out.samplers, out.runtime
         forms[name] = built.form
@@ -101,7 +109,7 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
-        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel)
+        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel, adaptive=bool(adaptive))
 
 
 from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)

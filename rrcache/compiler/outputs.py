@@ -49,10 +49,14 @@ def _assign(name: str, value: A.Expr) -> A.ExprStmt:
     return A.ExprStmt(A.Assign("=", A.Ident(name), value))
 
 
-def cache_writes(payload: A.Expr) -> list[A.Stmt]:
-    """``rr_outPayload = payload; rr_outInvDepth = gl_FragCoord.w;``"""
-    return [_assign(G.OUT_PAYLOAD, payload),
-            _assign(G.OUT_INVDEPTH, A.Field(A.Ident("gl_FragCoord"), "w"))]
+def cache_writes(payload: A.Expr, state: Optional[A.Expr] = None) -> list[A.Stmt]:
+    """``rr_outPayload = payload; rr_outInvDepth = gl_FragCoord.w;`` (and ``rr_outState =
+    state;`` for an adaptive variant, :mod:`rrcache.runtime.adaptive`)"""
+    writes = [_assign(G.OUT_PAYLOAD, payload),
+              _assign(G.OUT_INVDEPTH, A.Field(A.Ident("gl_FragCoord"), "w"))]
+    if state is not None:
+        writes.append(_assign("rr_outState", state))
+    return writes
 
 
 def packed_writes(value: A.Expr, components: int) -> list[A.Stmt]:
@@ -70,11 +74,16 @@ def packed_writes(value: A.Expr, components: int) -> list[A.Stmt]:
     return [_assign(G.OUT_PAYLOAD, A.Call("vec4", [value, A.Field(A.Ident("gl_FragCoord"), "w")] + rest))]
 
 
-def cache_init(packed: bool = False) -> list[A.Stmt]:
+def cache_init(packed: bool = False, adaptive: bool = False) -> list[A.Stmt]:
     """``rr_outInvDepth = 0.0; rr_outPayload = vec4(0.0);`` (``packed``: the inverse depth is in
-    the payload, whose zero then marks the entry invalid: ``rr_outPayload = vec4(0.0);``)."""
+    the payload, whose zero then marks the entry invalid: ``rr_outPayload = vec4(0.0);``;
+    ``adaptive``: and ``rr_outState = 0.0;``)."""
     init = [_assign(G.OUT_PAYLOAD, A.Call("vec4", [float_lit(0.0)]))]
-    return init if packed else [_assign(G.OUT_INVDEPTH, float_lit(0.0))] + init
+    if not packed:
+        init.insert(0, _assign(G.OUT_INVDEPTH, float_lit(0.0)))
+    if adaptive:
+        init.append(_assign("rr_outState", float_lit(0.0)))
+    return init
 
 
 def color_outputs(unit: A.TranslationUnit) -> list[A.VariableDecl]:

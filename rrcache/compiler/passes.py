@@ -62,6 +62,7 @@ from rrcache.compiler.prune import prune
 from rrcache.compiler.replace import (
     NODE_VAR, current_value, node_variable, previous_payload, previous_value, replace_node,
 )
+from rrcache.runtime import adaptive as AD
 from rrcache.runtime import glsl as G
 
 
@@ -106,16 +107,23 @@ class PassUnit:
     form: str
 
 
-def runtime_snippets(spec: PassSpec, filter: str, depth_channel: Optional[int] = None) -> str:
+def runtime_snippets(spec: PassSpec, filter: str, depth_channel: Optional[int] = None,
+                     adaptive: bool = False) -> str:
     """The runtime GLSL a pass needs, in the order it is emitted (``depth_channel``: the payload
-    channel holding the inverse depth, None for its own texture)."""
+    channel holding the inverse depth, None for its own texture). An adaptive variant's passes
+    that write the cache all read the previous frame's too (the recomputing ones measure the
+    entry's change, :mod:`rrcache.runtime.adaptive`) and write the volatility after the inverse
+    depth."""
     text = ""
-    if spec.lookup:
-        text += G.lookup_glsl(filter, depth_channel)
+    if spec.lookup or (adaptive and spec.cache):
+        lookup = G.lookup_glsl(filter, depth_channel)
+        text += AD.lookup_glsl(lookup) if adaptive else lookup
     if spec.current:
         text += G.current_glsl()
     if spec.cache:
         text += G.output_glsl(spec.cache_location, depth_channel)
+        if adaptive:
+            text += AD.output_glsl(spec.cache_location + 2)
     return text
 
 
@@ -133,10 +141,17 @@ def _set(name: str, value: A.Expr) -> A.ExprStmt:
     return A.ExprStmt(A.Assign("=", A.Ident(name), value))
 
 
-def transform(loc: Located, name: str, depth_channel: Optional[int] = None) -> tuple[A.TranslationUnit, str]:
+def transform(loc: Located, name: str, depth_channel: Optional[int] = None,
+              adaptive: bool = False) -> tuple[A.TranslationUnit, str]:
     """The transformed (not yet checked or pruned) unit of pass ``name``, and the binding form
     (``depth_channel``: the inverse depth packed into that payload channel, None: its own
-    output)."""
+    output). ``adaptive``: the cache writes carry the entry's volatility too
+    (:mod:`rrcache.runtime.adaptive`: the reprojected one at hits, the measured change where the
+    value is recomputed); the one-pass algorithm has no adaptive form, nor a packed depth."""
+    if adaptive and name == "single":
+        raise ValueError("adaptive refresh runs with the three-pass and two-pass algorithms, not one-pass")
+    if adaptive and depth_channel is not None:
+        raise ValueError("adaptive refresh keeps the inverse depth in its own target: not packed")
     if name not in PASS_SPECS:
         raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(PASS_SPECS)}")
     spec = PASS_SPECS[name]
@@ -151,12 +166,15 @@ def transform(loc: Located, name: str, depth_channel: Optional[int] = None) -> t
         insert_before(site, [
             A.If(_miss_condition(), A.Discard()),
             declare(t, NODE_VAR, previous_value(n)),
-            *(cache_writes(previous_payload()) if depth_channel is None else packed_writes(previous_value(n), n)),
+            *(cache_writes(previous_payload(), A.Ident("rr_carried") if adaptive else None)
+              if depth_channel is None else packed_writes(previous_value(n), n)),
         ])
         replace_node(site.stmt, node_variable)
         form = "replace"
     elif name in ("payload", "miss"):
-        form = hoist(site, t, clone(loc.expr), then=writes(node_variable()))
+        fresh = (A.Call("rr_freshState", [pack(node_variable(), n)]) if adaptive else None)
+        form = hoist(site, t, clone(loc.expr),
+                     then=cache_writes(pack(node_variable(), n), fresh) if adaptive else writes(node_variable()))
     elif name == "shade":
         replace_node(site.stmt, lambda: current_value(n))
         form = "replace"
@@ -168,19 +186,21 @@ def transform(loc: Located, name: str, depth_channel: Optional[int] = None) -> t
         if form == "hoist":
             move_feeders(site, setter, miss_branch, main_function(unit).body)
     if spec.cache:
-        main_function(unit).body.stmts[0:0] = cache_init(packed=depth_channel is not None)
+        main_function(unit).body.stmts[0:0] = cache_init(packed=depth_channel is not None, adaptive=adaptive)
     set_color_output(unit, keep=spec.color, location=spec.color_location)
     return unit, form
 
 
-def build_pass(loc: Located, name: str, filter: str = "bilinear", depth_channel: Optional[int] = None) -> PassUnit:
+def build_pass(loc: Located, name: str, filter: str = "bilinear", depth_channel: Optional[int] = None,
+               adaptive: bool = False) -> PassUnit:
     """Transform, type-check and prune pass ``name`` for the located node (``depth_channel``:
-    the inverse depth packed into that payload channel; None: its own render target)."""
+    the inverse depth packed into that payload channel; None: its own render target;
+    ``adaptive``: with the adaptive refresh's volatility, :mod:`rrcache.runtime.adaptive`)."""
     spec = PASS_SPECS.get(name)
     if spec is None:
         raise ValueError(f"unknown pass {name!r}; expected one of {', '.join(PASS_SPECS)}")
-    unit, form = transform(loc, name, depth_channel)
-    runtime = runtime_snippets(spec, filter, depth_channel)
+    unit, form = transform(loc, name, depth_channel, adaptive)
+    runtime = runtime_snippets(spec, filter, depth_channel, adaptive)
     snippet_decls = parse_source("#version 330 core\n" + runtime, "<rrcache runtime>").decls
     unit.decls[0:0] = snippet_decls
     try:

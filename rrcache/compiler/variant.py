@@ -73,6 +73,8 @@ class Variant:
     #: the payload channel holding the inverse depth (None: its own texture); the runtime must
     #: be made with it (``CacheRuntime(..., depth_channel=variant.depth_channel)``)
     depth_channel: Optional[int] = None
+    # adaptive refresh (rrcache.runtime.adaptive): the passes keep each entry's volatility
+    adaptive: bool = False
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -121,6 +123,7 @@ class Variant:
             "textures": sorted({s for names in self.samplers.values() for s in names}),
             **({"runtime": dict(runtime)} if runtime else {}),
             **({"amortized": dict(self.amortized)} if self.amortized else {}),
+            **({"adaptive": True} if self.adaptive else {}),
         }
 
     def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,

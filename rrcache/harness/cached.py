@@ -31,6 +31,7 @@ from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
+from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD, DEFAULT_SPREAD
 from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
 
 def _unreliable() -> float:
@@ -78,7 +79,8 @@ class CachedRenderer:
                  depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
-                 color_format: str = "rgba32f"):
+                 color_format: str = "rgba32f", threshold: Optional[float] = None,
+                 fast_period: int = DEFAULT_FAST_PERIOD, spread: float = DEFAULT_SPREAD):
         self.ctx = ctx or get_context()
         self.color_format = color_format
         self.variant = variant
@@ -109,7 +111,8 @@ class CachedRenderer:
                 clear_color=session_background(session), color_format=color_format,
                 blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
                 phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1),
-                depth_channel=getattr(variant, "depth_channel", None))
+                depth_channel=getattr(variant, "depth_channel", None),
+                threshold=threshold, fast_period=fast_period, spread=spread)
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:
@@ -396,19 +399,23 @@ def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_P
             resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
             depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
-            window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f") -> Comparison:
+            window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f",
+            threshold: Optional[float] = None, fast_period: int = DEFAULT_FAST_PERIOD,
+            spread: float = DEFAULT_SPREAD) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
     is called per frame (for progress bars and writing images). ``window``: both render only
     that rectangle of the frame (errors and times are then the window's). ``color_format``: the
     colour target both draw into (:mod:`rrcache.gl.formats`; ``rgba8`` as an application draws,
-    the error then being what it displays)."""
+    the error then being what it displays). ``threshold``, ``fast_period``, ``spread``: the
+    adaptive refresh of a variant compiled for it (:mod:`rrcache.runtime.adaptive`)."""
     result = Comparison()
     result.color_format = color_format
     with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
             CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
                            depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window,
-                           color_format=color_format) as cached:
+                           color_format=color_format, threshold=threshold, fast_period=fast_period,
+                           spread=spread) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:

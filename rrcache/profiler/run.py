@@ -47,7 +47,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None) -> Profile:
+            vertex=None, adaptive=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -55,7 +55,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     raises an error naming it, or with ``wait=True`` waits. ``vertex`` is the user's vertex shader
     file (None: the session's ``"vertex"``, else generated). ``progress`` receives :class:`~rrcache.profiler.train.ProgressEvent`
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
-    propagates.
+    propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
+    with adaptive refresh at these thresholds and replaced where that was measured faster at the
+    same level (:mod:`rrcache.profiler.adaptive`).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -84,6 +86,11 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             from rrcache.profiler.amortize import train_estimators
             prof.estimators = train_estimators(work, session, resolved, store, result, progress)
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+            if adaptive and prof.selections and resolved.validate:
+                from rrcache.profiler.adaptive import extend
+
+                prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
+                                         window=result.plan.timing_window if result.plan is not None else None)
             _write_outputs(prof, out, work, plots)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
@@ -252,7 +259,9 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
             prof.write_variant(sel, folder)
         else:
             variant, period = variant_for_selection(work, sel)
-            variant.write(folder, period=period, runtime=prof.settings.cache_options())
+            from rrcache.profiler.adaptive import runtime_kwargs
+
+            variant.write(folder, period=period, runtime=dict(prof.settings.cache_options(), **runtime_kwargs(sel)))
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out

@@ -33,6 +33,11 @@ one-pass (program ``single``): a dynamic branch in one shader.
 All passes rely on identical vertex processing to reproduce identical depths; the compiler emits
 one vertex shader for all of them.
 
+Adaptive refresh (a variant compiled with ``adaptive=True``; :mod:`rrcache.runtime.adaptive`):
+``threshold``, ``fast_period`` and ``spread`` make the runtime keep each entry's volatility in
+two more ``R32F`` targets (read: the previous frame's, unit 14; written after the inverse depth)
+and set the adaptive rule's uniforms each frame.
+
 Window: :meth:`CacheRuntime.set_window` restricts every pass (clears included) to a rectangle
 of the targets with the scissor test, at the targets' full pixel density; read-backs return
 only that rectangle. The profiler measures the error of a cache this way on part of the frame
@@ -60,6 +65,7 @@ from rrcache.gl.formats import bytes_per_texel, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.runtime import glsl as G
+from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD, DEFAULT_SPREAD, adaptive_uniforms
 from rrcache.runtime.refresh import BLOCK_SIZES, REFRESH_MODES, refresh_uniforms
 
 ALGORITHMS = {
@@ -83,7 +89,7 @@ DEFAULT_DEPTH_EPSILON = 1e-3
 
 DrawCallback = Callable[[moderngl.Program, str], None]
 
-_UNIT_PREV_PAYLOAD, _UNIT_PREV_INVDEPTH, _UNIT_CUR_PAYLOAD = 12, 13, 15
+_UNIT_PREV_PAYLOAD, _UNIT_PREV_INVDEPTH, _UNIT_PREV_STATE, _UNIT_CUR_PAYLOAD = 12, 13, 14, 15
 
 
 @dataclass
@@ -156,6 +162,9 @@ class CacheRuntime:
         phase_cycle: int = 1,
         color_format: str = "rgba32f",
         depth_channel: Optional[int] = None,
+        threshold: Optional[float] = None,
+        fast_period: int = DEFAULT_FAST_PERIOD,
+        spread: float = DEFAULT_SPREAD,
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
@@ -168,6 +177,17 @@ class CacheRuntime:
             raise ValueError(f"refresh must be one of {REFRESH_MODES}, not {refresh!r}")
         if block not in BLOCK_SIZES:
             raise ValueError(f"block must be one of {BLOCK_SIZES}, not {block}")
+        # adaptive refresh (rrcache.runtime.adaptive): a variant compiled for it declares
+        # rr_threshold and needs one (and the volatility targets); any other variant takes none
+        compiled_adaptive = any("rr_threshold" in programs[p] for p in self.required_passes(algorithm, programs))
+        if compiled_adaptive and threshold is None:
+            raise ValueError("this variant was compiled for adaptive refresh: give a threshold")
+        if threshold is not None and not compiled_adaptive:
+            raise ValueError("a threshold needs a variant compiled with adaptive=True")
+        self.adaptive = threshold is not None
+        self.threshold = float(threshold) if threshold is not None else None
+        self.fast_period = check_period(fast_period, "fast_period", MAX_RUNTIME_PERIOD) if self.adaptive else 1
+        self.spread = float(spread)
         self.ctx = ctx
         self.color_format = color_format
         self._color_dtype = color_dtype(color_format)
@@ -271,22 +291,26 @@ class CacheRuntime:
             self._payload = [ctx.texture((w, h), channels, dtype=self.payload_dtype) for _ in range(2)]
             # packed: the inverse depth is the payload's channel depth_channel, no texture of its own
             self._invdepth = [] if packed else [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
-            for tex in self._payload + self._invdepth:
+            # adaptive refresh: each entry's volatility, written after the inverse depth
+            self._state = [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)] if self.adaptive else []
+            state = [[t] for t in self._state] if self.adaptive else [[], []]
+            for tex in self._payload + self._invdepth + self._state:
                 tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
                 tex.repeat_x = tex.repeat_y = False
             depth_of = self._payload if packed else self._invdepth
             cache = [[self._payload[i]] + ([] if packed else [self._invdepth[i]]) for i in range(2)]
             if self.algorithm == "three-pass":
-                self._cache_fbos = [ctx.framebuffer(cache[i], self.depth) for i in range(2)]
+                self._cache_fbos = [ctx.framebuffer(cache[i] + state[i], self.depth) for i in range(2)]
             else:
-                self._cache_fbos = [ctx.framebuffer([self.color] + cache[i], self.depth) for i in range(2)]
+                self._cache_fbos = [ctx.framebuffer([self.color] + cache[i] + state[i], self.depth)
+                                    for i in range(2)]
             # cleared each frame: inverse depth to 0 ("nothing cached here") with the depth buffer, and
             # the colour to the background; the payload needs no clear (it is read only where the
             # inverse depth says a surface was cached; packed, it is cleared with it)
             self._clear_fbos = [ctx.framebuffer([depth_of[i]], self.depth) for i in range(2)]
             self._out_fbo = ctx.framebuffer([self.color], self.depth)
             self._color_only_fbo = ctx.framebuffer([self.color])
-        self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._cache_fbos,
+        self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._state, *self._cache_fbos,
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
         if self.window is not None:
             try:
@@ -319,7 +343,8 @@ class CacheRuntime:
         depths) plus the colour and depth read back (41): what :meth:`resize` checks first."""
         packed = getattr(self, "depth_channel", None) is not None
         payload = (self.payload_components + (1 if packed else 0)) * (4 if self.payload_dtype == "f4" else 2)
-        return 4 + bytes_per_texel(self.color_format) + 2 * payload + (0 if packed else 2 * 4) + 41
+        state = 2 * 4 if getattr(self, "adaptive", False) else 0
+        return 4 + bytes_per_texel(self.color_format) + 2 * payload + (0 if packed else 2 * 4) + state + 41
 
     def reset(self) -> None:
         """Forget the cache: the next frame misses everywhere (as after a camera cut), and the
@@ -377,6 +402,11 @@ class CacheRuntime:
         self._set(program, G.CUR_PAYLOAD, _UNIT_CUR_PAYLOAD)
         for name, value in self._refresh_values.items():
             self._set(program, name, value)
+        if self.adaptive:
+            self._state[prev].use(_UNIT_PREV_STATE)
+            self._set(program, "rr_prevState", _UNIT_PREV_STATE)
+            for name, value in self._adaptive_values.items():
+                self._set(program, name, value)
         self._set(program, "rr_valid", self._valid)
         self._set(program, "rr_depthEpsilon", self.depth_epsilon)
         # amortized sampling (rrcache.compiler.amortize): the frame picks the subset, λ the blend
@@ -414,6 +444,10 @@ class CacheRuntime:
         # the refresh rule's uniforms, once per frame for every pass
         self._refresh_values = refresh_uniforms(self.size, self._block, self._refresh_mode, self.seed,
                                                 self._period, self.clock)
+        if self.adaptive:
+            self._adaptive_values = adaptive_uniforms(self.size, self._block, self._refresh_mode, self.seed,
+                                                      self.fast_period, self.clock, self.threshold, self.spread,
+                                                      self.payload_components)
         mark("clear")
         covered = misses = None
         if self.algorithm == "three-pass":

@@ -39,7 +39,7 @@ from typing import Optional
 
 from rrcache.runtime.refresh import REFRESH_GLSL
 
-FILTERS = ("nearest", "bilinear", "catmull-rom")
+FILTERS = ("nearest", "bilinear", "catmull-rom", "edge")
 
 # Names the runtime binds. Kept in one place so the compiler and the runtime agree.
 PREV_PAYLOAD = "rr_prevPayload"
@@ -112,6 +112,47 @@ vec4 rr_previous() {
 }
 """
 
+_EDGE = """
+vec4 rr_edgeWeights;
+ivec2 rr_edgeBase;
+bool rr_edgeFull;
+
+bool rr_hit() {
+    if (!rr_valid || rr_prevClip.w <= 0.0) return false;
+    rr_uv = rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5;
+    if (any(lessThan(rr_uv, vec2(0.0))) || any(greaterThan(rr_uv, vec2(1.0)))) return false;
+    float expected = 1.0 / rr_prevClip.w;
+    float tolerance = rr_depthEpsilon * expected;
+    rr_edgeFull = abs(texture(rr_prevInvDepth, rr_uv).r - expected) <= tolerance;
+    if (rr_edgeFull) return true;
+    ivec2 size = textureSize(rr_prevInvDepth, 0);
+    vec2 p = rr_uv * vec2(size) - 0.5;
+    rr_edgeBase = ivec2(floor(p));
+    vec2 f = p - vec2(rr_edgeBase);
+    ivec2 hi = size - 1;
+    vec4 d = vec4(texelFetch(rr_prevInvDepth, clamp(rr_edgeBase, ivec2(0), hi), 0).r,
+                  texelFetch(rr_prevInvDepth, clamp(rr_edgeBase + ivec2(1, 0), ivec2(0), hi), 0).r,
+                  texelFetch(rr_prevInvDepth, clamp(rr_edgeBase + ivec2(0, 1), ivec2(0), hi), 0).r,
+                  texelFetch(rr_prevInvDepth, clamp(rr_edgeBase + ivec2(1, 1), ivec2(0), hi), 0).r);
+    vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    vec4 ok = vec4(lessThanEqual(abs(d - vec4(expected)), vec4(2.0 * tolerance)));
+    rr_edgeWeights = w * ok;
+    float total = dot(rr_edgeWeights, vec4(1.0));
+    if (total <= 0.0) return false;
+    rr_edgeWeights /= total;
+    return true;
+}
+
+vec4 rr_previous() {
+    if (rr_edgeFull) return texture(rr_prevPayload, rr_uv);
+    ivec2 hi = textureSize(rr_prevPayload, 0) - 1;
+    return rr_edgeWeights.x * texelFetch(rr_prevPayload, clamp(rr_edgeBase, ivec2(0), hi), 0)
+         + rr_edgeWeights.y * texelFetch(rr_prevPayload, clamp(rr_edgeBase + ivec2(1, 0), ivec2(0), hi), 0)
+         + rr_edgeWeights.z * texelFetch(rr_prevPayload, clamp(rr_edgeBase + ivec2(0, 1), ivec2(0), hi), 0)
+         + rr_edgeWeights.w * texelFetch(rr_prevPayload, clamp(rr_edgeBase + ivec2(1, 1), ivec2(0), hi), 0);
+}
+"""
+
 _CURRENT = """
 vec4 rr_current() {
     return texelFetch(rr_curPayload, ivec2(gl_FragCoord.xy), 0);
@@ -147,6 +188,8 @@ def lookup_glsl(filter: str = "bilinear", depth_channel: Optional[int] = None) -
     """
     if filter not in FILTERS:
         raise ValueError(f"cache filter must be one of {FILTERS}, not {filter!r}")
+    if filter == "edge":  # its own hit test (and the common one's declarations before it)
+        return _COMMON.split("\nbool rr_hit()")[0] + "\n" + _EDGE
     body = {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM}[filter]
     common = _COMMON
     if depth_channel is not None:
