@@ -94,7 +94,7 @@ def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", f
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``;
     ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule)."""
-    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex, adaptive)
+    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex, adaptive=adaptive)
 
 
 def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = "bilinear",

@@ -179,7 +179,8 @@ class CacheRuntime:
             raise ValueError(f"block must be one of {BLOCK_SIZES}, not {block}")
         # adaptive refresh (rrcache.runtime.adaptive): a variant compiled for it declares
         # rr_threshold and needs one (and the volatility targets); any other variant takes none
-        compiled_adaptive = any("rr_threshold" in programs[p] for p in self.required_passes(algorithm, programs))
+        compiled_adaptive = any(programs[p] is not None and "rr_threshold" in programs[p]
+                                for p in self.required_passes(algorithm, programs))
         if compiled_adaptive and threshold is None:
             raise ValueError("this variant was compiled for adaptive refresh: give a threshold")
         if threshold is not None and not compiled_adaptive:
