@@ -56,16 +56,8 @@ uniform float rr_spread;
 uniform vec4 rr_stateMask;
 float rr_carried = 0.0;
 
-bool rr_fastRefreshNow() {
-    ivec2 b = ivec2(gl_FragCoord.xy) >> rr_blockShift;
-    uint x = (uint(b.x) * 0x8da6b343u) ^ (uint(b.y) * 0xd8163841u) ^ rr_seed;
-    x ^= x >> 16u;
-    x *= 0x7feb352du;
-    x ^= x >> 15u;
-    x *= 0x846ca68bu;
-    x ^= x >> 16u;
-    float u = rr_tiled ? float(b.y * rr_blockColumns + b.x) + 0.5 : float(x >> 8u);
-    return min(int(u * rr_fastScale), rr_fastPeriod - 1) == rr_fastPhase;
+bool rr_fastRefreshNow() {  // the fixed rule's block ranks (runtime/refresh.py) at the fast period
+    return min(int(rr_blockRank() * rr_fastScale), rr_fastPeriod - 1) == rr_fastPhase;
 }
 
 bool rr_refreshNow() {

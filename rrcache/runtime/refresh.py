@@ -42,7 +42,8 @@ uniform uint rr_seed;
 uniform float rr_refreshScale;
 uniform int rr_blockColumns;
 
-bool rr_refreshNow() {
+// the block's rank: its hash (random) or its index (tiled); a period's phases split the ranks
+float rr_blockRank() {
     ivec2 b = ivec2(gl_FragCoord.xy) >> rr_blockShift;
     uint x = (uint(b.x) * 0x8da6b343u) ^ (uint(b.y) * 0xd8163841u) ^ rr_seed;
     x ^= x >> 16u;
@@ -50,8 +51,11 @@ bool rr_refreshNow() {
     x ^= x >> 15u;
     x *= 0x846ca68bu;
     x ^= x >> 16u;
-    float u = rr_tiled ? float(b.y * rr_blockColumns + b.x) + 0.5 : float(x >> 8u);
-    return min(int(u * rr_refreshScale), rr_period - 1) == rr_refreshPhase;
+    return rr_tiled ? float(b.y * rr_blockColumns + b.x) + 0.5 : float(x >> 8u);
+}
+
+bool rr_refreshNow() {
+    return min(int(rr_blockRank() * rr_refreshScale), rr_period - 1) == rr_refreshPhase;
 }
 """
 
