@@ -34,7 +34,7 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.model.amortize import TRAIN_BLENDS, fit_amortized_error, fit_amortized_time, training_samples
-from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn, timing_frame_indices
+from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn, timed_beside, timing_frame_indices
 from rrcache.profiles import amortize as data
 from rrcache.profiles.amortize import EstimatorProfile
 from rrcache.runtime import DEFAULT_PERIOD
@@ -172,10 +172,7 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
                 # first draw compiles it, 100-300 ms on a 1 ms shader)
                 out = []
                 for index in timing:
-                    ref = original.render_frame(index)
-                    cached.reset()
-                    cached.render_frame(index - 1)
-                    got = cached.render_frame(index)
+                    got, ref = timed_beside(cached, original, index)
                     out.append((index, got, ref.ms))
                     step(f"{est.id} m={m} timing", 3)
             wall = (clock() - start) / max(1, len(out))

@@ -209,15 +209,21 @@ def _error_run(cached: CachedRenderer, node_id: str, period: int, refs: list, me
     return run, frames
 
 
+def timed_beside(cached: CachedRenderer, original: Renderer, index: int):
+    """(cached frame, original frame) of frame ``index``: the original just before, and the cache
+    restarted and filled by frame ``index - 1`` so that frame ``index`` is a steady frame."""
+    ref = original.render_frame(index)
+    cached.reset()
+    cached.render_frame(index - 1)
+    return cached.render_frame(index), ref
+
+
 def _timing_run(cached: CachedRenderer, original: Renderer, node_id: str, period: int, indices: list[int],
                 meter: _Meter) -> list[TimingFrame]:
     cached.period = period
     out = []
     for index in indices:
-        ref = original.render_frame(index)
-        cached.reset()
-        cached.render_frame(index - 1)
-        got = cached.render_frame(index)
+        got, ref = timed_beside(cached, original, index)
         out.append(TimingFrame(index, int(got.hits), int(got.misses), float(got.ms), float(ref.ms)))
         meter.step("timing", f"{node_id} Δn={period}", 3)
     return out
@@ -502,27 +508,27 @@ def _measure_overhead(work, session, settings, store, node_id, timing, meter, al
     store.set_overhead(node_id, OVERHEAD_SIZE, len(times), statistics.median(times))
 
 
-def _typical_originals(store: ProfileStore, nodes, settings: TrainingSettings) -> dict[int, float]:
-    """Per timing frame, the median of the original's times measured beside the variants."""
+def _original_times(store: ProfileStore, nodes, settings: TrainingSettings) -> dict[int, list[float]]:
+    """Per timing frame, every time of the original measured beside the variants of ``nodes``."""
     samples: dict[int, list[float]] = {}
     for nid in nodes:
         for period, frames in store.timing_frames(nid).items():
             if period in settings.timing_periods:
                 for f in frames:
                     samples.setdefault(f.frame, []).append(f.original_ms)
-    return {frame: float(statistics.median(v)) for frame, v in samples.items()}
+    return samples
+
+
+def _typical_originals(store: ProfileStore, nodes, settings: TrainingSettings) -> dict[int, float]:
+    """Per timing frame, the median of the original's times measured beside the variants."""
+    return {frame: float(statistics.median(v)) for frame, v in _original_times(store, nodes, settings).items()}
 
 
 def _original_noise(store: ProfileStore, nodes, settings: TrainingSettings) -> float:
     """The noise of the training's timings: every timing run renders the original on the same
     timing frames, so per frame the spread of its times (1.4826 × MAD / median) is the machine's
     noise; the median over the frames (0 when nothing was timed twice)."""
-    samples: dict[int, list[float]] = {}
-    for nid in nodes:
-        for period, frames in store.timing_frames(nid).items():
-            if period in settings.timing_periods:
-                for f in frames:
-                    samples.setdefault(f.frame, []).append(f.original_ms)
+    samples = _original_times(store, nodes, settings)
     spreads = []
     for values in samples.values():
         if len(values) > 2:

@@ -483,7 +483,12 @@ class CacheRuntime:
             mark("single")
         if count:
             mark("queries")
-        ctx.depth_func = "<"
+        return self._end_frame(covered, misses)
+
+    def _end_frame(self, covered, misses) -> FrameStats:
+        """The frame's statistics; the depth test back to ``<``, the targets swapped (this
+        frame's cache becomes the previous one) and the clock advanced."""
+        self.ctx.depth_func = "<"
         stats = FrameStats(self.clock, covered, misses)
         self._index = 1 - self._index
         self._valid = True

@@ -187,7 +187,6 @@ class MultiCacheRuntime(CacheRuntime):
         if not (self.algorithm == "three-pass" and self.node_passes):
             return super().frame(draw, count, after_first_pass)
 
-        from rrcache.runtime.cache import FrameStats
 
         ctx = self.ctx
         self._begin_frame()
@@ -218,12 +217,7 @@ class MultiCacheRuntime(CacheRuntime):
         covered = misses = None
         if count:
             misses, covered = max(int(q.samples) for q in queries), int(second.samples)
-        ctx.depth_func = "<"
-        stats = FrameStats(self.clock, covered, misses)
-        self._index = 1 - self._index
-        self._valid = True
-        self.clock += 1
-        return stats
+        return self._end_frame(covered, misses)
 
     def node_refresh_values(self, j: int) -> dict:
         """The refresh rule's uniforms of node ``j`` at the current clock (its own period and
