@@ -60,6 +60,7 @@ class AmortizedRun:
     original_cpu_ms: list[list[float]] = field(default_factory=list)
     amortized_cpu_ms: list[list[float]] = field(default_factory=list)
     reference_defines: dict = field(default_factory=dict)
+    filter: str = "bilinear"
 
     def _steady(self, values: list) -> list:
         return values[1:] or values
@@ -82,7 +83,7 @@ class AmortizedRun:
         cpu = self.cpu_speedups()
         return {
             "estimator": self.estimator, "samples": self.samples, "of": self.total, "lambda": self.blend,
-            "phase": self.phase, "history": self.history, "algorithm": self.algorithm, "frames": len(self.frames), "resolution": list(self.resolution),
+            "phase": self.phase, "history": self.history, "filter": self.filter, "algorithm": self.algorithm, "frames": len(self.frames), "resolution": list(self.resolution),
             "repeats": len(speedups), "speedup": statistics.median(speedups),
             "speedup_range": [min(speedups), max(speedups)],
             "original_ms": statistics.median(statistics.median(self._steady(o)) for o in self.original_ms),
@@ -102,7 +103,7 @@ class AmortizedRun:
 
 def run(shader, session, estimator: str, samples: int, blend: float, reference_defines: Mapping[str, str],
         frames=None, repeats: int = 3, error_every: int = 5, algorithm: str = "two-pass", phase: str = "frame",
-        history: str = "blend",
+        history: str = "blend", filter: str = "bilinear",
         resolution: Optional[tuple[int, int]] = None, defines: Optional[Mapping[str, str]] = None,
         on_frame: Optional[Callable[[int, int, object, object, object], None]] = None) -> AmortizedRun:
     """Measure (see the module doc). ``session`` is a path or a loaded session; ``frames`` as
@@ -112,12 +113,13 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
         session = load_session(session)
     work = load_for_session(shader, session, defines)
     variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend, phase=phase,
-                                 history=history, vertex=work.vertex)
+                                 history=history, filter=filter, vertex=work.vertex)
     reference = prepare_file(shader, session, {**dict(defines or {}), **dict(reference_defines)})
     indices = frame_indices(session, frames)
     amort = variant.amortized
     out = AmortizedRun(estimator, samples, phase, history, amort["of"], float(blend), algorithm, indices,
-                       tuple(resolution or session.resolution), reference_defines=dict(reference_defines))
+                       tuple(resolution or session.resolution), reference_defines=dict(reference_defines),
+                       filter=filter)
     for repeat in range(repeats):
         o_ms, a_ms, o_cpu, a_cpu = [], [], [], []
         with Renderer(work.prepared, session, resolution) as original, \

@@ -28,6 +28,8 @@ from rrcache.cli.options import parse_defines, resolution_option as _resolution
 @click.option("--lambda", "blend", default=0.6, show_default=True, type=click.FloatRange(0.0, 1.0, max_open=True),
               help="λ: weight of the reprojected estimate.")
 @click.option("--history", type=click.Choice(["blend", "slots"]), default="blend", show_default=True)
+@click.option("--filter", "filter_", type=click.Choice(["nearest", "bilinear", "catmull-rom", "edge"]),
+              default="bilinear", show_default=True, help="How the previous frame's estimate is resampled.")
 @click.option("--phase", type=click.Choice(["frame", "pixel"]), default="frame", show_default=True)
 @click.option("--algorithm", type=click.Choice(["three-pass", "two-pass", "one-pass"]), default="two-pass",
               show_default=True)
@@ -41,7 +43,7 @@ from rrcache.cli.options import parse_defines, resolution_option as _resolution
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
 @click.option("--images", type=click.Path(file_okay=False), default=None, help="Write comparison PNGs here.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
-def command(shader, session, estimator, samples, blend, history, phase, algorithm, reference, also, frames,
+def command(shader, session, estimator, samples, blend, history, filter_, phase, algorithm, reference, also, frames,
             repeats, error_every, resolution, images, as_json):
     """Measure amortized sampling of one estimator of SHADER over SESSION."""
     from rrcache.bench.amortize import run, write_images
@@ -57,7 +59,7 @@ def command(shader, session, estimator, samples, blend, history, phase, algorith
                 kept.update(original=original.image, amortized=amortized.image)
 
     result = run(shader, session, estimator, samples, blend, ref_defines, frames=frames, repeats=repeats,
-                 error_every=error_every, algorithm=algorithm, phase=phase, history=history,
+                 error_every=error_every, algorithm=algorithm, phase=phase, history=history, filter=filter_,
                  resolution=resolution, on_frame=on_frame)
     summary = result.summary()
     if images:
