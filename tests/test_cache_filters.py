@@ -13,10 +13,11 @@ import pytest
 
 os.environ.setdefault("LP_NUM_THREADS", "1")
 
-from rrcache.gl.context import get_context  # noqa: E402
+from rrcache.gl.context import bind_default_framebuffer, get_context  # noqa: E402
 from rrcache.runtime import glsl as G  # noqa: E402
 
 N = 32
+pytestmark = pytest.mark.usefixtures("gl_ctx")  # and the GL error flag is checked after each
 
 VERTEX = """#version 330 core
 in vec2 a_position;
@@ -57,6 +58,7 @@ def _reconstruct(filter_name: str, payload: np.ndarray, shift) -> np.ndarray:
         vao.render(mode=moderngl.TRIANGLE_STRIP)
         return np.frombuffer(fbo.read(components=4, dtype="f4"), dtype="f4").reshape(N, N, 4).copy()
     finally:
+        bind_default_framebuffer(ctx)  # before the framebuffer is released (see its doc)
         for obj in (vao, quad, prog, fbo, out, tex):
             obj.release()
 
