@@ -151,6 +151,10 @@ class AmortizeErrorFit:
         out = self.a * noise + self.b * lag
         return float(out) if np.ndim(out) == 0 else out
 
+    def to_json(self) -> dict:
+        return {"a": self.a, "b": self.b, "total": self.total, "r2": self.r2, "rms": self.rms, "n": self.n,
+                "quality": self.quality}
+
 
 def fit_amortized_error(samples: Sequence[int], blends: Sequence[float], errors: Sequence[float],
                         total: int) -> AmortizeErrorFit:
@@ -207,11 +211,6 @@ def fit_amortized_error(samples: Sequence[int], blends: Sequence[float], errors:
     r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0
     quality = "insufficient" if n < 2 else ("poor" if r2 < 0.8 else "ok")
     return AmortizeErrorFit(a, b, int(total), float(min(r2, 1.0)), math.sqrt(ss_res / n), n, quality)
-
-
-    def to_json(self) -> dict:
-        return {"a": self.a, "b": self.b, "total": self.total, "r2": self.r2, "rms": self.rms, "n": self.n,
-                "quality": self.quality}
 
 
 def _lag_squared(blends) -> np.ndarray:
