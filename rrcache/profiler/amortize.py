@@ -119,6 +119,7 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             target = rec.runs(history)
             try:
                 if refs is None and _missing_errors(store, est.id, ms_list, history):
+                    state["total"] += len(frames)  # the reference frames, rendered once for all
                     refs = _references(work, session, settings, plan, frames, step)
                 _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock, history)
                 _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
