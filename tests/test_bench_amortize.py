@@ -23,8 +23,13 @@ def test_bench_amortize_json_and_images(gl_ctx, tmp_path):
     assert doc["error_frames"] == 2 and 0 < doc["original_error"] and 0 < doc["amortized_error"]
     assert doc["speedup_range"][0] <= doc["speedup"] <= doc["speedup_range"][1]
     assert doc["original_cpu_ms"] > 0 and doc["amortized_cpu_ms"] > 0
-    assert sorted(doc["images"]) == ["also", "amortized", "original", "reference"]
+    assert sorted(doc["images"]) == ["also", "amortized", "comparison", "original", "reference"]
     assert all(Path(p).stat().st_size > 100 for p in doc["images"].values())
+    # the labelled figure: four columns (1 sample, 16, amortized, reference), two rows
+    import OpenImageIO as oiio
+
+    spec = oiio.ImageInput.open(doc["images"]["comparison"]).spec()
+    assert spec.width > 4 * 64 and spec.height > 64
 
 
 def test_bench_amortize_unknown_estimator(tmp_path):
@@ -51,3 +56,23 @@ def test_instance_writes_an_amortized_variant(tmp_path):
     assert "rr_lambda" in (tmp_path / "hit@2.frag").read_text()
     both = CliRunner().invoke(cli, ["instance", str(ROOT / "shaders" / "pcf_shadows.glsl"), "--out", str(tmp_path)])
     assert both.exit_code == 2 and "--node or --estimator" in both.output
+
+
+def test_the_comparison_window_is_where_the_image_differs_most(tmp_path):
+    """The magnified window follows the chosen panel's error, and each caption's error is the
+    panel's mean RGB distance from the reference."""
+    import numpy as np
+
+    from rrcache.bench.amortize_sheet import noisiest_window, write_sheet
+
+    ref = np.zeros((40, 60, 4), np.float32)
+    ref[..., 3] = 1.0
+    a, b = ref.copy(), ref.copy()
+    a[30:40, 50:60, :3] = 0.3        # a's error sits bottom right
+    b[0:10, 0:10, :3] = 0.6          # b's top left
+    assert noisiest_window(a, ref, 10) == (30, 50) and noisiest_window(b, ref, 10) == (0, 0)
+    out = write_sheet(str(tmp_path / "sheet.png"), [("a", a), ("b", b)], ref, crop=10, window_of=1)
+    assert out["window"] == [0, 0, 10]
+    expect_a = 100 * np.sqrt(3 * 0.3 ** 2) / (40 * 60)
+    assert abs(out["errors"]["a"] - expect_a) < 1e-6 and out["errors"]["b"] > out["errors"]["a"]
+    assert (tmp_path / "sheet.png").stat().st_size > 1000

@@ -206,13 +206,17 @@ def test_the_bench_measures_the_papers_amortized_setting(trained):
     prof, _, folder = trained
     session = load_session(folder / "orbit.json")
     work = load_for_session(folder / "soft.frag", session)
-    [row] = _amortized_rows(prof, work, session, list(range(6)), QUICK, None)
+    # the paper's running blend, and the per-subset slots (4 sums of one float fit the payload)
+    row, slots = _amortized_rows(prof, work, session, list(range(6)), QUICK, None)
     assert row.setting == "e1: 2 of 8 per frame, λ=0.6"
-    assert row.speedup > 0 and 0 < row.mean_error < 0.5 and row.ms > 0 and row.original_ms > 0
+    assert slots.setting == "e1: 2 of 8 per frame, λ=0.6, slots" and "slots" in slots.method
+    for r in (row, slots):
+        assert r.speedup > 0 and 0 < r.mean_error < 0.5 and r.ms > 0 and r.original_ms > 0
     scene = SceneResult("soft", str(folder / "soft.frag"), str(folder / "orbit.json"), (64, 64), 6, 1, 1,
-                        amortized=[row])
-    assert "amortized sampling at the paper's setting" in scene_markdown(scene)
-    assert scene.to_json()["amortized"][0]["setting"] == row.setting
+                        amortized=[row, slots])
+    text = scene_markdown(scene)
+    assert "amortized sampling at the paper's setting" in text and "2 of 8 per frame, λ=0.6, slots" in text
+    assert [r["setting"] for r in scene.to_json()["amortized"]] == [row.setting, slots.setting]
 
 
 def test_the_profile_command_shows_estimators_and_an_amortized_row(amortized_wins):

@@ -29,6 +29,7 @@ from typing import Callable, Mapping, Optional
 
 import numpy as np
 
+from rrcache.bench.amortize_sheet import write_sheet
 from rrcache.compiler.amortize import instance_amortized
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
@@ -148,8 +149,9 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
 def write_images(out_dir: str, shader, session, result: AmortizedRun, kept: dict,
                  also: Optional[Mapping[str, str]] = None) -> dict:
     """PNGs of the last frame of the first repeat: ``original.png``, ``amortized.png`` (from
-    ``kept``), ``reference.png``, and ``also.png`` (the shader with the ``also`` defines); returns
-    name → path."""
+    ``kept``), ``reference.png``, ``also.png`` (the shader with the ``also`` defines) and ``comparison.png``
+    (all of them labelled with their error against the reference, whole and magnified:
+    :func:`rrcache.bench.amortize_sheet.write_sheet`); returns name → path."""
     import os
 
     from rrcache.harness.images import write_image
@@ -161,11 +163,28 @@ def write_images(out_dir: str, shader, session, result: AmortizedRun, kept: dict
     renders = {"reference": result.reference_defines}
     if also:
         renders["also"] = dict(also)
+    mask = None
     for name, defines in renders.items():
         with Renderer(prepare_file(shader, session, defines), session, result.resolution) as r:
-            kept[name] = r.render_frame(index).image
+            got = r.render_frame(index)
+            kept[name] = got.image
+            mask = got.mask if name == "reference" else mask
     for name, image in kept.items():
         path = os.path.join(out_dir, f"{name}.png")
         write_image(path, image)
         paths[name] = path
+    if {"original", "amortized"} <= set(kept):
+        panels = [(_defines_label(also), kept["also"])] if "also" in kept else []
+        panels += [(f"original ({result.total} of {result.total})", kept["original"]),
+                   (f"amortized {result.samples} of {result.total}, λ = {result.blend:g}, {result.history}",
+                    kept["amortized"])]
+        path = os.path.join(out_dir, "comparison.png")
+        write_sheet(path, panels, kept["reference"], mask, window_of=len(panels) - 2,
+                    title=f"frame {index}, against the reference ({_defines_label(result.reference_defines)}); "
+                          "below: the window where the original differs most from it")
+        paths["comparison"] = path
     return paths
+
+
+def _defines_label(defines: Mapping[str, str]) -> str:
+    return ", ".join(f"{k}={v}" for k, v in sorted(dict(defines).items())) or "the original"

@@ -11,14 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
+from rrcache.report.agg import agg_pyplot
 
 
 def _x(speedup):
@@ -27,7 +20,7 @@ def _x(speedup):
 
 def write_scene_plot(scene, out) -> str:
     """Write the figure of one :class:`~rrcache.bench.paper.SceneResult`; returns its path."""
-    plt = _pyplot()
+    plt = agg_pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=110)
     try:
         ax.scatter([1.0], [0.0], color="black", zorder=3, label="original")

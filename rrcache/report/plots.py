@@ -18,16 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from rrcache.report.agg import agg_pyplot
+
 PERIODS = np.arange(1, 51)
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _curves(prof):
@@ -59,7 +52,7 @@ def _front_points(prof):
 
 def plot_tradeoff(prof, out_dir) -> list[str]:
     """Write ``tradeoff.png`` and ``tradeoff.svg``; returns their paths."""
-    plt = _pyplot()
+    plt = agg_pyplot()
     curves, _ = _curves(prof)
     fig, ax = plt.subplots(figsize=(8, 5.5), dpi=110)
     cmap = plt.get_cmap("viridis")
@@ -126,7 +119,7 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
 
 def plot_hitrate(prof, out_dir) -> list[str]:
     """Write ``hitrate.png``; returns its path."""
-    plt = _pyplot()
+    plt = agg_pyplot()
     _, hit = _curves(prof)
     fig, ax = plt.subplots(figsize=(6, 4), dpi=110)
     for node in prof.trained_nodes:
@@ -152,7 +145,7 @@ def plot_validation(prof, out_dir) -> list[str]:
     rows = [s for s in prof.selections if s.measured_error is not None]
     if not rows:
         return []
-    plt = _pyplot()
+    plt = agg_pyplot()
     fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4), dpi=110)
     for ax, pred, meas, name in ((a, "predicted_error", "measured_error", "mean RGB L2 error"),
                                  (b, "predicted_ms", "measured_ms", "ms per frame")):

@@ -59,11 +59,9 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
     original, a validation's against its own): the single-node front, the front with the trained
     sets, the sets (predicted, and trained joined to their prediction, numbered as listed under
     the panel) and the validated selections."""
-    import matplotlib
+    from rrcache.report.agg import agg_pyplot
 
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
+    plt = agg_pyplot()
     profiles = list(profiles)
     fig, axes = plt.subplots(1, len(profiles), figsize=(7 * len(profiles), 6.2), dpi=110, squeeze=False)
     for k, (ax, prof) in enumerate(zip(axes[0], profiles)):
