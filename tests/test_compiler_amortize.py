@@ -183,3 +183,34 @@ def test_an_amortized_choice_is_a_kind_of_selection(tmp_path):
     assert variant.algorithm == "two-pass"
     assert variant.amortized == {"estimator": "e1", "samples": 4, "of": 16, "lambda": 0.6, "phase": "frame",
                                  "cycle": 4, "history": "slots", "accumulators": ["hits"]}
+
+
+@pytest.mark.parametrize("name", sorted(ESTIMATORS))
+def test_one_slots_rule_for_compiler_profiler_and_models(name):
+    """The compiler builds a slots variant exactly at the m where rrcache.selection.slots_fit says
+    it fits, and the profiler trains (and the models offer) the slots history at those m and no
+    others: one rule, for every estimator of the corpus."""
+    from rrcache.glsl.frontend import parse_shader
+    from rrcache.model.amortize import training_samples
+    from rrcache.profiler.amortize import _slots_record
+    from rrcache.selection import slots_fit, slots_samples
+
+    shader = parse_shader(ESTIMATORS[name][0], f"{name}.frag")
+    for est in find_estimators(shader).estimators:
+        total, comps = int(est.samples), int(est.components)
+        compiled = []
+        for m in range(1, total + 1):
+            why = slots_fit(total, m, comps)
+            try:
+                v = instance_amortized(shader, est.id, "two-pass", samples=m, blend=0.0, history="slots")
+            except ValueError as err:
+                assert why is not None and why in str(err), (m, why, err)
+                continue
+            assert why is None, (m, why)
+            assert v.components == (total // m) * comps <= 4 and v.amortized["history"] == "slots"
+            compiled.append(m)
+        assert compiled == slots_samples(total, comps) == training_samples(total, "slots", comps)
+        record = _slots_record(est)
+        assert (record.note is None) == bool(compiled)
+        # the pixel phase never fits
+        assert all(slots_fit(total, m, comps, "pixel") is not None for m in compiled)

@@ -6,7 +6,12 @@ a shader whose soft lighting sums 8 terms in a loop: estimator e1), real GL and 
 - fewer terms per frame cost error (at λ = 0); the nlopt fit follows the runs;
 - every level's choice is the faster of the nodes' and the estimator's best admissible option;
 - a profile whose estimator is predicted fastest selects an AmortizedLoop: `rrcache select`
-  shows and writes it, validation measures it beside the original.
+  shows and writes it, validation measures it beside the original;
+- the slots history (the N/m subset sums kept apart) is trained too, at the m where it fits
+  (8 terms of one component: m = 2, 4), with its own fits and options on the same front; a store
+  and a document written before it load as blend only (the store resumed adds the slots runs);
+  a profile whose slots options are predicted fastest selects one, and its optimized/eN shader
+  files are the slots variant's, which renders.
 """
 from __future__ import annotations
 
@@ -229,3 +234,218 @@ def test_the_profile_command_shows_estimators_and_an_amortized_row(amortized_win
     console.print(_table(prof))
     text = console.export_text()
     assert "e1 m=" in text and "/8 λ=" in text
+
+
+# ---------------------------------------------------------------------------- the slots history
+def test_the_slots_history_is_trained_where_it_fits(trained):
+    from rrcache.model.amortize import SlotsErrorFit
+    from rrcache.selection import slots_fit
+
+    prof, events, _ = trained
+    est = prof.estimators[0]
+    assert est.components == 1
+    slots = est.slots
+    assert slots is not None and slots.trained and slots.note is None
+    # 8 terms of one component: 4 sums at m = 2, 2 at m = 4; not m = 1 (8 sums)
+    assert sorted(set(slots.run_samples)) == [2, 4] and slots.timed_samples == [2, 4]
+    assert sorted(set(slots.run_blends)) == sorted(TRAIN_BLENDS)
+    assert len(slots.errors) == 2 * len(TRAIN_BLENDS) and all(e > 0 for e in slots.errors)
+    assert all(ms > 0 for ms in slots.timed_ms) and 0 < slots.hit_rate <= 1
+    assert any("slots" in e.detail for e in events if e.stage == "amortize")
+    # the slots are exact on a still image: at λ = 0 their error is the reprojection's alone,
+    # below the blend's at the same m (a subset scaled to the whole sum)
+    blend0 = {m: e for m, lam, e in zip(est.run_samples, est.run_blends, est.errors) if lam == 0.0}
+    slots0 = {m: e for m, lam, e in zip(slots.run_samples, slots.run_blends, slots.errors) if lam == 0.0}
+    assert all(slots0[m] < blend0[m] for m in (2, 4)), (slots0, blend0)
+    # its own model: one floor per trained m, the lag term shared; the nlopt fit follows the runs
+    model = est.model("slots")
+    assert model.history == "slots" and isinstance(model.error, SlotsErrorFit)
+    assert list(model.error.samples) == [2, 4] and all(c >= 0 for c in model.error.base) and model.error.b >= 0
+    predicted = model.error.predict(np.array(slots.run_samples), np.array(slots.run_blends))
+    assert np.corrcoef(predicted, slots.errors)[0, 1] > 0.8
+    # its options: only where the slots fit, beside the blend's on the profile's front
+    options = prof.amortized_options()
+    histories = {(o.parts[0].history, o.parts[0].samples) for o in options}
+    assert {m for h, m in histories if h == "slots"} == {2, 4}
+    assert {m for h, m in histories if h == "blend"} == {1, 2, 4}
+    assert all(slots_fit(8, o.parts[0].samples, 1) is None for o in options if o.parts[0].history == "slots")
+    assert all(o.predicted_ms > 0 and o.predicted_error >= 0 for o in options)
+
+
+def _old_store(path):
+    """Rewrite the amortize_run table of the store at ``path`` as it was before the history
+    column (its blend rows only)."""
+    import sqlite3
+
+    conn = sqlite3.connect(str(path), isolation_level=None)
+    conn.execute("PRAGMA journal_mode=DELETE")
+    cols = ("estimator, kind, samples, blend, frame, mean_error, psnr, hit_rate, hits, misses, ms, original_ms, "
+            "wall_s")
+    rows = conn.execute(f"SELECT {cols} FROM amortize_run WHERE history = 'blend'").fetchall()
+    conn.execute("DROP TABLE amortize_run")
+    conn.execute("""CREATE TABLE amortize_run (estimator TEXT NOT NULL, kind TEXT NOT NULL,
+        samples INTEGER NOT NULL, blend REAL NOT NULL, frame INTEGER NOT NULL, mean_error REAL NOT NULL,
+        psnr REAL NOT NULL, hit_rate REAL NOT NULL, hits INTEGER NOT NULL, misses INTEGER NOT NULL,
+        ms REAL NOT NULL, original_ms REAL NOT NULL, wall_s REAL NOT NULL,
+        PRIMARY KEY (estimator, kind, samples, blend, frame))""")
+    conn.executemany(f"INSERT INTO amortize_run ({cols}) VALUES ({', '.join('?' * 13)})", rows)
+    conn.close()
+    return rows
+
+
+def test_a_store_written_before_the_slots_history_opens_and_resumes(trained, tmp_path):
+    import shutil
+
+    from rrcache.profiles import amortize as data
+    from rrcache.profiles.store import read_store
+
+    prof, _, folder = trained
+    out = tmp_path / "out"
+    shutil.copytree(folder / "out", out)
+    old_rows = _old_store(out / "profile.sqlite")
+    assert old_rows
+    before = (out / "profile.sqlite").read_bytes()
+    store = read_store(out / "profile.sqlite")
+    try:
+        blend = data.rows(store, "e1", "error") + data.rows(store, "e1", "timing")
+        assert len(blend) == len(old_rows) and all(r["history"] == "blend" for r in blend)
+        assert data.rows(store, "e1", "error", "slots") == [] and data.rows(store, "e1", "timing", "slots") == []
+    finally:
+        store.close()
+    assert (out / "profile.sqlite").read_bytes() == before  # reading changed nothing
+    # resumed: the blend runs are skipped (kept), the slots runs added
+    events = []
+    shader, session = folder / "soft.frag", folder / "orbit.json"
+    again = profile(shader, session, out, TrainingSettings(**SETTINGS, validate=False), progress=events.append)
+    details = [e.detail for e in events if e.stage == "amortize"]
+    assert details and all("slots" in d for d in details if " m=" in d), details
+    est, first = again.estimators[0], prof.estimators[0]
+    assert est.errors == first.errors and est.run_samples == first.run_samples
+    assert est.slots.trained and sorted(set(est.slots.run_samples)) == [2, 4]
+    store = read_store(out / "profile.sqlite")
+    try:
+        assert len(data.rows(store, "e1", "error")) == len(first.errors)
+        assert len(data.rows(store, "e1", "error", "slots")) == len(est.slots.errors)
+    finally:
+        store.close()
+
+
+def test_a_document_without_the_slots_loads_as_blend_only(trained, tmp_path):
+    prof, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    assert data["estimators"][0]["slots"]["trained"] and data["estimators"][0]["components"] == 1
+    for est in data["estimators"]:
+        del est["slots"], est["components"]
+    (tmp_path / "profile.json").write_text(json.dumps(data))
+    old = load_profile(tmp_path)
+    assert old.estimators[0].slots is None and old.estimators[0].model("slots") is None
+    options = old.amortized_options()
+    assert options and {o.parts[0].history for o in options} == {"blend"}
+    assert old.select_psnr(30).kind in ("cache", "original", "amortize")
+
+    def refused(change, where):
+        doc = json.loads((folder / "out" / "profile.json").read_text())
+        change(doc["estimators"][0])
+        (tmp_path / "profile.json").write_text(json.dumps(doc))
+        with pytest.raises(Exception, match=where):
+            load_profile(tmp_path)
+
+    refused(lambda e: e["slots"]["errors"].__setitem__(0, -1), r"estimators\[0\]\.slots\.errors\[0\]")
+    refused(lambda e: e["slots"].__setitem__("colour", 1), r"estimators\[0\]\.slots\.colour: unknown key")
+    refused(lambda e: e["slots"].__setitem__("trained", "yes"), r"estimators\[0\]\.slots\.trained")
+    refused(lambda e: e["slots"]["error_fit"]["base"].__setitem__(0, -0.5),
+            r"estimators\[0\]\.slots\.error_fit\.base\[0\]")
+    refused(lambda e: e["slots"]["error_fit"].pop("base"), r"estimators\[0\]\.slots\.error_fit\.base: is missing")
+    refused(lambda e: e["slots"]["time_fit"].__setitem__("t_sample", None),
+            r"estimators\[0\]\.slots\.time_fit\.t_sample")
+    refused(lambda e: e["error_fit"].__setitem__("a", -1.0), r"estimators\[0\]\.error_fit\.a")
+    refused(lambda e: e["error_fit"].__setitem__("form", "x"), r"estimators\[0\]\.error_fit\.form: unknown key")
+    refused(lambda e: e.__setitem__("components", 5), r"estimators\[0\]\.components")
+
+
+@pytest.fixture(scope="module")
+def slots_win(trained, tmp_path_factory):
+    """The trained profile with the slots history's time per term made tiny and the blend's
+    slow: the slots options are predicted the fastest (so the choice does not depend on this
+    machine's speed)."""
+    prof, _, folder = trained
+    data = json.loads((folder / "out" / "profile.json").read_text())
+    est = data["estimators"][0]
+    est["time_fit"]["fixed_ms"] = 10.0 * data["original_ms"]
+    est["slots"]["time_fit"]["fixed_ms"] = 0.01 * data["original_ms"]
+    est["slots"]["time_fit"]["t_sample"] = 1e-9
+    out = tmp_path_factory.mktemp("slots_win")
+    (out / "profile.json").write_text(json.dumps(data))
+    return load_profile(out), folder
+
+
+def test_select_returns_a_slots_selection_that_compiles_and_renders(slots_win, tmp_path):
+    from rrcache.compiler.amortize import instance_amortized
+    from rrcache.pipeline import load_for_session
+    from rrcache.profiler.run import _write_outputs
+    from rrcache.profiler.validate import validate
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.session import load_session
+
+    prof, folder = slots_win
+    choice = prof.select(1.0)
+    part = choice.parts[0]
+    assert choice.kind == "amortize" and part.history == "slots" and part.samples in (2, 4)
+    assert choice.predicted_speedup > 1 and choice.predicted_psnr is not None
+    level = prof.select_psnr(20.0)
+    assert level.kind == "amortize" and level.parts[0].history == "slots"
+    # the CLI: JSON and text say the history; --out writes the slots variant
+    cmd = [sys.executable, "-m", "rrcache", "select", str(prof.path), "--max-error", "1"]
+    got = subprocess.run(cmd + ["--json"], capture_output=True, text=True)
+    assert got.returncode == 0, got.stderr
+    doc = json.loads(got.stdout)
+    assert doc["history"] == "slots" and doc["phase"] == "frame" and doc["samples"] == part.samples
+    got = subprocess.run(cmd + ["--out", str(tmp_path / "opt")], capture_output=True, text=True)
+    assert got.returncode == 0, got.stderr
+    assert "slots history" in got.stdout
+    manifest = json.loads((tmp_path / "opt" / "manifest.json").read_text())
+    assert manifest["amortized"]["history"] == "slots" and manifest["amortized"]["samples"] == part.samples
+    assert manifest["node"]["components"] == 8 // part.samples
+    # the profile's optimized/e1 files are the slots variant's, phase by phase
+    session = load_session(folder / "orbit.json")
+    work = load_for_session(folder / "soft.frag", session)
+    prof.selections = [choice.replace(label="e1")]
+    _write_outputs(prof, tmp_path / "prof", work, plots=False)
+    written = tmp_path / "prof" / "optimized" / "e1"
+    expected = instance_amortized(work.shader, "e1", prof.algorithm, samples=part.samples, blend=part.blend,
+                                  history="slots", vertex=work.vertex)
+    assert set(expected.passes) == {p.name[:-5] for p in written.glob("*.frag")}
+    assert len([k for k in expected.passes if "@" in k]) == (8 // part.samples - 1) * len(
+        [k for k in expected.passes if "@" not in k and k + "@1" in expected.passes])
+    for key, source in expected.passes.items():
+        assert (written / f"{key}.frag").read_text() == source.fragment
+    assert json.loads((written / "manifest.json").read_text())["amortized"]["history"] == "slots"
+    # it renders: validation measures it beside the original, and beside the blend history at
+    # the same (m, λ) it is the closer to the original
+    settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    blend = choice.replace(parts=(AmortizedLoop("e1", part.samples, part.blend),), label="e2")
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        slots_row, blend_row = validate(work, session, settings, store, [choice.replace(label="e1"), blend],
+                                        fallback=False)
+    assert slots_row.key == choice.key and slots_row.frames == 6
+    assert 0 < slots_row.measured_error < 0.5 and math.isfinite(slots_row.measured_psnr)
+    if part.blend == 0.0:
+        assert slots_row.measured_error < blend_row.measured_error
+
+
+def test_the_cli_and_report_show_the_slots_history(slots_win):
+    from rich.console import Console
+
+    from rrcache.cli.profile import _estimator_lines, _table
+    from rrcache.report.html import _estimators
+
+    prof, _ = slots_win
+    [line] = _estimator_lines(prof)
+    assert "amortization trained at m = 1, 2, 4" in line and "slots history at m = 2, 4" in line
+    prof.selections = [prof.select(1.0).replace(label="e1")]
+    console = Console(record=True, width=200)
+    console.print(_table(prof))
+    assert "slots" in console.export_text()
+    table = _estimators(prof)
+    assert "<td>slots</td>" in table and "<td>blend</td>" in table and "c<sub>2</sub>" in table

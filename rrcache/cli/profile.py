@@ -248,15 +248,28 @@ def _estimator_lines(prof) -> list[str]:
     """One line per estimator (amortized sampling): trained or why not, and its options' best
     predicted speed-up with the PSNR there."""
     out = []
+    options = prof.amortized_options()
     for est in prof.estimators:
-        if not est.trained:
+        if not est.trained and not (est.slots is not None and est.slots.trained):
             out.append(f"estimator {est.id} (line {est.line}, {est.samples} terms): {est.note or 'not trained'}")
             continue
-        options = [o for o in prof.amortized_options() if o.parts[0].estimator == est.id]
-        best = max(options, key=lambda o: o.predicted_speedup, default=None)
-        fit = est.error_fit
-        text = (f"estimator {est.id} (line {est.line}, {est.samples} terms): amortization trained at m = "
-                f"{', '.join(str(m) for m in est.timed_samples)} (error fit R² {fit.get('r2', float('nan')):.2f})")
+        mine = [o for o in options if o.parts[0].estimator == est.id]
+        text = f"estimator {est.id} (line {est.line}, {est.samples} terms): amortization trained at m = "
+        parts = []
+        for history in ("blend", "slots"):
+            runs = est.runs(history)
+            if runs is None:
+                continue
+            if not runs.trained:
+                parts.append(f"{history} history {runs.note or 'not trained'}")
+                continue
+            fit = runs.error_fit
+            r2 = fit.get("r2")
+            part = (f"{', '.join(str(m) for m in runs.timed_samples)} (error fit R² "
+                    f"{r2 if r2 is not None else float('nan'):.2f})")
+            parts.append(part if history == "blend" else f"slots history at m = {part}")
+        text += "; ".join(parts)
+        best = max(mine, key=lambda o: o.predicted_speedup, default=None)
         if best is not None:
             text += (f"; fastest option {best.describe()} {best.predicted_speedup:.2f}× at "
                      f"{_fmt(best.predicted_psnr, '.1f')} dB (predicted)")
@@ -316,8 +329,9 @@ def _table(prof) -> Table:
             node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
         elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
             part = s.parts[0]
+            slots = " slots" if part.history == "slots" else ""
             node, period = (f"{part.estimator} m={part.samples}/{prof.estimator(part.estimator).samples} "
-                            f"λ={part.blend:g}: {part.text or ''}"), "–"
+                            f"λ={part.blend:g}{slots}: {part.text or ''}"), "–"
         else:
             node = "(original)" if s.node is None else f"{s.node}: {s.text}"
             period = _fmt(s.period, "d")

@@ -11,8 +11,9 @@ PSNR against the original of at least that many dB (the PSNR model of :mod:`rrca
 "predicted_error", "predicted_ms", "predicted_speedup", "predicted_speedup_range",
 "predicted_psnr", "predicted_psnr_uncertainty", "exact", "visible_artifacts"}`` (node null: the
 original shader is the best choice; PSNR null with ``exact`` true: the original's image; an
-amortized estimator adds ``"kind": "amortize", "estimator", "samples", "of", "blend"`` with node
-null);
+amortized estimator adds ``"kind": "amortize", "estimator", "samples", "of", "blend", "history"``
+(``blend``: the paper's running estimate; ``slots``: the N/m subset sums kept apart) and
+``"phase"`` with node null);
 ``--out`` writes the chosen variant's shader files.
 """
 from __future__ import annotations
@@ -49,6 +50,7 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
             part = choice.parts[0]
             data = {"node": None, "period": None, "kind": "amortize", "estimator": part.estimator,
                     "samples": part.samples, "of": prof.estimator(part.estimator).samples, "blend": part.blend,
+                    "history": part.history, "phase": part.phase,
                     "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
                     "predicted_speedup": float(choice.predicted_speedup),
                     "predicted_speedup_range": list(choice.predicted_speedup_range),
@@ -74,7 +76,8 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
     if choice.kind == "amortize":
         part = choice.parts[0]
         click.echo(f"amortize {part.estimator} ({part.text}): {part.samples} of "
-                   f"{prof.estimator(part.estimator).samples} terms per frame, blend λ = {part.blend:g}: predicted "
+                   f"{prof.estimator(part.estimator).samples} terms per frame, {_history(part)}, λ = {part.blend:g}: "
+                   f"predicted "
                    f"error {choice.predicted_error:.4g}, PSNR {psnr_text(choice.predicted_psnr)} ± "
                    f"{choice.predicted_psnr_uncertainty or 0:.1f} dB, {choice.predicted_ms:.3f} ms per frame, "
                    f"{choice.predicted_speedup:.2f}× the original")
@@ -96,3 +99,10 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
             click.echo(f"note: below {VISIBLE_DB:.0f} dB: expect visible artifacts")
     if written:
         click.echo(f"wrote {len(written)} files to {out_dir}")
+
+
+def _history(part) -> str:
+    """How the amortized choice keeps its history, in words."""
+    if part.history == "slots":
+        return "slots history (the N/m subset sums kept apart, each blended with its own)"
+    return "blend history (one running estimate)"

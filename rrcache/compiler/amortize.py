@@ -27,7 +27,8 @@ estimators`: ``a0 + Σ_i t(i)`` over ``N`` iterations), packed into the payload.
 - at a **miss** (disocclusion) all ``N`` iterations run, as in the original.
 
 ``history="slots"`` (with the ``frame`` phase and ``N = s·m``, when ``s`` times the
-accumulators fit in the payload's 4 components): the payload keeps the ``s`` subset sums
+accumulators fit in the payload's 4 components: :func:`rrcache.selection.slots_fit`, the rule the
+profiler and the models use too): the payload keeps the ``s`` subset sums
 apart. A hit recomputes its phase's sum (blended with that slot's reprojected value by ``λ``;
 ``λ = 0`` replaces it) and the value is the start plus all ``s`` slots, so on a still image the
 full sum is back after one cycle, exactly; a miss computes the ``s`` sums (all ``N``
@@ -75,6 +76,7 @@ from rrcache.compiler.prune import prune
 from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import AMORTIZE_GLSL, AMORTIZE_PIXEL_GLSL, FILTERS
+from rrcache.selection import slots_fit
 
 __all__ = ["instance_amortized", "LocatedLoop", "HISTORIES", "PHASES", "prepare_loop", "subset_indices"]
 
@@ -490,13 +492,10 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         raise ValueError(f"history must be one of {HISTORIES}, not {history!r}")
     payload_components = loc.components
     if history == "slots":
-        if phase != "frame" or samples >= est.samples or est.samples % samples:
-            raise ValueError("the 'slots' history needs the 'frame' phase and m < N dividing N "
-                             f"(estimator {est.id}: N = {est.samples}, m = {samples})")
+        why = slots_fit(est.samples, samples, loc.components, phase)
+        if why is not None:
+            raise ValueError(f"estimator {est.id}: {why}")
         payload_components = (est.samples // samples) * loc.components
-        if payload_components > 4:
-            raise ValueError(f"the 'slots' history keeps N/m = {est.samples // samples} sums of "
-                             f"{loc.components} component(s): more than the payload's 4")
     passes: dict[str, PassSource] = {}
     uniforms: dict[str, list[str]] = {}
     samplers: dict[str, list[str]] = {}

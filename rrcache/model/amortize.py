@@ -24,6 +24,30 @@ for every m, the reflections lagging the orbiting camera). Of the lag terms trie
 b·λ/(1−λ), b·λ and b·sqrt(λ/(1−λ)), the last fitted best on both (R² 0.96 and 0.91 against
 0.96 and 0.70, 0.95 and 0.80).
 
+**Error of the slots history** (``history="slots"``: the N/m subset sums kept apart in the
+payload, each blended with its own reprojected value by λ at its phase):
+
+    ε̂(m, λ) = sqrt(c_m² + b² · λ/(1 − λ))
+
+No noise term: the slots are exact on a still image whatever λ (after one cycle every slot holds
+its own subset's sum), so the error against the original is all reprojection and motion. ``c_m``
+is the floor at λ = 0 (the N/m − 1 slots not recomputed this frame are 1..N/m − 1 frames old and
+resampled every frame); it is one coefficient per m, because the measurements follow no law in
+m: on the temple with ``PCF_SAMPLES=12`` the error at λ = 0 is 0.0028 at m = 3, 0.0037 at m = 4
+and 0.0024 at m = 6 (the subsets of a stratified pattern differ in shape, not only in size). That
+costs nothing in prediction: the slots fit at few m (one component: N/m = 2, 3 or 4) and the
+profiler trains every one of them, so the options are only at trained m. The second term is the
+blend model's lag term, added in quadrature: a slot blended by λ is λ/(1 − λ) cycles older on
+average and each slot's drift is an independent error of variance growing with its age
+(``b ≥ 0`` shared by the m). Why this form, from measurements (m × λ grids, λ = 0, 0.3, 0.6,
+0.8, 0.9, 320×240, 40 frames, least squares on the error; docs/amortize_model_grid.json): R² 0.95
+(temple, N = 16, m = 4, 8) and 0.91 (N = 12, m = 3, 4, 6) over each grid, and 0.90 and 0.87 on
+the runs left out when fitted on λ = 0, 0.6, 0.9 only; the blend form fitted to the slots runs
+gave 0.90 and 0.65, c_m + b·sqrt(λ/(1−λ)) 0.94 and 0.84, the age of the slots in frames
+(N/m·λ/(1−λ)) in place of λ/(1−λ) 0.97 and 0.89 (0.93 and 0.86 held out), and one floor for
+every m (a·sqrt((N/m − 1)·m/N)) 0.96 and 0.79. The error grows with λ (0.0016 at λ = 0 to 0.0034
+at λ = 0.9, N = 16, m = 4): the best slots option is usually λ = 0.
+
 **Time**: a frame costs ``c + t_s · S`` where ``S = P (h m + (1 − h) N)`` is the number of terms
 evaluated over the frame's ``P`` covered pixels at hit rate ``h`` (least squares over the timed
 frames, each taken relative to the original timed beside it; ``t_s`` ≥ 0, ms per evaluated
@@ -45,7 +69,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from rrcache.errors import RRCacheError
-from rrcache.selection import AmortizedLoop, Selection
+from rrcache.selection import AmortizedLoop, Selection, slots_fit, slots_samples
 
 #: the blends the options are predicted at (the paper's 3/5 and 7/9 among them)
 BLEND_GRID = (0.0, 0.2, 0.4, 0.5, 0.6, 0.7, 7.0 / 9.0, 0.85, 0.9)
@@ -69,13 +93,19 @@ def sample_counts(total: int) -> list[int]:
     return divisors if len(divisors) >= 2 else list(range(1, n))
 
 
-def training_samples(total: int) -> list[int]:
-    """The m the error and timing runs measure: the smallest, the middle and the largest of
-    :func:`sample_counts` (at most :data:`TRAIN_SAMPLES`).
+def training_samples(total: int, history: str = "blend", components: int = 1) -> list[int]:
+    """The m the error and timing runs measure: for ``blend`` the smallest, the middle and the
+    largest of :func:`sample_counts` (at most :data:`TRAIN_SAMPLES`); for ``slots`` every m where
+    the N/m sums of ``components`` components fit (:func:`rrcache.selection.slots_samples`: at
+    most three, N/m = 2, 3 or 4 for one component), the only m it is offered at.
 
     >>> training_samples(16), training_samples(5), training_samples(2)
     ([1, 4, 8], [1, 3, 4], [1])
+    >>> training_samples(16, "slots"), training_samples(16, "slots", 2), training_samples(5, "slots")
+    ([4, 8], [8], [])
     """
+    if history == "slots":
+        return slots_samples(total, components)
     counts = sample_counts(total)
     if len(counts) <= TRAIN_SAMPLES:
         return counts
@@ -120,6 +150,10 @@ class AmortizeErrorFit:
         noise, lag = _terms(samples, blend, self.total)
         out = self.a * noise + self.b * lag
         return float(out) if np.ndim(out) == 0 else out
+
+    def to_json(self) -> dict:
+        return {"a": self.a, "b": self.b, "total": self.total, "r2": self.r2, "rms": self.rms, "n": self.n,
+                "quality": self.quality}
 
 
 def fit_amortized_error(samples: Sequence[int], blends: Sequence[float], errors: Sequence[float],
@@ -179,6 +213,132 @@ def fit_amortized_error(samples: Sequence[int], blends: Sequence[float], errors:
     return AmortizeErrorFit(a, b, int(total), float(min(r2, 1.0)), math.sqrt(ss_res / n), n, quality)
 
 
+def _lag_squared(blends) -> np.ndarray:
+    lam = np.clip(np.asarray(blends, dtype=np.float64), 0.0, 0.999)
+    return lam / (1.0 - lam)
+
+
+@dataclass(frozen=True)
+class SlotsErrorFit:
+    """ε̂(m, λ) = sqrt(c_m² + ``b``²·λ/(1−λ)) (module docstring, the slots history) with the
+    floors c_m ``base`` at the m of ``samples`` (NaN at any other m: the profiler trains every
+    m the slots fit); ``r2``, ``rms`` over the ``n`` runs; ``quality`` ``ok``, ``poor`` (R² <
+    0.8), ``insufficient`` (no more runs than coefficients) or ``zero``.
+
+    >>> fit = fit_slots_error([4, 4, 4, 8, 8, 8], [0, 0.6, 0.85] * 2, [0.0016, 0.0021, 0.0030, 0.0015, 0.0016, 0.0025], 16)
+    >>> fit.samples, fit.quality, round(float(fit.predict(4, 0.0)), 4), bool(np.isnan(fit.predict(2, 0.0)))
+    ((4, 8), 'ok', 0.0017, True)
+    """
+
+    samples: tuple
+    base: tuple
+    b: float
+    total: int
+    r2: float
+    rms: float
+    n: int
+    quality: str
+
+    def predict(self, samples, blend):
+        m = np.asarray(samples, dtype=np.float64)
+        floor = np.full(np.broadcast_shapes(m.shape, np.shape(blend)), np.nan)
+        for k, c in zip(self.samples, self.base):
+            floor = np.where(np.broadcast_to(m, floor.shape) == k, c, floor)
+        out = np.sqrt(floor * floor + self.b * self.b * _lag_squared(blend))
+        return float(out) if np.ndim(out) == 0 else out
+
+    def to_json(self) -> dict:
+        return {"samples": [int(m) for m in self.samples], "base": [float(c) for c in self.base], "b": self.b,
+                "total": self.total, "r2": self.r2, "rms": self.rms, "n": self.n, "quality": self.quality}
+
+
+def fit_slots_error(samples: Sequence[int], blends: Sequence[float], errors: Sequence[float],
+                    total: int) -> SlotsErrorFit:
+    """Fit the slots history's error model (module docstring) to error runs at (``samples[i]``,
+    ``blends[i]``) with mean errors ``errors[i]`` (non-finite runs left out): nlopt's
+    Nelder–Mead over (b, c_m...) ≥ 0 on the errors divided by their largest, from the best of a
+    few closed-form starts. Never returns NaN."""
+    import nlopt
+
+    m = np.asarray(samples, dtype=np.float64)
+    lam = np.asarray(blends, dtype=np.float64)
+    e = np.asarray(errors, dtype=np.float64)
+    if not (m.shape == lam.shape == e.shape):
+        raise RRCacheError("samples, blends and errors must have one value per run", "amortization model")
+    keep = np.isfinite(m) & np.isfinite(lam) & np.isfinite(e) & (m >= 1) & (lam >= 0) & (lam < 1)
+    m, lam, e = m[keep].astype(np.int64), lam[keep], np.maximum(e[keep], 0.0)
+    ms = tuple(int(v) for v in sorted(set(m.tolist())))
+    n = int(e.size)
+    if n == 0:
+        return SlotsErrorFit((), (), 0.0, int(total), 1.0, 0.0, 0, "insufficient")
+    scale = float(e.max())
+    if scale <= 0:
+        return SlotsErrorFit(ms, tuple(0.0 for _ in ms), 0.0, int(total), 1.0, 0.0, n, "zero")
+    y = e / scale
+    x = _lag_squared(lam)
+    which = np.array([ms.index(int(v)) for v in m])
+
+    def model(v):
+        c = np.asarray(v[1:])[which]
+        return np.sqrt(c * c + v[0] * v[0] * x)
+
+    def sse(v, grad=None):
+        r = model(v) - y
+        return float(np.dot(r, r))
+
+    # starts: each m's smallest-λ run as its floor with b from the rest on the squares; the
+    # linear least squares of the squares (floors² and b² clipped at 0); b = 0 with each m's mean
+    floors = np.array([y[which == k][np.argmin(lam[which == k])] for k in range(len(ms))])
+    rest = y * y - floors[which] ** 2
+    b2 = float(np.dot(x, rest) / np.dot(x, x)) if np.dot(x, x) > 0 else 0.0
+    starts = [np.concatenate([[math.sqrt(max(b2, 0.0))], floors]),
+              np.concatenate([[0.0], [float(y[which == k].mean()) for k in range(len(ms))]])]
+    design = np.concatenate([x[:, None], (which[:, None] == np.arange(len(ms))[None, :]).astype(np.float64)], axis=1)
+    sq, *_ = np.linalg.lstsq(design, y * y, rcond=None)
+    starts.append(np.sqrt(np.maximum(sq, 0.0)))
+    start = min(starts, key=sse)
+    opt = nlopt.opt(nlopt.LN_NELDERMEAD, 1 + len(ms))
+    opt.set_min_objective(sse)
+    opt.set_lower_bounds([0.0] * (1 + len(ms)))
+    opt.set_upper_bounds([1e6] * (1 + len(ms)))
+    opt.set_xtol_rel(1e-10)
+    opt.set_ftol_abs(1e-16)
+    opt.set_maxeval(8000)
+    opt.set_initial_step([max(0.1 * v, 1e-3) for v in start])
+    try:
+        v = opt.optimize(np.clip(start, 0.0, 1e6))
+        if sse(v) > sse(start) or not np.all(np.isfinite(v)):
+            v = start
+    except (RuntimeError, ValueError, nlopt.RoundoffLimited):
+        v = start
+    v = np.asarray(v, dtype=np.float64)
+    pred = model(v) * scale
+    res = pred - e
+    ss_res = float(np.dot(res, res))
+    ss_tot = float(np.dot(e - e.mean(), e - e.mean()))
+    r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else 1.0
+    quality = "insufficient" if n <= len(ms) else ("poor" if r2 < 0.8 else "ok")
+    return SlotsErrorFit(ms, tuple(float(c) * scale for c in v[1:]), float(v[0]) * scale, int(total),
+                         float(min(r2, 1.0)), math.sqrt(ss_res / n), n, quality)
+
+
+def fit_error(history: str, samples, blends, errors, total: int):
+    """The error model of ``history`` (``blend``: :func:`fit_amortized_error`; ``slots``:
+    :func:`fit_slots_error`) fitted to its runs."""
+    if history == "slots":
+        return fit_slots_error(samples, blends, errors, total)
+    return fit_amortized_error(samples, blends, errors, total)
+
+
+def error_fit_from_json(history: str, data: dict):
+    """The error fit of ``history`` from its ``error_fit`` record (what ``to_json`` wrote)."""
+    if history == "slots":
+        return SlotsErrorFit(tuple(int(m) for m in data["samples"]), tuple(float(c) for c in data["base"]),
+                             float(data["b"]), int(data["total"]), float(data["r2"]), float(data["rms"]),
+                             int(data["n"]), str(data["quality"]))
+    return AmortizeErrorFit(**{k: data[k] for k in ("a", "b", "total", "r2", "rms", "n", "quality")})
+
+
 @dataclass(frozen=True)
 class AmortizeTimeFit:
     """Frame time = ``fixed_ms`` + ``t_sample`` · (terms evaluated over the frame); ``rms``
@@ -218,32 +378,47 @@ def fit_amortized_time(evaluated: Sequence[float], ms: Sequence[float]) -> Amort
 
 @dataclass(frozen=True)
 class AmortizeModel:
-    """One trained estimator's models: ``estimator`` id, ``total`` N, ``error`` and ``time``
-    fits, ``hit_rate`` h (the timing runs'), ``pixels`` P (mean covered pixels per frame),
-    ``psnr`` (a :class:`~rrcache.model.psnr.PsnrFit` or None), ``text`` (the loop)."""
+    """One trained estimator's models for one history: ``estimator`` id, ``total`` N,
+    ``error`` (:class:`AmortizeErrorFit` for ``blend``, :class:`SlotsErrorFit` for ``slots``) and
+    ``time`` fits, ``hit_rate`` h (the timing runs'), ``pixels`` P (mean covered pixels per
+    frame), ``psnr`` (a :class:`~rrcache.model.psnr.PsnrFit` or None), ``text`` (the loop),
+    ``history``, ``components`` (the accumulators' payload components; None: not recorded)."""
 
     estimator: str
     total: int
-    error: AmortizeErrorFit
+    error: object
     time: AmortizeTimeFit
     hit_rate: float
     pixels: float
     psnr: object = None
     text: Optional[str] = None
+    history: str = "blend"
+    components: Optional[int] = None
+
+    def sample_counts(self) -> list[int]:
+        """The m this history is offered at: :func:`sample_counts` for ``blend``; for ``slots``
+        the trained m where the slots fit (:func:`rrcache.selection.slots_fit`)."""
+        if self.history != "slots":
+            return sample_counts(self.total)
+        trained = [int(m) for m in getattr(self.error, "samples", ())]
+        if self.components is None:
+            return trained
+        return [m for m in trained if slots_fit(self.total, m, self.components) is None]
 
     def evaluated(self, samples) -> np.ndarray:
         h = min(max(self.hit_rate, 0.0), 1.0)
         return self.pixels * (h * np.asarray(samples, dtype=np.float64) + (1.0 - h) * self.total)
 
     def options(self, original_ms: float) -> list[Selection]:
-        """Every (m, λ) of :func:`sample_counts` × :data:`BLEND_GRID` as a predicted
-        :class:`Selection` (one :class:`AmortizedLoop` part)."""
+        """Every (m, λ) of :meth:`sample_counts` × :data:`BLEND_GRID` as a predicted
+        :class:`Selection` (one :class:`AmortizedLoop` part of this history)."""
         out = []
-        for m in sample_counts(self.total):
+        for m in self.sample_counts():
             ms = float(self.time.frame_ms(self.evaluated(m)))
             for lam in BLEND_GRID:
                 err = max(float(self.error.predict(m, lam)), 0.0)
-                sel = Selection((AmortizedLoop(self.estimator, int(m), float(round(lam, 6)), text=self.text),),
+                sel = Selection((AmortizedLoop(self.estimator, int(m), float(round(lam, 6)), self.history,
+                                               text=self.text),),
                                 err, ms, float(original_ms) / ms if ms > 0 else math.inf)
                 if self.psnr is not None:
                     sel = sel.replace(predicted_psnr=float(self.psnr.predict(err)) if err > 0 else None)

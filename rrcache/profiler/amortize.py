@@ -2,24 +2,32 @@
 (Nehab et al. 2007 §6; the models are :mod:`rrcache.model.amortize`).
 
 :func:`train_estimators` runs after the nodes are trained (:mod:`rrcache.profiler.train`), in
-the same windows (:mod:`rrcache.profiler.plan`) and with the same algorithm:
+the same windows (:mod:`rrcache.profiler.plan`) and with the same algorithm. Each estimator is trained for both histories of the compiler
+(:func:`rrcache.compiler.amortize.instance_amortized`): the paper's running ``blend`` at m of
+:func:`rrcache.model.amortize.training_samples` (for 16 terms m = 1, 4, 8) and ``slots`` (the
+N/m subset sums kept apart) at every m where they fit the payload
+(:func:`rrcache.selection.slots_fit`: for 16 terms of one component m = 4 and 8; none for a
+prime N or four components), the only m it is offered at. Per history:
 
-1. **Error runs.** Per estimator and per trained m (:func:`rrcache.model.amortize.training_samples`:
-   for 16 terms m = 1, 4, 8) one compiled variant serves every blend (λ is the runtime's
+1. **Error runs.** Per trained m one compiled variant serves every blend (λ is the runtime's
    ``blend``): the training frames are rendered in order from an empty cache at each λ of
    :data:`~rrcache.model.amortize.TRAIN_BLENDS` and compared with the original (the error window
    at full pixel density), as a node's error runs are at each Δn; a run's error is the mean over
    the frames after the first.
-2. **Timing.** Each trained m at the session's full resolution on the timing frames: the original
-   renders frame f, the variant f − 1 (untimed, from an empty cache) and f timed; each variant
-   time is taken relative to the original's beside it and scaled by the original's typical
-   frame time, so machine load cancels.
-3. **Fits.** The error model by nlopt over every error run, the time per evaluated term by least
-   squares through each timed m's median relative frame time.
+2. **Timing.** Each trained m at the session's full resolution on the timing frames (the slots
+   write and read N/m times the payload's components: timed, not assumed): the original renders
+   frame f, the variant f − 1 (untimed, from an empty cache) and f timed; each variant time is
+   taken relative to the original's beside it and scaled by the original's typical frame time,
+   so machine load cancels.
+3. **Fits.** The history's error model (:func:`rrcache.model.amortize.fit_error`) by nlopt over
+   its error runs, the time per evaluated term by least squares through each timed m's median
+   relative frame time.
 
 The estimators are trained costliest (most terms) first; the first always, the others while the
 training budget (``settings.budget_s``, node runs included) lasts. Every run is stored as it
-completes (:mod:`rrcache.profiles.amortize`) and skipped when a profile is resumed.
+completes (:mod:`rrcache.profiles.amortize`, keyed by history) and skipped when a profile is
+resumed. The slots history adds 2 × 3 error runs and 2 timed m for a 16-term estimator (the blend
+history's 3 × 3 and 3).
 """
 from __future__ import annotations
 
@@ -33,22 +41,35 @@ from rrcache.errors import RRCacheError
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
-from rrcache.model.amortize import TRAIN_BLENDS, fit_amortized_error, fit_amortized_time, training_samples
+from rrcache.compiler.amortize import HISTORIES
+from rrcache.model.amortize import TRAIN_BLENDS, fit_amortized_time, fit_error, training_samples
 from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn, timed_beside, timing_frame_indices
 from rrcache.profiles import amortize as data
-from rrcache.profiles.amortize import EstimatorProfile
+from rrcache.profiles.amortize import EstimatorProfile, HistoryRuns
+from rrcache.selection import PAYLOAD_COMPONENTS
 from rrcache.runtime import DEFAULT_PERIOD
 
 
 def _record(est) -> EstimatorProfile:
-    return EstimatorProfile(est.id, est.line, est.column, int(est.samples), est.text)
+    return EstimatorProfile(est.id, est.line, est.column, int(est.samples), est.text, components=int(est.components))
+
+
+def _slots_record(est) -> Optional[HistoryRuns]:
+    """The slots history's record before training: None for an estimator that is not trained at
+    all; a note when the slots fit no m (:func:`rrcache.selection.slots_fit`)."""
+    if training_samples(int(est.samples), "slots", int(est.components)):
+        return HistoryRuns()
+    n = int(est.samples)
+    return HistoryRuns(note=f"not offered: no m < N dividing N = {n} keeps the N/m sums of {int(est.components)} "
+                            f"component(s) within the payload's {PAYLOAD_COMPONENTS}")
 
 
 def train_estimators(work, session, settings, store, result, progress: Optional[ProgressFn] = None,
                      clock=time.perf_counter) -> list[EstimatorProfile]:
-    """Train every estimator of ``work`` the budget allows (module docstring) and return their
-    records, trained or with a ``note`` saying why not. ``result`` is the nodes'
-    :class:`~rrcache.profiler.train.TrainingResult` (its plan, algorithm and original time)."""
+    """Train every estimator of ``work`` the budget allows, each history at its m (module
+    docstring), and return their records, trained or with a ``note`` saying why not. ``result``
+    is the nodes' :class:`~rrcache.profiler.train.TrainingResult` (its plan, algorithm and
+    original time)."""
     from rrcache.analysis.estimators import find_estimators
 
     try:
@@ -85,26 +106,33 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             rec.note = f"not trained: its accumulators need {est.components} payload components (at most 4)"
             continue
         spent = store.spent_s() + data.spent_s(store)
-        started = bool(data.rows(store, est.id, "error") or data.rows(store, est.id, "timing"))
+        started = any(data.rows(store, est.id, kind, history) for kind in ("error", "timing") for history in HISTORIES)
         if k > 0 and not started and spent >= settings.budget_s:
             rec.note = "not reached within the training budget (--budget)"
             continue
-        ms_list = training_samples(est.samples)
-        state["total"] += len(ms_list) * (len(TRAIN_BLENDS) * len(frames) + 3 * len(timing))
-        try:
-            if refs is None and _missing_errors(store, est.id, ms_list):
-                refs = _references(work, session, settings, plan, frames, step)
-            _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock)
-            _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock)
-        except RRCacheError as err:  # a variant that does not compile or run: say why, go on
-            rec.note = f"not trained: {err}"
-            continue
-        _fit(rec, store, result.original_ms)
+        rec.slots = _slots_record(est)
+        plans = [(history, training_samples(int(est.samples), history, int(est.components))) for history in HISTORIES]
+        plans = [(history, ms_list) for history, ms_list in plans if ms_list]
+        state["total"] += sum(len(ms_list) * (len(TRAIN_BLENDS) * len(frames) + 3 * len(timing))
+                              for _, ms_list in plans)
+        for history, ms_list in plans:
+            target = rec.runs(history)
+            try:
+                if refs is None and _missing_errors(store, est.id, ms_list, history):
+                    state["total"] += len(frames)  # the reference frames, rendered once for all
+                    refs = _references(work, session, settings, plan, frames, step)
+                _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock, history)
+                _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
+                             history)
+            except RRCacheError as err:  # a variant that does not compile or run: say why, go on
+                target.note = f"not trained: {err}"
+                continue
+            _fit(target, store, result.original_ms, est.id, int(est.samples), history)
     return records
 
 
-def _missing_errors(store, eid: str, ms_list) -> bool:
-    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, eid, "error")}
+def _missing_errors(store, eid: str, ms_list, history: str = "blend") -> bool:
+    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, eid, "error", history)}
     return any((m, round(lam, 6)) not in have for m in ms_list for lam in TRAIN_BLENDS)
 
 
@@ -117,20 +145,26 @@ def _references(work, session, settings, plan, frames, step) -> list:
     return refs
 
 
-def _variant(work, est, algorithm: str, m: int):
+def _variant(work, est, algorithm: str, m: int, history: str = "blend"):
     from rrcache.compiler.amortize import instance_amortized
 
-    return instance_amortized(work.shader, est.id, algorithm, samples=m, blend=0.0, vertex=work.vertex)
+    return instance_amortized(work.shader, est.id, algorithm, samples=m, blend=0.0, history=history,
+                              vertex=work.vertex)
 
 
-def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock) -> None:
-    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error")}
+def _label(est, m: int, history: str) -> str:
+    return f"{est.id} m={m}" + (" slots" if history == "slots" else "")
+
+
+def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock,
+                history: str = "blend") -> None:
+    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error", history)}
     for m in ms_list:
         todo = [lam for lam in TRAIN_BLENDS if (m, round(lam, 6)) not in have]
         if not todo:
             continue
         built = clock()
-        with CachedRenderer(_variant(work, est, algorithm, m), session, work.prepared, settings.resolution,
+        with CachedRenderer(_variant(work, est, algorithm, m, history), session, work.prepared, settings.resolution,
                             period=DEFAULT_PERIOD, window=plan.error_window, **settings.cache_options()) as cached:
             extra = clock() - built
             for lam in todo:
@@ -140,7 +174,7 @@ def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, r
                 errs, psnrs, hits, misses = [], [], 0, 0
                 for i, ref in enumerate(refs):
                     got = cached.render_frame(ref.index)
-                    step(f"{est.id} m={m} λ={lam:g}")
+                    step(f"{_label(est, m, history)} λ={lam:g}")
                     if i == 0:
                         continue  # the first frame has no cache
                     errs.append(float(mean_l2(got.image, ref.image, ref.mask)[0]))
@@ -152,12 +186,13 @@ def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, r
                 rate = hits / (hits + misses) if hits + misses else 0.0
                 wall = clock() - start + extra
                 extra = 0.0
-                data.add_rows(store, [(est.id, "error", int(m), float(lam), -1, float(np.mean(errs)),
+                data.add_rows(store, [(est.id, history, "error", int(m), float(lam), -1, float(np.mean(errs)),
                                        float(np.mean(psnrs)), rate, hits, misses, 0.0, 0.0, wall)])
 
 
-def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock) -> None:
-    have = {r["samples"] for r in data.rows(store, est.id, "timing")}
+def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
+                 history: str = "blend") -> None:
+    have = {r["samples"] for r in data.rows(store, est.id, "timing", history)}
     todo = [m for m in ms_list if m not in have]
     if not todo or not timing:
         return
@@ -165,7 +200,7 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
     with Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt) as original:
         for m in todo:
             start = clock()
-            with CachedRenderer(_variant(work, est, algorithm, m), session, work.prepared, full,
+            with CachedRenderer(_variant(work, est, algorithm, m, history), session, work.prepared, full,
                                 period=DEFAULT_PERIOD, window=plan.timing_window, color_format=fmt,
                                 **settings.cache_options()) as cached:
                 # (the renderer's first frame draws every phase program once, untimed: a phase's
@@ -174,17 +209,19 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
                 for index in timing:
                     got, ref = timed_beside(cached, original, index)
                     out.append((index, got, ref.ms))
-                    step(f"{est.id} m={m} timing", 3)
+                    step(f"{_label(est, m, history)} timing", 3)
             wall = (clock() - start) / max(1, len(out))
-            data.add_rows(store, [(est.id, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0, int(got.hits or 0),
-                                   int(got.misses or 0), float(got.ms), float(ref_ms), wall)
+            data.add_rows(store, [(est.id, history, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0,
+                                   int(got.hits or 0), int(got.misses or 0), float(got.ms), float(ref_ms), wall)
                                   for index, got, ref_ms in out])
 
 
-def _fit(rec: EstimatorProfile, store, original_ms: float) -> None:
-    """The models of ``rec`` from its stored runs (module docstring, step 3)."""
-    errors = data.rows(store, rec.id, "error")
-    timed = data.rows(store, rec.id, "timing")
+def _fit(rec, store, original_ms: float, estimator: str, total: int, history: str = "blend") -> None:
+    """The models of one history of an estimator from its stored runs (module docstring, step
+    3), into ``rec`` (the :class:`EstimatorProfile` for ``blend``, its :class:`HistoryRuns`
+    for ``slots``)."""
+    errors = data.rows(store, estimator, "error", history)
+    timed = data.rows(store, estimator, "timing", history)
     if not errors or not timed:
         rec.note = "not trained: runs missing"
         return
@@ -193,7 +230,7 @@ def _fit(rec: EstimatorProfile, store, original_ms: float) -> None:
     rec.errors = [float(r["mean_error"]) for r in errors]
     rec.psnrs = [float(r["psnr"]) for r in errors]
     rec.hit_rates = [float(r["hit_rate"]) for r in errors]
-    ef = fit_amortized_error(rec.run_samples, rec.run_blends, rec.errors, rec.samples)
+    ef = fit_error(history, rec.run_samples, rec.run_blends, rec.errors, total)
     # every variant frame relative to the original beside it, on the original's typical time
     hits, covered = 0, 0
     by_m: dict[int, list] = {}
@@ -201,7 +238,7 @@ def _fit(rec: EstimatorProfile, store, original_ms: float) -> None:
         if r["original_ms"] <= 0:
             continue
         rel = float(r["ms"]) / float(r["original_ms"]) * float(original_ms)
-        n = int(r["hits"]) * int(r["samples"]) + int(r["misses"]) * rec.samples
+        n = int(r["hits"]) * int(r["samples"]) + int(r["misses"]) * total
         hits += int(r["hits"])
         covered += int(r["hits"]) + int(r["misses"])
         by_m.setdefault(int(r["samples"]), []).append((rel, float(n)))
@@ -210,8 +247,7 @@ def _fit(rec: EstimatorProfile, store, original_ms: float) -> None:
     rec.timed_evaluated = [float(statistics.median(v[1] for v in by_m[m])) for m in rec.timed_samples]
     # the line through each m's median (a loaded machine's outlier frames do not pull it)
     tf = fit_amortized_time(rec.timed_evaluated, rec.timed_ms)
-    rec.error_fit = {"a": ef.a, "b": ef.b, "total": ef.total, "r2": ef.r2, "rms": ef.rms, "n": ef.n,
-                     "quality": ef.quality}
+    rec.error_fit = ef.to_json()
     rec.time_fit = {"fixed_ms": tf.fixed_ms, "t_sample": tf.t_sample, "rms": tf.rms, "n": tf.n, "quality": tf.quality}
     rec.hit_rate = hits / covered if covered else 0.0
     rec.pixels = covered / max(1, len(timed))

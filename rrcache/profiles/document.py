@@ -354,9 +354,9 @@ class Profile:
                     "visible_artifacts": False,
                     "predicted_speedup_range": (choice.predicted_speedup, choice.predicted_speedup)}
         if isinstance(choice.parts[0], AmortizedLoop):
-            est = self.estimator(choice.parts[0].estimator)
+            runs = self.estimator(choice.parts[0].estimator).runs(choice.parts[0].history)
             value, spread = predicted_psnr(self._estimator_psnr(choice), choice.predicted_error)
-            rms = float(est.time_fit.get("rms") or 0.0)
+            rms = float((runs.time_fit if runs is not None else {}).get("rms") or 0.0)
         else:
             trained = [n.id for n in self.trained_nodes]
             i = trained.index(choice.node)
@@ -423,15 +423,15 @@ class Profile:
                            hint="the profile lists its estimators in profile.json")
 
     def amortized_options(self) -> list[Selection]:
-        """Every (estimator, m, λ) the trained estimators' models predict
-        (:meth:`rrcache.model.amortize.AmortizeModel.options`), on the same error-against-time
-        axes as the cached nodes' options."""
+        """Every (estimator, history, m, λ) the trained estimators' models predict
+        (:meth:`rrcache.model.amortize.AmortizeModel.options`: the blend history's and, where
+        they fit and were trained, the slots history's), on the same error-against-time axes as
+        the cached nodes' options."""
         if not self.original_ms:
             return []
         out = []
         for est in self.estimators:
-            model = est.model()
-            if model is not None:
+            for model in est.models():
                 out.extend(model.options(float(self.original_ms)))
         return out
 
@@ -451,7 +451,8 @@ class Profile:
         return choice
 
     def _estimator_psnr(self, choice: Selection):
-        model = self.estimator(choice.parts[0].estimator).model()
+        part = choice.parts[0]
+        model = self.estimator(part.estimator).model(part.history)
         return model.psnr if model is not None else None
 
     def write_variant(self, choice: Selection, out_dir) -> list[str]:
@@ -655,6 +656,57 @@ def _check_models(prof: "Profile", file: str) -> None:
                 check(getattr(node, kind), kind, f"nodes[{i}].{kind}")
     if prof.hit_fit:
         check(prof.hit_fit, "hit_fit", "hit_fit")
+    for i, est in enumerate(prof.estimators):
+        _check_estimator(est, f"estimators[{i}]", "blend", file)
+        if est.slots is not None:
+            _check_estimator(est.slots, f"estimators[{i}].slots", "slots", file)
+
+
+#: the keys of a trained estimator history's fits (what :meth:`EstimatorProfile.model` rebuilds
+#: its models from), and the numbers among them the selection computes with (finite, ≥ 0)
+_ESTIMATOR_FITS = {
+    "blend": {"error_fit": (("a", "b", "total", "r2", "rms", "n", "quality"), ("a", "b")),
+              "time_fit": (("fixed_ms", "t_sample", "rms", "n", "quality"), ("fixed_ms", "t_sample"))},
+    "slots": {"error_fit": (("samples", "base", "b", "total", "r2", "rms", "n", "quality"), ("b",)),
+              "time_fit": (("fixed_ms", "t_sample", "rms", "n", "quality"), ("fixed_ms", "t_sample"))},
+}
+
+
+def _check_estimator(runs, at: str, history: str, file: str) -> None:
+    """A trained history of an estimator (its record, or its ``slots``) has its fits' keys, their
+    numbers finite and ≥ 0 (the slots floors ``base`` one per whole ``samples`` ≥ 1), and no
+    unknown key in them."""
+    if not runs.trained:
+        return
+    for kind, (keys, numbers) in _ESTIMATOR_FITS[history].items():
+        data = getattr(runs, kind)
+        where = f"{at}.{kind}"
+        if not data:
+            raise _fail(file, where, "is missing for a trained estimator")
+        unknown = sorted(set(data) - set(keys))
+        if unknown:
+            raise _fail(file, f"{where}.{unknown[0]}", "unknown key")
+        missing = [k for k in keys if k not in data]
+        if missing:
+            raise _fail(file, f"{where}.{missing[0]}", "is missing")
+        for key in numbers:
+            value = data[key]
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise _fail(file, f"{where}.{key}", "must be a finite number >= 0")
+        for key in ("total", "n"):
+            if key in data and (isinstance(data[key], bool) or not isinstance(data[key], int) or data[key] < 0):
+                raise _fail(file, f"{where}.{key}", "must be a whole number >= 0")
+    if history == "slots":
+        fit = runs.error_fit
+        samples, base = fit["samples"], fit["base"]
+        if not isinstance(samples, list) or not all(isinstance(m, int) and not isinstance(m, bool) and m >= 1
+                                                    for m in samples):
+            raise _fail(file, f"{at}.error_fit.samples", "must be a list of whole numbers >= 1")
+        if not isinstance(base, list) or len(base) != len(samples):
+            raise _fail(file, f"{at}.error_fit.base", "must be a list of one number per sample count")
+        for j, c in enumerate(base):
+            if isinstance(c, bool) or not isinstance(c, (int, float)) or not math.isfinite(c) or c < 0:
+                raise _fail(file, f"{at}.error_fit.base[{j}]", "must be a finite number >= 0")
 
 
 def _in_range(value, meta) -> bool:

@@ -123,8 +123,10 @@ def _multi_selection(sel) -> str:
     are not rendered here: the report's images show one cached node)."""
     if sel.kind == "amortize":
         p = sel.parts[0]
-        what = (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples} of its terms per frame, blended "
-                f"with the reprojected estimate by λ = {p.blend:g}" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
+        how = ("each of its N/m subset sums kept apart and blended with its own reprojected value"
+               if p.history == "slots" else "blended with the reprojected estimate")
+        what = (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples} of its terms per frame, {how} by "
+                f"λ = {p.blend:g}" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
     else:
         what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
                                      + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
@@ -232,19 +234,31 @@ def _estimators(prof) -> str:
         return ""
     rows = []
     for est in prof.estimators:
-        ef, tf = est.error_fit or {}, est.time_fit or {}
-        fit = (f"a = {_f(ef.get('a'))}, b = {_f(ef.get('b'))}, R² = {_f(ef.get('r2'), 3)}" if est.trained else
-               _e(est.note or "not trained"))
-        per = _f(float(tf.get("t_sample") or 0.0) * 1e6, 3) if est.trained else "–"
-        rows.append(f"<tr><td>{_e(est.id)}</td><td class=num>{est.line}</td><td class=num>{est.samples}</td>"
-                    f"<td><code>{_e(est.text)}</code></td><td>{fit}</td><td class=num>{per}</td></tr>")
+        for history in ("blend", "slots"):
+            runs = est.runs(history)
+            if runs is None:
+                continue
+            ef, tf = runs.error_fit or {}, runs.time_fit or {}
+            if not runs.trained:
+                fit = _e(runs.note or "not trained")
+            elif history == "slots":
+                floors = ", ".join(f"c<sub>{m}</sub> = {_f(c)}" for m, c in zip(ef.get("samples", []), ef.get("base", [])))
+                fit = f"{floors}, b = {_f(ef.get('b'))}, R² = {_f(ef.get('r2'), 3)}"
+            else:
+                fit = f"a = {_f(ef.get('a'))}, b = {_f(ef.get('b'))}, R² = {_f(ef.get('r2'), 3)}"
+            per = _f(float(tf.get("t_sample") or 0.0) * 1e6, 3) if runs.trained else "–"
+            rows.append(f"<tr><td>{_e(est.id)}</td><td>{history}</td><td class=num>{est.line}</td>"
+                        f"<td class=num>{est.samples}</td><td><code>{_e(est.text)}</code></td><td>{fit}</td>"
+                        f"<td class=num>{per}</td></tr>")
     return ("<h2>Amortized sampling</h2><p class=\"muted\">Loops that sum independent terms, evaluated at m of "
-            "their N terms per frame and blended with the reprojected estimate by λ; error against the "
-            "original ε = a·sqrt(s(m)(1−λ)/(1+λ)) + b·sqrt(λ/(1−λ)), s(m) = (N−m)/(m(N−1)); time per evaluated "
-            "term (per frame, over every evaluated term) from timed frames. Their options compete with the "
-            "cached nodes at every level.</p><table><tr><th>estimator</th><th class=num>line</th>"
-            "<th class=num>N</th><th>loop</th><th>error model</th><th class=num>ms per 1e6 terms</th></tr>"
-            + "".join(rows) + "</table>")
+            "their N terms per frame. The blend history blends them with the reprojected estimate by λ; error "
+            "against the original ε = a·sqrt(s(m)(1−λ)/(1+λ)) + b·sqrt(λ/(1−λ)), s(m) = (N−m)/(m(N−1)). The "
+            "slots history keeps the N/m subset sums apart, each blended with its own reprojected value by λ "
+            "(where they fit the payload); ε = sqrt(c<sub>m</sub>² + b²·λ/(1−λ)), a floor c<sub>m</sub> per "
+            "trained m. Time per evaluated term (per frame, over every evaluated term) from timed frames, per "
+            "history. Their options compete with the cached nodes at every level.</p><table><tr>"
+            "<th>estimator</th><th>history</th><th class=num>line</th><th class=num>N</th><th>loop</th>"
+            "<th>error model</th><th class=num>ms per 1e6 terms</th></tr>" + "".join(rows) + "</table>")
 
 
 def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:

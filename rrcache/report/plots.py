@@ -67,16 +67,21 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
             idx = [n.id for n in prof.trained_nodes].index(node.id)
             tms = np.asarray(predict_ms(perfs[idx], hit.mu, prof.pixels, trained), float)
             ax.plot(tms, node.errors, "o", color=color, ms=3)
-    for est in prof.estimators:  # amortized sampling: one line per m over λ
-        options = [o for o in prof.amortized_options() if o.parts[0].estimator == est.id]
-        for m in sorted({o.parts[0].samples for o in options}):
-            row = sorted((o for o in options if o.parts[0].samples == m), key=lambda o: o.parts[0].blend)
-            ax.plot([o.predicted_ms for o in row], [o.predicted_error for o in row], "x:", color="darkorange",
+    colors = {"blend": "darkorange", "slots": "firebrick"}
+    amortized = prof.amortized_options()
+    for est in prof.estimators:  # amortized sampling: one line per history and m over λ
+        options = [o for o in amortized if o.parts[0].estimator == est.id]
+        for history, m in sorted({(o.parts[0].history, o.parts[0].samples) for o in options}):
+            row = sorted((o for o in options if (o.parts[0].history, o.parts[0].samples) == (history, m)),
+                         key=lambda o: o.parts[0].blend)
+            ax.plot([o.predicted_ms for o in row], [o.predicted_error for o in row], "x:", color=colors[history],
                     ms=4, lw=1.0)
-            ax.annotate(f"{est.id} m={m}", (row[0].predicted_ms, row[0].predicted_error), fontsize=7,
-                        color="darkorange", textcoords="offset points", xytext=(4, 2))
-    if prof.estimators and prof.amortized_options():
-        ax.plot([], [], "x:", color="darkorange", ms=4, label="amortized estimator, m samples, λ = 0..0.9")
+            ax.annotate(f"{est.id} m={m}" + (" slots" if history == "slots" else ""),
+                        (row[0].predicted_ms, row[0].predicted_error), fontsize=7, color=colors[history],
+                        textcoords="offset points", xytext=(4, 2))
+    for history in sorted({o.parts[0].history for o in amortized}):
+        what = "amortized estimator, slots history" if history == "slots" else "amortized estimator"
+        ax.plot([], [], "x:", color=colors[history], ms=4, label=f"{what}, m samples, λ = 0..0.9")
     front = _front_points(prof)
     if front:
         ax.plot([p[1] for p in front], [p[0] for p in front], "-", color="black", lw=2.2, alpha=0.55,
