@@ -245,7 +245,7 @@ def _amortized_rows(prof, work, session, frames, settings: BenchSettings, progre
     image; :mod:`rrcache.compiler.amortize`)."""
     from rrcache.harness.cached import compare
     from rrcache.pipeline import variant_for_selection
-    from rrcache.selection import AmortizedLoop
+    from rrcache.selection import AmortizedLoop, slots_fit
 
     rows = []
     for est in getattr(prof, "estimators", []):
@@ -255,13 +255,13 @@ def _amortized_rows(prof, work, session, frames, settings: BenchSettings, progre
         for history in ("blend", "slots"):
             sel = Selection((AmortizedLoop(est.id, m, PAPER_BLEND, history=history),), 0.0, float("nan"), 1.0,
                             algorithm=prof.algorithm)
-            try:
-                variant, period = variant_for_selection(work, sel)
-            except ValueError as err:  # the slots do not fit this estimator's payload
-                if history == "blend":
-                    raise
-                _say(progress, f"amortized {sel.describe()}: not measured ({err})", None, None)
-                continue
+            if history == "slots":
+                why = (slots_fit(est.samples, m, est.components) if est.components
+                       else "the profile does not record its accumulators' components (written before them)")
+                if why:
+                    _say(progress, f"amortized {sel.describe()}: not measured ({why})", None, None)
+                    continue
+            variant, period = variant_for_selection(work, sel)
             _say(progress, f"amortized {sel.describe()}", None, None)
             runs = [compare(variant, session, work.prepared, frames, period=period, **prof.settings.cache_options())
                     for _ in range(settings.repeats)]
