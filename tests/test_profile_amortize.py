@@ -449,3 +449,107 @@ def test_the_cli_and_report_show_the_slots_history(slots_win):
     assert "slots" in console.export_text()
     table = _estimators(prof)
     assert "<td>slots</td>" in table and "<td>blend</td>" in table and "c<sub>2</sub>" in table
+
+
+# ---------------------------------------------------------------------------- report and explorer
+def _with_selection(prof, choice):
+    """A shallow copy of the module's profile whose only selection is ``choice`` (labelled e4)."""
+    import copy
+
+    out = copy.copy(prof)
+    out.selections = [choice.replace(label="e4")]
+    return out
+
+
+def test_frame_shots_render_an_amortized_selection(amortized_wins):
+    """FrameShots renders an amortized choice for real: the run settles its history (the N/m
+    cycle and the blend's memory), the cached frame is near the original but not equal to it,
+    hits blend and misses evaluate every term, and the payload is the running estimate."""
+    from rrcache.report.images import HIT_COLOR, MISS_COLOR, FrameShots, settle_frame
+
+    prof, _ = amortized_wins
+    choice = prof.select(1.0)
+    part = choice.parts[0]
+    shots = FrameShots(prof)
+    images = shots.selection_images(choice)
+    assert images.part == part and images.node is None and images.cached and images.what == part.describe()
+    assert list(images.arrays) == ["original", "cached", "error_map", "payload", "hit_map"]
+    variant, _ = shots.selection_variant(choice)
+    assert images.frame == settle_frame(shots.session.frames, variant.amortized["cycle"], part.blend)
+    assert images.frame >= variant.amortized["cycle"]
+    assert 0 < images.error < 0.5
+    assert np.abs(images.arrays["cached"] - images.arrays["original"]).max() > 0
+    hit = np.all(np.isclose(images.arrays["hit_map"], HIT_COLOR), axis=-1).sum()
+    miss = np.all(np.isclose(images.arrays["hit_map"], MISS_COLOR), axis=-1).sum()
+    assert hit > 0 and miss > 0 and images.hit_rate == pytest.approx(hit / (hit + miss))
+    assert images.caption("payload").startswith("running estimate" if part.history == "blend" else "the ")
+    assert f"{part.samples} of 8 terms" in images.caption("cached")
+    assert images.png("payload")[:4] == b"\x89PNG"
+    assert shots.selection_images(choice) is images  # kept, not rendered again
+
+
+def test_frame_shots_render_a_slots_selection(slots_win):
+    from rrcache.report.images import FrameShots
+
+    prof, _ = slots_win
+    choice = prof.select(1.0)
+    part = choice.parts[0]
+    assert part.history == "slots"
+    images = FrameShots(prof).selection_images(choice)
+    assert "payload" in images.arrays and f"{8 // part.samples} subset sums" in images.caption("payload")
+    assert len(images.payload_ranges) == min(3, 8 // part.samples)
+    assert 0 < images.error < 0.5
+
+
+def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
+    import base64
+    import io
+    import re
+
+    from PIL import Image
+
+    from rrcache.report.html import report_html
+
+    prof, _ = amortized_wins
+    choice = prof.select(1.0)
+    page = report_html(_with_selection(prof, choice))
+    block = re.search(r'<div class="sel" id="sel-e4".*?</div></div>', page, re.S).group(0)
+    assert 'data-kind="amortize"' in block and "amortize estimator <b>e1</b>" in block
+    assert f"λ = {choice.parts[0].blend:g}" in block and "no frames" not in block
+    assert re.findall(r'data-image="(\w+)"', block) == ["original", "cached", "error_map", "payload", "hit_map"]
+    sources = re.findall(r'<img [^>]*src="([^"]+)"', block)
+    assert len(sources) == 5 and all(s.startswith("data:image/png;base64,") for s in sources)
+    for src in sources:
+        Image.open(io.BytesIO(base64.b64decode(src.split(",", 1)[1]))).verify()
+    assert "its history settled" in block and "hit rate" in block
+
+
+def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
+    from rrcache.report.explore import Explorer, measure_choice, selections_figure, tradeoff_figure
+
+    prof, _ = amortized_wins
+    choice = prof.select(1.0)
+    prof = _with_selection(prof, choice.replace(max_error=1.0))
+    ui = Explorer(prof, value=1.0, measure=True)
+    assert ui.error is None, ui.status.value
+    assert ui.choice.kind == "amortize" and ui.choice.key == choice.key
+    assert ui.images.part == choice.parts[0] and len(ui.frames.children) == 5
+    summary = ui.summary.value
+    assert "amortize estimator <b>e1</b>" in summary and f"λ = {choice.parts[0].blend:g}" in summary
+    assert f"<b>{choice.parts[0].samples} of 8</b>" in summary and "blend history" in summary
+    # measured beside the original (not stored: the profile never validated it)
+    m = ui.measured
+    assert m is not None and not m["stored"] and m["frames"] > 0
+    assert 0 < m["error"] < 0.5 and m["speedup"] > 0 and 0 < m["hit_rate"] < 1
+    assert "<mark" in ui.source.value  # the estimator's loop highlighted
+    # a choice the profile measured is returned as stored
+    stored = choice.with_measurement(0.01, 40.0, 1.0, 2.0, 2.0, 0.9, 6, (2.0,)).replace(label="e4")
+    prof.selections = [stored]
+    assert measure_choice(prof, stored, None, ui.shots)["stored"]
+    # the tradeoff figure draws the amortized options (reused from the report's plot)
+    fig = tradeoff_figure(prof)
+    assert "amortized options" in fig.axes[0].get_title()
+    assert any(line.get_color() == "darkorange" for line in fig.axes[0].lines)
+    # the selections figure shows the amortized selection's frames
+    fig = selections_figure(prof, ui.shots)
+    assert sum(len(ax.images) for ax in fig.axes) == 5

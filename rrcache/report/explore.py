@@ -1,8 +1,8 @@
 """The notebooks' figures and the interactive profiler widget (``notebooks/explore.ipynb`` and
 ``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.profiler.demo_profile`).
 
-Figures (matplotlib): :func:`tradeoff_figure` (every node path, the original's time, the Pareto
-front, the selections), :func:`node_figure` (a node's measured errors with the fitted error model,
+Figures (matplotlib): :func:`tradeoff_figure` (every node path, the amortized estimators' options,
+the original's time, the Pareto front, the selections), :func:`node_figure` (a node's measured errors with the fitted error model,
 and its predicted frame time over Δn), :func:`images_figure` (a choice's original, cached frame,
 error map, payload and hit/miss map). HTML: :func:`source_html` (the shader with a node
 highlighted), :func:`selections_html` (the four selections, predicted against measured).
@@ -11,7 +11,9 @@ highlighted), :func:`selections_html` (the four selections, predicted against me
 threshold re-selects from the models as it moves (:meth:`Profile.select`, microseconds; the time
 of each re-selection is shown), then shows the chosen node highlighted in the source, its Δn, the
 predicted and measured speed-up and error, a frame with and without the cache side by side, the
-payload and the hit/miss map; a button writes the chosen shader files.
+payload and the hit/miss map; a button writes the chosen shader files. A choice that amortizes an
+estimator (m of its N terms per frame, blend λ, history ``blend`` or ``slots``) is shown,
+rendered and measured the same way, its loop highlighted in the source.
 
 >>> prof = demo_profile("demo.rrprofile")          # doctest: +SKIP
 >>> Explorer(prof)                                 # doctest: +SKIP
@@ -61,9 +63,10 @@ def _f(value, digits: int = 4) -> str:
 # ---------------------------------------------------------------------- figures
 def tradeoff_figure(prof, log_error: bool = True, highlight: Optional[str] = None):
     """Error against ms per frame: every trained node over Δn = 1..50 (from the model table), the
-    original's time (dashed), the Pareto front (black) and the four selections (squares);
-    ``highlight`` draws one node's path thicker. Returns the matplotlib figure."""
-    from rrcache.model import pareto_front
+    amortized estimators' options (m, λ; :func:`rrcache.report.plots.draw_amortized`), the
+    original's time (dashed), the Pareto front over both (black) and the four selections
+    (squares); ``highlight`` draws one node's path thicker. Returns the matplotlib figure."""
+    from rrcache.report.plots import draw_amortized, front_points
 
     plt = _pyplot()
     table = prof.table
@@ -74,8 +77,9 @@ def tradeoff_figure(prof, log_error: bool = True, highlight: Optional[str] = Non
         wide = node_id == highlight
         ax.plot(table.T[i, first:], table.E[i, first:], "-", lw=2.5 if wide else 0.9,
                 color="crimson" if wide else cmap(i / max(1, len(table.node_ids) - 1)), alpha=1 if wide else 0.7)
-    front = [p for p in pareto_front(table) if not log_error or p.predicted_error > 0]
-    ax.plot([p.predicted_ms for p in front], [p.predicted_error for p in front], "-", color="black", lw=2,
+    amortized = draw_amortized(ax, prof, positive_only=log_error)
+    front = [(err, ms) for err, ms in front_points(prof) if not log_error or err > 0]
+    ax.plot([ms for _, ms in front], [err for err, _ in front], "-", color="black", lw=2,
             alpha=0.5, label="Pareto front")
     ax.axvline(prof.original_ms, ls="--", color="gray", label=f"original ({prof.original_ms:.3g} ms)")
     for sel in prof.selections:
@@ -87,7 +91,8 @@ def tradeoff_figure(prof, log_error: bool = True, highlight: Optional[str] = Non
         ax.set_yscale("log")
     ax.set_xlabel("ms per frame (predicted)")
     ax.set_ylabel("mean RGB L2 error (predicted)")
-    ax.set_title(f"{Path(prof.shader).name}: {len(table.node_ids)} trained nodes over Δn = 1..{table.max_period}")
+    title = f"{Path(prof.shader).name}: {len(table.node_ids)} trained nodes over Δn = 1..{table.max_period}"
+    ax.set_title(title + (f", {amortized} amortized options" if amortized else ""))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -133,33 +138,33 @@ def images_figure(images):
         ax.imshow(np.clip(images.arrays[name], 0, 1), interpolation="nearest")
         ax.set_title(images.caption(name), fontsize=7)
         ax.axis("off")
-    what = f"{images.node} Δn={images.period}" if images.node else "the original shader"
-    fig.suptitle(f"{what}, frame {images.frame}", fontsize=9)
+    fig.suptitle(f"{images.what}, frame {images.frame}", fontsize=9)
     fig.tight_layout()
     plt.close(fig)
     return fig
 
 
 def selections_figure(prof, shots: FrameShots):
-    """One row of images per selection (e1..e4; see :func:`images_figure`)."""
+    """One row of images per selection (e1..e4; see :func:`images_figure`): the original, a cached
+    node or an amortized estimator (several nodes at once: their description only)."""
     plt = _pyplot()
     names = list(CAPTIONS)
     fig, axes = plt.subplots(len(prof.selections), len(names), figsize=(2.4 * len(names), 2.2 * len(prof.selections)),
                              dpi=100, squeeze=False)
     for row, sel in zip(axes, prof.selections):
-        if sel.multi or sel.kind == "amortize":  # no frames (the shots render one cached node)
+        if sel.multi:  # no frames (the shots render one cached node or one amortized estimator)
             for ax in row:
                 ax.axis("off")
             row[0].text(-0.08, 0.5, f"{sel.label}: {sel.describe()}", transform=row[0].transAxes, rotation=90,
                         ha="right", va="center", fontsize=8)
             continue
-        images = shots.images(sel.node, sel.period)
+        images = shots.selection_images(sel)
         for ax, name in zip(row, names):
             ax.axis("off")
             if name in images.arrays:
                 ax.imshow(np.clip(images.arrays[name], 0, 1), interpolation="nearest")
                 ax.set_title(images.caption(name), fontsize=7)
-        what = f"{sel.node} Δn={sel.period}" if sel.node else "original"
+        what = images.what if images.cached else "original"
         row[0].text(-0.08, 0.5, f"{sel.label}: {what}", transform=row[0].transAxes, rotation=90,
                     ha="right", va="center", fontsize=8)
     fig.tight_layout()
@@ -168,8 +173,10 @@ def selections_figure(prof, shots: FrameShots):
 
 
 def default_choice(prof) -> tuple:
-    """``(node, Δn)`` worth a first look: the last selection that caches something, else the
-    costliest trained node at the largest trained period."""
+    """``(node, Δn)`` worth a first look at one *node* (the notebook's node section): the last
+    selection that caches a node, else the costliest trained node at the largest trained period.
+    Amortized selections are not nodes: :func:`selections_figure` and the :class:`Explorer` show
+    them; :func:`default_selection` returns the last selection of any kind."""
     for sel in reversed(prof.selections):
         if sel.parts and sel.kind == "cache":
             return sel.node, int(sel.period)
@@ -177,13 +184,48 @@ def default_choice(prof) -> tuple:
     return node.id, int(max(node.periods))
 
 
+def default_selection(prof):
+    """The last selection that changes the shader (a cached node or an amortized estimator; not
+    several nodes at once, which have no frames), else the original's selection: what
+    :func:`describe_choice` and :meth:`FrameShots.selection_images` show first."""
+    for sel in reversed(prof.selections):
+        if sel.parts and not sel.multi:
+            return sel
+    return prof.selections[0] if prof.selections else None
+
+
+def describe_choice(prof, choice) -> str:
+    """One line of HTML saying what a selection does: the original, a node cached every Δn
+    frames, or an estimator amortized (m of N terms per frame, blend λ, its history)."""
+    if not choice.parts:
+        return "<b>the original shader</b>: no variant is predicted faster within this error"
+    if choice.kind == "amortize":
+        part = choice.parts[0]
+        est = next((e for e in prof.estimators if e.id == part.estimator), None)
+        of = f" of {est.samples}" if est is not None else ""
+        loop = f" <code>{html.escape(est.text)}</code>" if est is not None and est.text else ""
+        how = ("its N/m subset sums kept apart (slots history)" if part.history == "slots"
+               else "blended with the reprojected estimate (blend history)")
+        return (f"amortize estimator <b>{html.escape(part.estimator)}</b>{loop}: <b>{part.samples}{of}</b> terms "
+                f"per frame, {how}, <b>λ = {part.blend:g}</b>")
+    if choice.multi:
+        return "cache " + " + ".join(f"<b>{html.escape(n)}</b> every Δn = {p}"
+                                     for n, p in zip(choice.nodes, choice.periods))
+    return (f"cache <b>{html.escape(choice.node)}</b> <code>{html.escape(prof.node(choice.node).text)}</code> "
+            f"every <b>Δn = {choice.period}</b> frames")
+
+
 # ---------------------------------------------------------------------- HTML pieces
 def source_html(prof, node_id: Optional[str] = None, context: Optional[int] = None) -> str:
     """The shader source as HTML, the line of ``node_id`` highlighted from its column on (lines
-    where other trained nodes start get a faint mark). ``context``: only that many lines around
-    the node."""
+    where other trained nodes start get a faint mark). ``node_id`` may also name an estimator
+    (``e1``: its loop). ``context``: only that many lines around the node."""
     lines = read_source(prof)
-    node = prof.node(node_id) if node_id else None
+    estimator = next((e for e in prof.estimators if e.id == node_id), None) if node_id else None
+    if estimator is not None:  # an estimator's loop (no mark where its line is not known)
+        node = estimator if estimator.line else None
+    else:
+        node = prof.node(node_id) if node_id else None
     starts = {int(n.line) for n in prof.trained_nodes}
     lo, hi = 1, len(lines)
     if node is not None and context is not None:
@@ -224,29 +266,41 @@ def selections_html(prof) -> str:
 
 
 # ---------------------------------------------------------------------- measuring a choice
-def measure_choice(prof, node: Optional[str], period: Optional[int], shots: FrameShots,
+def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
                    frames: Optional[int] = None) -> dict:
     """Render the session with the choice beside the original (:func:`rrcache.harness.cached.compare`,
     at the session's resolution, the first ``frames`` frames, default the profile's validation
     frames) and return ``{"error", "psnr", "speedup", "ms", "original_ms", "hit_rate", "frames"}``.
-    A choice the profile validated is not rendered again: its stored figures are returned."""
+    The choice is ``node`` cached every ``period`` frames (``node`` None: the original), or
+    ``node`` a :class:`~rrcache.selection.Selection` of any kind with a variant (an amortized
+    estimator included; ``period`` is then not read). A choice the profile validated is not
+    rendered again: its stored figures are returned."""
+    from rrcache.selection import CachedNode, Selection
+
+    if isinstance(node, Selection):
+        choice = node
+        node, period = (choice.node, choice.period) if choice.kind in ("cache", "original") else (None, None)
+    else:
+        choice = (Selection((CachedNode(node, int(period)),)) if node is not None
+                  else Selection.original(prof.original_ms))
     for sel in prof.selections:
-        if sel.multi or sel.kind == "amortize":
-            continue
-        if sel.node == node and sel.period == period and sel.measured_error is not None and (node or sel.frames):
+        if sel.key == choice.key and sel.measured_error is not None and (sel.parts or sel.frames):
             return {"error": sel.measured_error, "psnr": sel.measured_psnr, "speedup": sel.measured_speedup,
                     "ms": sel.measured_ms, "original_ms": sel.measured_original_ms, "hit_rate": sel.hit_rate,
                     "frames": sel.frames, "stored": True}
-    if node is None:
+    if not choice.parts:
         return {"error": 0.0, "psnr": None, "speedup": 1.0, "ms": prof.original_ms, "original_ms": prof.original_ms,
                 "hit_rate": None, "frames": 0, "stored": True}
     from rrcache.harness.cached import compare
 
     settings = prof.settings
     count = min(int(frames or settings.validation_frames or shots.session.frames), int(shots.session.frames))
-    variant = shots.variant(node)
-    result = compare(variant, shots.session, shots.work.prepared, range(count), period=int(period),
-                     block=settings.block, refresh=settings.refresh, depth_epsilon=settings.depth_epsilon)
+    if choice.kind == "cache":
+        variant, period = shots.variant(node), int(period)
+    else:  # an amortized estimator (its variant does not use the refresh rule), several nodes
+        variant, period = shots.selection_variant(choice)
+    result = compare(variant, shots.session, shots.work.prepared, range(count), period=period,
+                     **settings.cache_options())
     return {"error": result.mean_error, "psnr": result.psnr, "speedup": result.speedup, "ms": result.ms_per_frame,
             "original_ms": result.original_ms_per_frame, "hit_rate": result.hit_rate, "frames": count,
             "stored": False}
@@ -329,13 +383,9 @@ class Explorer:
     def update(self, max_error: float):
         """Re-select for ``max_error`` and refresh the view (renders only when the choice changes)."""
         start = time.perf_counter()
-        choice = self.prof.select(max_error)
-        if choice.kind == "amortize":  # the explorer shows cached nodes' frames: their best choice
-            from rrcache.model import select as model_select
-
-            choice = self.prof.adopt(model_select(self.prof.table, float(max_error)), max_error=float(max_error))
+        choice = self.prof.select(max_error)  # a cached node, an amortized estimator or the original
         self.select_ms = (time.perf_counter() - start) * 1000.0
-        changed = self.choice is None or (choice.node, choice.period) != (self.choice.node, self.choice.period)
+        changed = self.choice is None or choice.key != self.choice.key
         self.choice = choice
         if changed:  # the predictions show at once; the frames and the measurement follow
             self.measured = None
@@ -349,7 +399,7 @@ class Explorer:
     def _show_choice(self, choice) -> None:
         import ipywidgets as w
 
-        images = self.shots.images(choice.node, choice.period)
+        images = self.shots.selection_images(choice)
         boxes = []
         for name in CAPTIONS:
             if name in images.arrays:
@@ -358,19 +408,16 @@ class Explorer:
                                      w.HTML(f"<small>{html.escape(images.caption(name))}</small>")]))
         self.frames.children = boxes
         self.images = images
-        if self.measure or choice.node is None:
-            self.measured = measure_choice(self.prof, choice.node, choice.period, self.shots)
+        if self.measure or not choice.parts:
+            self.measured = measure_choice(self.prof, choice, None, self.shots)
         else:
             self.measured = None
-        self.source.value = source_html(self.prof, choice.node, context=8) if choice.node else source_html(self.prof)
+        shown = choice.parts[0].estimator if choice.kind == "amortize" else (choice.node if choice.parts else None)
+        self.source.value = source_html(self.prof, shown, context=8) if shown else source_html(self.prof)
 
     def _show_summary(self, max_error: float, pending: bool = False) -> None:
         c, m = self.choice, self.measured or {}
-        if c.node is None:
-            what = "<b>the original shader</b>: no cached variant is predicted faster within this error"
-        else:
-            what = (f"cache <b>{html.escape(c.node)}</b> <code>{html.escape(self.prof.node(c.node).text)}</code> "
-                    f"every <b>Δn = {c.period}</b> frames")
+        what = describe_choice(self.prof, c)
         measured = (f"measured over {m.get('frames')} frames{' (stored by the profile)' if m.get('stored') else ''}: "
                     f"speed-up <b>{_f(m.get('speedup'), 3)}×</b>, error <b>{_f(m.get('error'))}</b>, "
                     f"PSNR {_f(m.get('psnr'), 3)} dB, hit rate {_f(m.get('hit_rate'), 3)}"

@@ -118,18 +118,22 @@ def _source(prof, lines: list[str]) -> str:
     return legend + '<div class="src">' + "".join(rows) + "</div>"
 
 
+def _amortized_what(prof, sel) -> str:
+    """What an amortized selection does: the estimator, m of N terms per frame, the history and λ."""
+    p = sel.parts[0]
+    est = next((e for e in getattr(prof, "estimators", ()) if e.id == p.estimator), None)
+    of = f" of its {est.samples}" if est is not None else " of its"
+    how = ("each of its N/m subset sums kept apart and blended with its own reprojected value"
+           if p.history == "slots" else "blended with the reprojected estimate")
+    return (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples}{of} terms per frame, {how} by "
+            f"λ = {p.blend:g} ({_e(p.history)} history)" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
+
+
 def _multi_selection(sel) -> str:
     """A selection of several nodes: what each caches at which period and its figures (its frames
-    are not rendered here: the report's images show one cached node)."""
-    if sel.kind == "amortize":
-        p = sel.parts[0]
-        how = ("each of its N/m subset sums kept apart and blended with its own reprojected value"
-               if p.history == "slots" else "blended with the reprojected estimate")
-        what = (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples} of its terms per frame, {how} by "
-                f"λ = {p.blend:g}" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
-    else:
-        what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
-                                     + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
+    are not rendered here: the report's images show one cached node or one amortized estimator)."""
+    what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
+                                 + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
@@ -139,10 +143,9 @@ def _multi_selection(sel) -> str:
              + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
              + "</table>")
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
-    why = "amortized sampling" if sel.kind == "amortize" else "several nodes"
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
-            f'<p class="muted">{why}: no frames are shown for this choice</p></div>')
+            '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
 
 
 def _level(sel) -> str:
@@ -152,11 +155,15 @@ def _level(sel) -> str:
 
 
 def _selection(prof, sel, shots: FrameShots) -> str:
-    if sel.multi or sel.kind == "amortize":
+    if sel.multi:
         return _multi_selection(sel)
-    images = shots.images(sel.node, sel.period)
-    what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
-            if sel.node else "keep the original shader (nothing is predicted faster at this level)")
+    images = shots.selection_images(sel)  # the original, one cached node or one amortized estimator
+    amortized = sel.kind == "amortize"
+    if amortized:
+        what = _amortized_what(prof, sel)
+    else:
+        what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
+                if sel.node else "keep the original shader (nothing is predicted faster at this level)")
     if sel.fallback:
         what += f'<br><span class="warn">measured slowdown, fell back: {_e(sel.fallback)}</span>'
     if sel.visible_artifacts:
@@ -190,12 +197,14 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             h = round(h0 * w / w0)
             figures.append(f'<figure><img alt="{_e(name)}" data-image="{_e(name)}" width="{w}" height="{h}" '
                            f'src="{images.uri(name)}"><figcaption>{_e(images.caption(name))}</figcaption></figure>')
+    settled = " (its history settled: the cycle of subsets and the blend's memory)" if amortized else ""
     frame_note = (f"frame {images.frame} at {images.size[0]}×{images.size[1]}"
-                  + (f", after {images.frame + 1} frames with the cache: this frame's error {_f(images.error)}, "
-                     f"hit rate {_f(images.hit_rate, 3)}; the table's measurements are over {sel.frames} "
-                     "frames of the session" if sel.node else ""))
+                  + (f", after {images.frame + 1} frames with the cache{settled}: this frame's error "
+                     f"{_f(images.error)}, hit rate {_f(images.hit_rate, 3)}; the table's measurements are over "
+                     f"{sel.frames} frames of the session" if images.cached else ""))
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
-    return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(sel.node or "")}">'
+    node_attr = "" if amortized else (sel.node or "")
+    return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(node_attr)}" data-kind="{_e(sel.kind)}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
             f'<div class="shots">{"".join(figures)}</div></div>')

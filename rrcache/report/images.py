@@ -6,15 +6,25 @@ The cached frame is the last of a run of consecutive frames from frame 0, long e
 cache to be in its steady state (Δn + 2 frames, at most the session's), so its hits and its
 refreshes look as they do while the application runs. The original is rendered at the same frame.
 
+An amortized selection (an estimator's m of N terms per frame, blend λ, history ``blend`` or
+``slots``; :class:`rrcache.selection.AmortizedLoop`) is rendered the same way with its variant
+(:func:`rrcache.pipeline.variant_for_selection`): the run is long enough for its history to settle
+(:func:`settle_frame`: the N/m-frame cycle of subsets plus the frames the blend's memory λ^k needs
+to fall below 5 %), and its payload image is the running estimate (``blend``) or the N/m subset
+sums (``slots``). :meth:`FrameShots.selection_images` renders any selection with frames.
+
 >>> shots = FrameShots(load_profile("demo.rrprofile"))                     # doctest: +SKIP
 >>> images = shots.images("n932", 16)                                      # doctest: +SKIP
 >>> images.png("hit_map")[:4]                                              # doctest: +SKIP
 b'\\x89PNG'
+>>> shots.selection_images(prof.select(0.02)).what                         # doctest: +SKIP
+'e1 m=4 λ=0.6'
 """
 from __future__ import annotations
 
 import base64
 import io
+import math
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -36,6 +46,22 @@ CAPTIONS = {
     "payload": "cache payload",
     "hit_map": "hits (green) and misses (red)",
 }
+
+
+#: how far the blend's memory λ^k must fall before an amortized frame is shown
+SETTLED = 0.05
+
+
+def settle_frame(frames: int, cycle: int, blend: float) -> int:
+    """The frame shown for an amortized selection: after its ``cycle`` (N/m frames, every subset
+    once) and the frames its blend's memory needs (λ^k ≤ 5 %), plus one; at most the session's
+    last frame (``frames`` - 1).
+
+    >>> settle_frame(150, 4, 0.6), settle_frame(150, 4, 0.0), settle_frame(12, 2, 0.9)
+    (11, 5, 11)
+    """
+    memory = math.ceil(math.log(SETTLED) / math.log(blend)) if 0.0 < blend < 1.0 else 0
+    return min(int(frames) - 1, int(cycle) + memory + 1)
 
 
 def image_size(resolution, max_width: int = MAX_WIDTH) -> tuple[int, int]:
@@ -111,11 +137,13 @@ def hit_map_image(hits: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 @dataclass
 class ChoiceImages:
-    """The images of one choice (``node`` None: the original shader, nothing cached) at frame
-    ``frame``, ``size`` (w, h): float RGB arrays in ``arrays`` keyed as :data:`CAPTIONS` (the
-    cached ones absent for the original), the frame's measured ``error`` (mean RGB L2 over covered
-    pixels), its ``hit_rate``, the error map's ``error_scale`` and the payload's channel
-    ``payload_ranges``."""
+    """The images of one choice (``node`` None and ``part`` None: the original shader, nothing
+    cached; ``part`` an :class:`~rrcache.selection.AmortizedLoop`: an amortized estimator) at
+    frame ``frame``, ``size`` (w, h): float RGB arrays in ``arrays`` keyed as :data:`CAPTIONS`
+    (the cached ones absent for the original), the frame's measured ``error`` (mean RGB L2 over
+    covered pixels), its ``hit_rate``, the error map's ``error_scale`` and the payload's channel
+    ``payload_ranges``; ``captions`` overrides :data:`CAPTIONS` where this choice's image shows
+    something else (an amortized payload)."""
 
     node: Optional[str]
     period: Optional[int]
@@ -126,6 +154,20 @@ class ChoiceImages:
     hit_rate: Optional[float] = None
     error_scale: Optional[float] = None
     payload_ranges: list = field(default_factory=list)
+    part: object = None
+    captions: dict = field(default_factory=dict)
+
+    @property
+    def cached(self) -> bool:
+        """Whether these are a variant's images (not the original shader's alone)."""
+        return self.node is not None or self.part is not None
+
+    @property
+    def what(self) -> str:
+        """``n12 Δn=16``, ``e1 m=4 λ=0.6`` or ``the original shader``."""
+        if self.part is not None:
+            return self.part.describe()
+        return f"{self.node} Δn={self.period}" if self.node is not None else "the original shader"
 
     def png(self, name: str) -> bytes:
         """One image as PNG bytes (``KeyError`` for an image this choice does not have)."""
@@ -135,19 +177,20 @@ class ChoiceImages:
         return data_uri(self.png(name))
 
     def caption(self, name: str) -> str:
+        base = self.captions.get(name, CAPTIONS[name])
         if name == "error_map" and self.error_scale is not None:
-            return f"{CAPTIONS[name]} (white = {self.error_scale:.3g})"
+            return f"{base} (white = {self.error_scale:.3g})"
         if name == "payload" and self.payload_ranges:
             lo = min(r[0] for r in self.payload_ranges)
             hi = max(r[1] for r in self.payload_ranges)
-            return f"{CAPTIONS[name]} ({lo:.3g}…{hi:.3g}, stretched)"
-        return CAPTIONS[name]
+            return f"{base} ({lo:.3g}…{hi:.3g}, stretched)"
+        return base
 
 
 class FrameShots:
     """Renders :class:`ChoiceImages` for a profile's choices; the shader is loaded and analysed
     once (pass ``work``, a :class:`~rrcache.pipeline.ShaderWork`, when you have it), the original
-    frames and the images of each (node, Δn) are kept."""
+    frames and the images of each (node, Δn) and each amortized option are kept."""
 
     def __init__(self, profile, work=None, max_width: int = MAX_WIDTH):
         from rrcache.session import load_session
@@ -172,6 +215,38 @@ class FrameShots:
 
             self._variants[node] = variant_for(self.work, node, self.profile.algorithm)
         return self._variants[node]
+
+    def selection_variant(self, selection):
+        """``(variant, period)`` of any selection with parts (its ``algorithm``, else the profile's;
+        :func:`rrcache.pipeline.variant_for_selection`), compiled once per kind of choice."""
+        algorithm = selection.algorithm or self.profile.algorithm
+        key = (selection.key, algorithm)
+        if key not in self._variants:
+            if selection.kind == "cache":
+                self._variants[key] = (self.variant(selection.node), int(selection.period))
+            else:
+                from rrcache.pipeline import variant_for_selection
+
+                self._variants[key] = variant_for_selection(self.work, selection.replace(algorithm=algorithm))
+        return self._variants[key]
+
+    def selection_images(self, selection) -> ChoiceImages:
+        """The images of a selection: the original (no part), one cached node (kind ``cache`` or
+        ``adaptive``, as :meth:`images`) or an amortized estimator (kind ``amortize``). Several
+        nodes at once have no images here: RRCacheError."""
+        if not selection.parts:
+            return self.images(None, None)
+        if selection.kind == "amortize":
+            key = (selection.key, selection.algorithm or self.profile.algorithm)
+            if key not in self._images:
+                self._images[key] = self._render_amortized(selection)
+            return self._images[key]
+        if selection.multi:
+            from rrcache.errors import RRCacheError
+
+            raise RRCacheError(f"no frames for a selection of several nodes ({selection.describe()})", "selection",
+                               hint="show one node's frames with FrameShots.images(node, period)")
+        return self.images(selection.node, selection.period)
 
     def frame_for(self, period: Optional[int]) -> int:
         """The frame shown for a refresh period: Δn + 2 frames into the session (at most its last)."""
@@ -200,10 +275,32 @@ class FrameShots:
         out.arrays["original"] = ref.image[..., :3]
         if node is None:
             return out
+        return self._cached_run(out, self.variant(node), period, ref)
+
+    def _render_amortized(self, selection) -> ChoiceImages:
+        part = selection.parts[0]
+        variant, period = self.selection_variant(selection)
+        info = getattr(variant, "amortized", None) or {}
+        frame = settle_frame(self.session.frames, info.get("cycle", 1), part.blend)
+        out = ChoiceImages(None, None, frame, self.size, part=part)
+        n, m = info.get("of"), part.samples
+        out.captions["cached"] = f"amortized: {m} of {n} terms per frame"
+        if part.history == "slots":
+            shown = min(3, variant.components)
+            sums = f"{n // m} subset sums" if n else "subset sums"
+            out.captions["payload"] = f"the {sums} (slots; {shown} channel(s) shown)"
+        else:
+            out.captions["payload"] = "running estimate (blend)"
+        ref = self.original(frame)
+        out.arrays["original"] = ref.image[..., :3]
+        return self._cached_run(out, variant, period, ref)
+
+    def _cached_run(self, out: ChoiceImages, variant, period, ref) -> ChoiceImages:
+        """Render ``variant`` from frame 0 to ``out.frame`` and fill in ``out``'s cached images."""
         from rrcache.harness.cached import CachedRenderer
         from rrcache.harness.metrics import mean_l2
 
-        variant = self.variant(node)
+        frame = out.frame
         with CachedRenderer(variant, self.session, self.work.prepared, self.size, period=period,
                             hit_maps=True, keep_payload=True, **self.profile.settings.cache_options()) as cached:
             for index in range(frame + 1):

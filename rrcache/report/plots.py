@@ -35,7 +35,9 @@ def _curves(prof):
     return out, hit
 
 
-def _front_points(prof):
+def front_points(prof):
+    """The Pareto front as ``(error, ms)`` pairs sorted by ms: one front over the cached nodes
+    (the model table) and the amortized estimators' options."""
     from rrcache.model import pareto_front
 
     points = [(float(p.predicted_error), float(p.predicted_ms)) for p in pareto_front(prof.table)]
@@ -48,6 +50,32 @@ def _front_points(prof):
                 best = err
         points = front
     return sorted(points, key=lambda p: p[1])
+
+
+#: the amortized options' colour per history
+AMORTIZED_COLORS = {"blend": "darkorange", "slots": "firebrick"}
+
+
+def draw_amortized(ax, prof, positive_only: bool = False) -> int:
+    """Draw the amortized estimators' options on ``ax`` (ms per frame across, error up): one
+    dotted line per estimator, history and m over λ, labelled, and one legend entry per history
+    (``positive_only``: leave out options predicted at error 0, for a log error axis). Returns
+    how many options were drawn (0 when the profile has none)."""
+    amortized = [o for o in prof.amortized_options() if not positive_only or o.predicted_error > 0]
+    for est in prof.estimators:  # amortized sampling: one line per history and m over λ
+        options = [o for o in amortized if o.parts[0].estimator == est.id]
+        for history, m in sorted({(o.parts[0].history, o.parts[0].samples) for o in options}):
+            row = sorted((o for o in options if (o.parts[0].history, o.parts[0].samples) == (history, m)),
+                         key=lambda o: o.parts[0].blend)
+            ax.plot([o.predicted_ms for o in row], [o.predicted_error for o in row], "x:",
+                    color=AMORTIZED_COLORS[history], ms=4, lw=1.0)
+            ax.annotate(f"{est.id} m={m}" + (" slots" if history == "slots" else ""),
+                        (row[0].predicted_ms, row[0].predicted_error), fontsize=7, color=AMORTIZED_COLORS[history],
+                        textcoords="offset points", xytext=(4, 2))
+    for history in sorted({o.parts[0].history for o in amortized}):
+        what = "amortized estimator, slots history" if history == "slots" else "amortized estimator"
+        ax.plot([], [], "x:", color=AMORTIZED_COLORS[history], ms=4, label=f"{what}, m samples, λ = 0..0.9")
+    return len(amortized)
 
 
 def plot_tradeoff(prof, out_dir) -> list[str]:
@@ -67,22 +95,8 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
             idx = [n.id for n in prof.trained_nodes].index(node.id)
             tms = np.asarray(predict_ms(perfs[idx], hit.mu, prof.pixels, trained), float)
             ax.plot(tms, node.errors, "o", color=color, ms=3)
-    colors = {"blend": "darkorange", "slots": "firebrick"}
-    amortized = prof.amortized_options()
-    for est in prof.estimators:  # amortized sampling: one line per history and m over λ
-        options = [o for o in amortized if o.parts[0].estimator == est.id]
-        for history, m in sorted({(o.parts[0].history, o.parts[0].samples) for o in options}):
-            row = sorted((o for o in options if (o.parts[0].history, o.parts[0].samples) == (history, m)),
-                         key=lambda o: o.parts[0].blend)
-            ax.plot([o.predicted_ms for o in row], [o.predicted_error for o in row], "x:", color=colors[history],
-                    ms=4, lw=1.0)
-            ax.annotate(f"{est.id} m={m}" + (" slots" if history == "slots" else ""),
-                        (row[0].predicted_ms, row[0].predicted_error), fontsize=7, color=colors[history],
-                        textcoords="offset points", xytext=(4, 2))
-    for history in sorted({o.parts[0].history for o in amortized}):
-        what = "amortized estimator, slots history" if history == "slots" else "amortized estimator"
-        ax.plot([], [], "x:", color=colors[history], ms=4, label=f"{what}, m samples, λ = 0..0.9")
-    front = _front_points(prof)
+    draw_amortized(ax, prof)
+    front = front_points(prof)
     if front:
         ax.plot([p[1] for p in front], [p[0] for p in front], "-", color="black", lw=2.2, alpha=0.55,
                 label="Pareto front")
