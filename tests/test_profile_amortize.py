@@ -525,11 +525,16 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
 
 def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
-    from rrcache.report.explore import Explorer, measure_choice, selections_figure, tradeoff_figure
+    from rrcache.report.explore import (Explorer, default_choice, default_selection, measure_choice,
+                                        selections_figure, tradeoff_figure)
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
     prof = _with_selection(prof, choice.replace(max_error=1.0))
+    # the first look: the amortized selection; the notebook's node section still gets a node
+    assert default_selection(prof).key == choice.key
+    node, period = default_choice(prof)
+    assert node == prof.trained_nodes[0].id and period >= 1
     ui = Explorer(prof, value=1.0, measure=True)
     assert ui.error is None, ui.status.value
     assert ui.choice.kind == "amortize" and ui.choice.key == choice.key

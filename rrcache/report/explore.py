@@ -1,10 +1,11 @@
 """The notebooks' figures and the interactive profiler widget (``notebooks/explore.ipynb`` and
 ``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.profiler.demo_profile`).
 
-Figures (matplotlib): :func:`tradeoff_figure` (every node path, the amortized estimators' options,
-the original's time, the Pareto front, the selections), :func:`node_figure` (a node's measured errors with the fitted error model,
-and its predicted frame time over Δn), :func:`images_figure` (a choice's original, cached frame,
-error map, payload and hit/miss map). HTML: :func:`source_html` (the shader with a node
+Figures (matplotlib): :func:`tradeoff_figure` (every node path, the amortized estimators'
+options, the original's time, the Pareto front, the selections), :func:`node_figure` (a node's
+measured errors with the fitted error model, and its predicted frame time over Δn),
+:func:`images_figure` (a choice's original, cached frame, error map, payload and hit/miss map;
+a cached node's or an amortized estimator's). HTML: :func:`source_html` (the shader with a node
 highlighted), :func:`selections_html` (the four selections, predicted against measured).
 
 :class:`Explorer` is the paper's interactive profiler (§4.5): a log-scale slider for the error
@@ -279,7 +280,9 @@ def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
 
     if isinstance(node, Selection):
         choice = node
-        node, period = (choice.node, choice.period) if choice.kind in ("cache", "original") else (None, None)
+        # adaptive refresh is measured as its node at its max age, as before (no adaptive runtime here)
+        node, period = ((choice.node, choice.period) if choice.kind in ("cache", "adaptive", "original")
+                        else (None, None))
     else:
         choice = (Selection((CachedNode(node, int(period)),)) if node is not None
                   else Selection.original(prof.original_ms))
@@ -295,7 +298,7 @@ def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
 
     settings = prof.settings
     count = min(int(frames or settings.validation_frames or shots.session.frames), int(shots.session.frames))
-    if choice.kind == "cache":
+    if choice.kind in ("cache", "adaptive"):
         variant, period = shots.variant(node), int(period)
     else:  # an amortized estimator (its variant does not use the refresh rule), several nodes
         variant, period = shots.selection_variant(choice)
