@@ -558,3 +558,18 @@ def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
     # the selections figure shows the amortized selection's frames
     fig = selections_figure(prof, ui.shots)
     assert sum(len(ax.images) for ax in fig.axes) == 5
+
+
+def test_the_estimator_record_keeps_the_text_as_written():
+    """A loop inside a function is found in the inlined program (names like ``_rr_i_3``); the
+    profile, its report and the bench show it as the user wrote it, as ``rrcache nodes`` does."""
+    from rrcache.analysis.estimators import find_estimators
+    from rrcache.glsl.frontend import parse_shader
+    from rrcache.profiler.amortize import _record
+
+    shader = parse_shader("#version 330\nin vec2 v_texcoord; out vec4 c;\n"
+                          "float soft(vec2 p) { float s = 0.0; for (int i = 0; i < 8; i++) s += sin(p.x * float(i));"
+                          " return s; }\nvoid main() { c = vec4(soft(v_texcoord)); }")
+    [est] = find_estimators(shader).estimators
+    assert "_rr_" in est.text
+    assert _record(est).text == "for (int i = 0; i < 8; i++)"

@@ -51,7 +51,12 @@ from rrcache.runtime import DEFAULT_PERIOD
 
 
 def _record(est) -> EstimatorProfile:
-    return EstimatorProfile(est.id, est.line, est.column, int(est.samples), est.text, components=int(est.components))
+    """The estimator's record; its text as the user wrote it (``for (int i = 0; i < 16; i++)``,
+    not the inliner's ``_rr_i_22``), as ``rrcache nodes --json`` lists it."""
+    from rrcache.analysis.estimators import display_name
+
+    return EstimatorProfile(est.id, est.line, est.column, int(est.samples), display_name(est.text),
+                            components=int(est.components))
 
 
 def _slots_record(est) -> Optional[HistoryRuns]:
