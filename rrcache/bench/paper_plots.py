@@ -41,9 +41,11 @@ def write_scene_plot(scene, out) -> str:
             if _x(r.speedup) is not None:
                 ax.scatter([_x(r.speedup)], [r.mean_error], marker="*", s=120, color=colours.get(r.method, "tab:red"),
                            zorder=4, label=f"{r.method} (equal time)")
-        for r in getattr(scene, "amortized", []):
+        styles = [("P", "darkorange"), ("X", "tab:purple"), ("D", "tab:brown"), ("v", "tab:pink")]
+        for k, r in enumerate(getattr(scene, "amortized", [])):
             if _x(r.speedup) is not None:
-                ax.scatter([_x(r.speedup)], [r.mean_error], marker="P", s=70, color="darkorange", zorder=4,
+                marker, colour = styles[k % len(styles)]
+                ax.scatter([_x(r.speedup)], [r.mean_error], marker=marker, s=70, color=colour, zorder=4,
                            label=f"amortized ({r.setting})")
         if scene.limit_speedup:
             ax.axvline(1.0 / scene.limit_speedup, color="tab:blue", linestyle=":", linewidth=1,
