@@ -18,6 +18,7 @@ import click
 from rich.console import Console
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.runtime.glsl import FILTERS
 
 
 @click.command("bench-amortize")
@@ -28,7 +29,7 @@ from rrcache.cli.options import parse_defines, resolution_option as _resolution
 @click.option("--lambda", "blend", default=0.6, show_default=True, type=click.FloatRange(0.0, 1.0, max_open=True),
               help="λ: weight of the reprojected estimate.")
 @click.option("--history", type=click.Choice(["blend", "slots"]), default="blend", show_default=True)
-@click.option("--filter", "filter_", type=click.Choice(["nearest", "bilinear", "catmull-rom", "edge"]),
+@click.option("--filter", "filter_", type=click.Choice(list(FILTERS)),
               default="bilinear", show_default=True, help="How the previous frame's estimate is resampled.")
 @click.option("--phase", type=click.Choice(["frame", "pixel"]), default="frame", show_default=True)
 @click.option("--algorithm", type=click.Choice(["three-pass", "two-pass", "one-pass"]), default="two-pass",
