@@ -91,18 +91,28 @@ vec4 rr_previous() {
 }
 """
 
+# The Catmull-Rom weights of the four taps around a texel offset ``f`` in [0, 1) (``T``: float
+# or vec2, one per axis), with the middle pair merged (``w12``) for a bilinear tap at ``w2/w12``.
+_CATMULL_ROM_WEIGHTS = """
+    T w0 = f * (-0.5 + f * (1.0 - 0.5 * f));
+    T w1 = 1.0 + f * f * (-2.5 + 1.5 * f);
+    T w2 = f * (0.5 + f * (2.0 - 1.5 * f));
+    T w3 = f * f * (-0.5 + 0.5 * f);
+    T w12 = w1 + w2;
+"""
+
+
+def _catmull_rom_weights(type_name: str) -> str:
+    return _CATMULL_ROM_WEIGHTS.replace("T ", f"{type_name} ").lstrip("\n")
+
+
 _CATMULL_ROM = """
 vec4 rr_previous() {
     vec2 size = vec2(textureSize(rr_prevPayload, 0));
     vec2 p = rr_uv * size;
     vec2 t1 = floor(p - 0.5) + 0.5;
     vec2 f = p - t1;
-    vec2 w0 = f * (-0.5 + f * (1.0 - 0.5 * f));
-    vec2 w1 = 1.0 + f * f * (-2.5 + 1.5 * f);
-    vec2 w2 = f * (0.5 + f * (2.0 - 1.5 * f));
-    vec2 w3 = f * f * (-0.5 + 0.5 * f);
-    vec2 w12 = w1 + w2;
-    vec2 t0 = (t1 - 1.0) / size;
+""" + _catmull_rom_weights("vec2") + """    vec2 t0 = (t1 - 1.0) / size;
     vec2 t3 = (t1 + 2.0) / size;
     vec2 t12 = (t1 + w2 / w12) / size;
     vec4 n = texture(rr_prevPayload, vec2(t12.x, t0.y));
@@ -130,11 +140,7 @@ vec4 rr_previous() {
     float p = rr_uv.y * size;
     float t1 = floor(p - 0.5) + 0.5;
     float f = p - t1;
-    float w0 = f * (-0.5 + f * (1.0 - 0.5 * f));
-    float w12 = 1.0 + f * f * (-2.5 + 1.5 * f) + f * (0.5 + f * (2.0 - 1.5 * f));
-    float w2 = f * (0.5 + f * (2.0 - 1.5 * f));
-    float w3 = f * f * (-0.5 + 0.5 * f);
-    vec4 a = texture(rr_prevPayload, vec2(rr_uv.x, (t1 - 1.0) / size));
+""" + _catmull_rom_weights("float") + """    vec4 a = texture(rr_prevPayload, vec2(rr_uv.x, (t1 - 1.0) / size));
     vec4 b = texture(rr_prevPayload, vec2(rr_uv.x, (t1 + w2 / w12) / size));
     vec4 c = texture(rr_prevPayload, vec2(rr_uv.x, (t1 + 2.0) / size));
     return clamp(a * w0 + b * w12 + c * w3, min(min(a, b), c), max(max(a, b), c));
