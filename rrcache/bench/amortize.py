@@ -61,6 +61,10 @@ class AmortizedRun:
     amortized_cpu_ms: list[list[float]] = field(default_factory=list)
     reference_defines: dict = field(default_factory=dict)
     filter: str = "bilinear"
+    #: the payload format the amortized cache used (``u8``: 8-bit, rrcache.compiler.payload_encoding;
+    #: a request that did not fit falls back to ``f4``, and ``payload_note`` says why)
+    payload: str = "f4"
+    payload_note: Optional[str] = None
 
     def _steady(self, values: list) -> list:
         return values[1:] or values
@@ -83,7 +87,8 @@ class AmortizedRun:
         cpu = self.cpu_speedups()
         return {
             "estimator": self.estimator, "samples": self.samples, "of": self.total, "lambda": self.blend,
-            "phase": self.phase, "history": self.history, "filter": self.filter, "algorithm": self.algorithm, "frames": len(self.frames), "resolution": list(self.resolution),
+            "phase": self.phase, "history": self.history, "filter": self.filter, "payload": self.payload,
+            **({"payload_note": self.payload_note} if self.payload_note else {}), "algorithm": self.algorithm, "frames": len(self.frames), "resolution": list(self.resolution),
             "repeats": len(speedups), "speedup": statistics.median(speedups),
             "speedup_range": [min(speedups), max(speedups)],
             "original_ms": statistics.median(statistics.median(self._steady(o)) for o in self.original_ms),
@@ -103,7 +108,7 @@ class AmortizedRun:
 
 def run(shader, session, estimator: str, samples: int, blend: float, reference_defines: Mapping[str, str],
         frames=None, repeats: int = 3, error_every: int = 5, algorithm: str = "two-pass", phase: str = "frame",
-        history: str = "blend", filter: str = "bilinear",
+        history: str = "blend", filter: str = "bilinear", payload: str = "f4",
         resolution: Optional[tuple[int, int]] = None, defines: Optional[Mapping[str, str]] = None,
         on_frame: Optional[Callable[[int, int, object, object, object], None]] = None) -> AmortizedRun:
     """Measure (see the module doc). ``session`` is a path or a loaded session; ``frames`` as
@@ -113,7 +118,7 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
         session = load_session(session)
     work = load_for_session(shader, session, defines)
     variant = instance_amortized(work.shader, estimator, algorithm, samples=samples, blend=blend, phase=phase,
-                                 history=history, filter=filter, vertex=work.vertex)
+                                 history=history, filter=filter, payload_dtype=payload, vertex=work.vertex)
     reference = prepare_file(shader, session, {**dict(defines or {}), **dict(reference_defines)})
     indices = frame_indices(session, frames)
     amort = variant.amortized
@@ -141,6 +146,7 @@ def run(shader, session, estimator: str, samples: int, blend: float, reference_d
                     out.psnrs[index] = (float(psnr(got_o.image, ref.image)), float(psnr(got_a.image, ref.image)))
                 if on_frame is not None:
                     on_frame(repeat, index, got_o, got_a, ref)
+            out.payload, out.payload_note = cached.payload_dtype, cached.payload_note
         out.original_ms.append(o_ms)
         out.amortized_ms.append(a_ms)
         out.original_cpu_ms.append(o_cpu)

@@ -32,6 +32,9 @@ from rrcache.runtime.glsl import FILTERS
 @click.option("--filter", "filter_", type=click.Choice(list(FILTERS)),
               default="bilinear", show_default=True, help="How the previous frame's estimate is resampled.")
 @click.option("--phase", type=click.Choice(["frame", "pixel"]), default="frame", show_default=True)
+@click.option("--payload", type=click.Choice(["f4", "f2", "u8"]), default="f4", show_default=True,
+              help="The cache's payload format: 32- or 16-bit floats, or u8, 8 bits by the range of the "
+                   "estimator's terms (slots history only; rrcache.compiler.payload_encoding).")
 @click.option("--algorithm", type=click.Choice(["three-pass", "two-pass", "one-pass"]), default="two-pass",
               show_default=True)
 @click.option("--reference", "reference", multiple=True, metavar="NAME=VALUE",
@@ -44,7 +47,7 @@ from rrcache.runtime.glsl import FILTERS
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
 @click.option("--images", type=click.Path(file_okay=False), default=None, help="Write comparison PNGs here.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
-def command(shader, session, estimator, samples, blend, history, filter_, phase, algorithm, reference, also, frames,
+def command(shader, session, estimator, samples, blend, history, filter_, phase, payload, algorithm, reference, also, frames,
             repeats, error_every, resolution, images, as_json):
     """Measure amortized sampling of one estimator of SHADER over SESSION."""
     from rrcache.bench.amortize import run, write_images
@@ -61,7 +64,7 @@ def command(shader, session, estimator, samples, blend, history, filter_, phase,
 
     result = run(shader, session, estimator, samples, blend, ref_defines, frames=frames, repeats=repeats,
                  error_every=error_every, algorithm=algorithm, phase=phase, history=history, filter=filter_,
-                 resolution=resolution, on_frame=on_frame)
+                 payload=payload, resolution=resolution, on_frame=on_frame)
     summary = result.summary()
     if images:
         os.makedirs(images, exist_ok=True)
@@ -71,8 +74,10 @@ def command(shader, session, estimator, samples, blend, history, filter_, phase,
         return
     s = summary
     click.echo(f"{estimator}: {s['samples']} of {s['of']} samples per frame, λ = {s['lambda']}, "
-               f"{s['history']} history, {s['phase']} phase, {s['algorithm']}, {s['frames']} frames "
+               f"{s['history']} history, {s['phase']} phase, {s['payload']} payload, {s['algorithm']}, {s['frames']} frames "
                f"at {s['resolution'][0]}x{s['resolution'][1]}, {s['repeats']} repeats")
+    if s.get("payload_note"):
+        click.echo(f"note: {s['payload_note']}")
     ratio = f" ({s['amortized_error'] / s['original_error']:.2f}x)" if s["original_error"] > 0 else ""
     click.echo(f"error against the reference ({s['error_frames']} frames): original {s['original_error']:.6f}, "
                f"amortized {s['amortized_error']:.6f}{ratio}; PSNR {s['original_psnr']:.1f} / "

@@ -37,7 +37,9 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
               help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
-@click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True)
+@click.option("--payload", type=click.Choice(["f4", "f2", "u8"]), default="f4", show_default=True,
+              help="32- or 16-bit floats; u8 (with --estimator and --history slots): 8 bits by the range of "
+                   "the estimator's terms.")
 @click.option("--session", type=click.Path(dir_okay=False), default=None,
               help="Take the MODEL_VERTEX_* defines from this session's meshes.")
 @include_dirs_option
@@ -57,6 +59,8 @@ def command(shader, node, estimator, samples, blend, history, period, algorithm,
     check_adaptive(adaptive, node, algorithm)
     loaded = load_session(session) if session else None
     work = load_for_session(shader, loaded, parse_defines(defines), include_dirs, vertex=vert)
+    if payload == "u8" and estimator is None:
+        raise click.UsageError("--payload u8 is for an amortized estimator's slots (--estimator, --history slots)")
     if estimator is not None:
         from rrcache.compiler.amortize import instance_amortized
 
@@ -65,7 +69,8 @@ def command(shader, node, estimator, samples, blend, history, period, algorithm,
         written = variant.write(out_dir)
         a = variant.amortized
         click.echo(f"{estimator} ({variant.node_text}, {variant.node_loc}) amortized with {algorithm}: "
-                   f"{a['samples']} of {a['of']} samples per frame, λ = {a['lambda']:g}, {a['history']}:")
+                   f"{a['samples']} of {a['of']} samples per frame, λ = {a['lambda']:g}, {a['history']}"
+                   + (f", {variant.payload_dtype} payload" if variant.payload_dtype != "f4" else "") + ":")
         for path in written:
             click.echo(f"  {path}")
         return

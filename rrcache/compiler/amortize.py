@@ -59,7 +59,7 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 from rrcache.deep import deep
-from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
+from rrcache.errors import GLSLError, RRCacheError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.legacy import to_core
 from rrcache.glsl.parser import parse_source
@@ -70,6 +70,8 @@ from rrcache.analysis.unroll import fold_copy
 from rrcache.analysis.estimators import Estimator, EstimatorTable, display_name, find_estimators
 from rrcache.glsl.ast import main_function, walk
 from rrcache.compiler.emit import emit_pass
+from rrcache.compiler.payload_encoding import (ENCODED_DTYPE, PayloadEncoding, decoded, encoded, encoding_glsl,
+                                               slots_encoding)
 from rrcache.compiler.outputs import cache_init, cache_writes, float_lit, set_color_output
 from rrcache.compiler.passes import PASS_SPECS, PassUnit, runtime_snippets
 from rrcache.compiler.prune import prune
@@ -346,7 +348,7 @@ def _sum(terms: list[A.Expr]) -> A.Expr:
     return out
 
 
-def _slots_hit(loc: LocatedLoop, loop: A.For, samples: int, phase: int) -> list[A.Stmt]:
+def _slots_hit(loc: LocatedLoop, loop: A.For, samples: int, phase: int, read=lambda e: e) -> list[A.Stmt]:
     """Hit, "slots" history: this frame's subset sum replaces (blended by λ) its own slot; the
     value is the start plus every slot (the other phases' sums reprojected)."""
     est = loc.estimator
@@ -355,7 +357,7 @@ def _slots_hit(loc: LocatedLoop, loop: A.For, samples: int, phase: int) -> list[
     for name, t in zip(loc.names, loc.types):
         out += [_decl(t, f"rr_start_{name}", _ident(name)), _set(name, _zero(t))]
     out.append(_unrolled(loop, _subset(est.samples, samples, phase), est.start, est.step, loc.unit))
-    out.append(_decl("vec4", "rr_prev", A.Call("rr_previous", [])))
+    out.append(_decl("vec4", "rr_prev", read(A.Call("rr_previous", []))))
     for k, (name, t) in enumerate(zip(loc.names, loc.types)):
         prev = _slot_field(loc, "rr_prev", phase, k)
         out.append(_decl(t, f"rr_new_{name}", A.Binary("+", A.Binary("*", _ident("rr_lambda"), prev), A.Binary(
@@ -385,37 +387,42 @@ def _slots_miss(loc: LocatedLoop, loop: A.For, samples: int) -> list[A.Stmt]:
     return out
 
 
-def _slots_transform(loc: LocatedLoop, name: str, samples: int, phase: int, block: A.Compound, i: int) -> None:
+def _slots_transform(loc: LocatedLoop, name: str, samples: int, phase: int, block: A.Compound, i: int,
+                     encoding: Optional[PayloadEncoding] = None) -> None:
     loop = block.stmts[i]
-    writes = cache_writes(_ident("rr_slots"))
+    # an 8-bit payload (rrcache.compiler.payload_encoding): encoded at the write, decoded at reads
+    read = decoded if encoding is not None else (lambda e: e)
+    writes = cache_writes(encoded(_ident("rr_slots")) if encoding is not None else _ident("rr_slots"))
     declare = _decl("vec4", "rr_slots")
     cycle = _cycle(loc.estimator.samples, samples)
     if name in ("reproject", "hit"):
         block.stmts[i:i + 1] = [_statement("if (!rr_hit()) discard;"), declare,
-                                *_slots_hit(loc, loop, samples, phase), *writes]
+                                *_slots_hit(loc, loop, samples, phase, read), *writes]
     elif name in ("payload", "miss"):
         block.stmts[i:i + 1] = [declare, *_slots_miss(loc, loop, samples), *writes]
     elif name == "shade":
-        stmts: list[A.Stmt] = [_decl("vec4", "rr_cur", A.Call("rr_current", []))]
+        stmts: list[A.Stmt] = [_decl("vec4", "rr_cur", read(A.Call("rr_current", [])))]
         for k, n in enumerate(loc.names):
             stmts.append(_set(n, _sum([_ident(n)] + [_slot_field(loc, "rr_cur", j, k) for j in range(cycle)])))
         block.stmts[i:i + 1] = stmts
     else:  # single
-        branch = A.If(A.Call("rr_hit", []), A.Compound(_slots_hit(loc, loop, samples, phase)),
+        branch = A.If(A.Call("rr_hit", []), A.Compound(_slots_hit(loc, loop, samples, phase, read)),
                       A.Compound(_slots_miss(loc, loop, samples)))
         block.stmts[i:i + 1] = [declare, branch, *writes]
 
 
-def transform(loc: LocatedLoop, name: str, samples: int, phase=0, history: str = "blend") -> A.TranslationUnit:
+def transform(loc: LocatedLoop, name: str, samples: int, phase=0, history: str = "blend",
+              encoding: Optional[PayloadEncoding] = None) -> A.TranslationUnit:
     """The transformed (not yet checked or pruned) unit of pass ``name``; ``phase`` is
-    ``"pixel"`` or the phase number of a ``"frame"``-mode program."""
+    ``"pixel"`` or the phase number of a ``"frame"``-mode program; ``encoding``: the slots'
+    8-bit payload (None: floats)."""
     spec = PASS_SPECS[name]
     unit = clone(loc.unit)
     block, i = _find(unit)
     loop = block.stmts[i]
     writes = cache_writes(_pack(loc))
     if history == "slots":
-        _slots_transform(loc, name, samples, int(phase), block, i)
+        _slots_transform(loc, name, samples, int(phase), block, i, encoding)
     elif name in ("reproject", "hit"):
         block.stmts[i:i + 1] = [_statement("if (!rr_hit()) discard;"), *_hit_statements(loc, loop, samples, phase), *writes]
     elif name in ("payload", "miss"):
@@ -434,11 +441,13 @@ def transform(loc: LocatedLoop, name: str, samples: int, phase=0, history: str =
 
 
 def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinear",
-               phase=0, history: str = "blend") -> PassUnit:
+               phase=0, history: str = "blend", encoding: Optional[PayloadEncoding] = None) -> PassUnit:
     """Transform, type-check and prune pass ``name`` of the amortized variant."""
     spec = PASS_SPECS[name]
-    unit = transform(loc, name, samples, phase, history)
+    unit = transform(loc, name, samples, phase, history, encoding)
     runtime = runtime_snippets(spec, filter)
+    if encoding is not None:
+        runtime += encoding_glsl(encoding)
     if spec.lookup:
         runtime += AMORTIZE_GLSL + (AMORTIZE_PIXEL_GLSL if phase == "pixel" else "")
     snippet_decls = parse_source("#version 330 core\n" + runtime, "<rrcache runtime>").decls
@@ -459,7 +468,8 @@ def build_pass(loc: LocatedLoop, name: str, samples: int, filter: str = "bilinea
 @deep
 def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-pass", samples: int = 4,
                        blend: float = 0.6, filter: str = "bilinear", payload_dtype: str = "f4",
-                       phase: str = "frame", history: str = "blend", vertex=None) -> Variant:
+                       phase: str = "frame", history: str = "blend", vertex=None,
+                       term_range: Optional[tuple[float, float]] = None) -> Variant:
     """Compile the variant of ``shader`` that amortizes estimator ``estimator_id`` (``e1``...):
     ``samples`` (m) of its N iterations per frame at hits, blended with weight ``blend`` (λ,
     kept in the variant for the runtime; it can be changed there between frames). ``phase``:
@@ -467,7 +477,9 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
     (the paper's running estimate) or ``slots`` (one reprojected sum per subset, see the module
     doc). ``vertex`` is the user's vertex shader (a
     :class:`rrcache.harness.user_vertex.UserVertex`; None: generated), as for
-    :func:`rrcache.compiler.instance`.
+    :func:`rrcache.compiler.instance`. ``payload_dtype="u8"`` (``slots`` only) stores the slots
+    in 8 bits (:mod:`rrcache.compiler.payload_encoding`) by the range of the estimator's terms
+    (``term_range``, else the analysis's or the pragma's: ``Estimator.term_range``).
 
     ``shader`` is a checked :class:`~rrcache.glsl.frontend.Shader` (not the analysed one: the
     loop must still be there) or an :class:`~rrcache.analysis.estimators.EstimatorTable`.
@@ -476,8 +488,8 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
     if filter not in FILTERS:
         raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
-    if payload_dtype not in PAYLOAD_DTYPES:
-        raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+    if payload_dtype not in PAYLOAD_DTYPES + (ENCODED_DTYPE,):
+        raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES + (ENCODED_DTYPE,)}, not {payload_dtype!r}")
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise ValueError(f"samples must be a positive int, not {samples!r}")
     if phase not in PHASES:
@@ -496,6 +508,7 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         if why is not None:
             raise ValueError(f"estimator {est.id}: {why}")
         payload_components = (est.samples // samples) * loc.components
+    encoding = _encoding(est, samples, loc.components, history, payload_dtype, term_range)
     passes: dict[str, PassSource] = {}
     uniforms: dict[str, list[str]] = {}
     samplers: dict[str, list[str]] = {}
@@ -507,7 +520,7 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         # runtime runs "<pass>@<k>" at frames with clock % cycle == k (k = 0: "<pass>")
         phases = range(cycle) if PASS_SPECS[name].lookup else range(1)
         for k in phases:
-            built = build_pass(loc, name, samples, filter, "pixel" if phase == "pixel" else k, history)
+            built = build_pass(loc, name, samples, filter, "pixel" if phase == "pixel" else k, history, encoding)
             key = name if k == 0 else f"{name}@{k}"
             out = emit_pass(built.unit, built.runtime_glsl, built.spec.lookup, vertex)
             passes[key] = PassSource(out.vertex, out.fragment, out.line_map)
@@ -521,4 +534,25 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         uniforms=uniforms, samplers=samplers, runtime_uniforms=runtime, forms=forms,
         node_loc=loop_loc, shader_path=loc.path, vertex_path=getattr(vertex, "path", None),
         amortized={"estimator": est.id, "samples": samples, "of": est.samples, "lambda": float(blend),
-                   "phase": phase, "cycle": cycle, "history": history, "accumulators": [display_name(a) for a in est.accumulators]})
+                   "phase": phase, "cycle": cycle, "history": history, "accumulators": [display_name(a) for a in est.accumulators],
+                   **({"payload_encoding": encoding.to_json()} if encoding is not None else {})})
+
+
+def _encoding(est: Estimator, samples: int, components: int, history: str, payload_dtype: str,
+              term_range: Optional[tuple[float, float]]) -> Optional[PayloadEncoding]:
+    """The 8-bit payload's encoding (None for a float payload); RRCacheError at the loop saying
+    what is missing."""
+    if payload_dtype != ENCODED_DTYPE:
+        return None
+    where = str(est.loop.loc) if est.loop is not None and est.loop.loc is not None else est.id
+    if history != "slots":
+        raise RRCacheError(f"estimator {est.id}: an 8-bit payload needs the slots history (the blend history "
+                           "stores the accumulators' start value too, whose range is not known)", where,
+                           hint="use --history slots, or a float payload (f4, f2)")
+    source = term_range if term_range is not None else getattr(est, "term_range", None)
+    if source is None:
+        why = getattr(est, "range_reason", "") or "the analysis could not bound its terms"
+        raise RRCacheError(f"estimator {est.id}: an 8-bit payload needs the range of the loop's terms: {why}",
+                           where, hint="declare it with '#pragma rrcache estimator range(LO, HI)' on a line "
+                                       "before the loop, or use a float payload (f4, f2)")
+    return slots_encoding(source, samples, est.samples // samples, components)

@@ -10,7 +10,7 @@ to the original shader), what the application must bind, and how the runtime mus
     programs = variant.build_programs(ctx)
     rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h), period=16,
                       payload_dtype=variant.payload_dtype, payload_components=variant.components,
-                      depth_channel=variant.depth_channel)
+                      depth_channel=variant.depth_channel, payload_decode=variant.payload_decode)
     variant.write("out/", period=16)                 # the manifest records the period it ran with
 
 The refresh period and the cache's other run-time parameters are not part of a variant (the same
@@ -80,6 +80,14 @@ class Variant:
     def pass_names(self) -> tuple[str, ...]:
         """The passes in the order the runtime runs them."""
         return ALGORITHMS[self.algorithm]
+
+    @property
+    def payload_decode(self) -> Optional[tuple[list[float], list[float]]]:
+        """(offset, span) per payload channel of an 8-bit payload (``payload_dtype`` ``u8``: the
+        passes store ``(value − offset) / span``, :mod:`rrcache.compiler.payload_encoding`), for
+        the runtime's ``payload_decode``; None for a float payload."""
+        enc = (self.amortized or {}).get("payload_encoding")
+        return (list(enc["offset"]), list(enc["span"])) if enc else None
 
     def manifest(self, period: Optional[int] = None, runtime: Optional[dict] = None) -> dict:
         """A JSON-able description of the variant; ``period`` is the refresh period Δn it runs

@@ -42,6 +42,8 @@ def _unreliable() -> float:
 
 #: the largest finite 16-bit float: payload values beyond it would be stored as ±inf
 HALF_MAX = 65504.0
+#: how far beyond [0, 1] an 8-bit payload's encoded value may be (float rounding) and still fit
+ENCODED_SLACK = 1e-4
 
 
 @dataclass
@@ -88,11 +90,12 @@ class CachedRenderer:
         self.size = tuple(int(v) for v in (resolution or session.resolution))
         self.hit_maps = hit_maps
         self.keep_payload = keep_payload
-        # a 16-bit payload asked for starts in 32 bits: the untimed first frame checks that its
-        # values fit in half floats before the cache is made 16-bit (see _settle_payload)
+        # a 16-bit or 8-bit payload asked for starts in 32 bits: the untimed first frame checks
+        # that its values fit (half floats; the 8-bit encoding's range) before the cache is made
+        # narrower (see _settle_payload)
         self.payload_dtype = variant.payload_dtype
         self.payload_note: Optional[str] = None
-        self._check_half = variant.payload_dtype == "f2"
+        self._check_payload = variant.payload_dtype in ("f2", "u8")
         self._scope = GLScope()
         self._last: Optional[int] = None
         self._warm = False
@@ -106,13 +109,14 @@ class CachedRenderer:
                 period = tuple(variant.periods(period))
             self.runtime = CacheRuntime(
                 self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
-                refresh=refresh, seed=seed, payload_dtype="f4" if self._check_half else variant.payload_dtype,
+                refresh=refresh, seed=seed, payload_dtype="f4" if self._check_payload else variant.payload_dtype,
                 payload_components=variant.components, depth_epsilon=depth_epsilon,
                 clear_color=session_background(session), color_format=color_format,
                 blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
                 phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1),
                 depth_channel=getattr(variant, "depth_channel", None),
-                threshold=threshold, fast_period=fast_period, spread=spread)
+                threshold=threshold, fast_period=fast_period, spread=spread,
+                payload_decode=getattr(variant, "payload_decode", None))
             if window is not None:
                 self.runtime.set_window(window)
         except BaseException:
@@ -128,24 +132,41 @@ class CachedRenderer:
         self.runtime.period = value
 
     def _settle_payload(self) -> None:
-        """After the first (untimed) frame of a 16-bit payload request: if any covered pixel's
-        payload is beyond ±65504 (or overflows), keep 32 bits, warn and say so in
-        ``payload_note``; else switch the cache to 16 bits. Later frames are not checked."""
-        self._check_half = False
+        """After the untimed first frames of a 16-bit or 8-bit payload request: if any covered
+        pixel's payload does not fit (beyond ±65504 or overflowing for 16 bits; outside the
+        encoding's range for 8 bits, which a range declared with the pragma can be), keep 32 bits,
+        warn and say so in ``payload_note``; else switch the cache to the narrower format. Later
+        frames are not checked."""
+        self._check_payload = False
         rt = self.runtime
         payloads = ([p[..., :c] for p, c in zip(rt.read_payloads(), rt.node_components)]
                     if hasattr(rt, "read_payloads") else [rt.read_payload()[..., :rt.payload_components]])
         covered = rt.read_depth() < 1.0
-        values = np.concatenate([np.abs(p[covered]).ravel() for p in payloads])
-        finite = values[np.isfinite(values)]
-        largest = float(finite.max()) if finite.size else 0.0
-        if largest <= HALF_MAX:
-            rt.payload_dtype = "f2"
-            rt.resize(self.size)
-            return
+        if self.payload_dtype == "u8":
+            offset, span = rt.payload_decode
+            c = rt.payload_components
+            stored = np.concatenate([((p[covered] - offset[:c]) / span[:c]).ravel() for p in payloads])
+            outside = stored[~((stored >= -ENCODED_SLACK) & (stored <= 1.0 + ENCODED_SLACK))]
+            if outside.size == 0:
+                rt.payload_dtype = "u8"
+                rt.resize(self.size)
+                return
+            low, high = offset[:c], offset[:c] + span[:c]
+            problem = (f"{outside.size} payload value(s) are outside the range the 8-bit payload encodes "
+                       f"([{float(low.min()):g}, {float(high.max()):g}]: the terms' range times the samples per slot)")
+            remedy = "check the range in '#pragma rrcache estimator range(LO, HI)'"
+        else:
+            values = np.concatenate([np.abs(p[covered]).ravel() for p in payloads])
+            finite = values[np.isfinite(values)]
+            largest = float(finite.max()) if finite.size else 0.0
+            if largest <= HALF_MAX:
+                rt.payload_dtype = "f2"
+                rt.resize(self.size)
+                return
+            problem = f"payload values up to {largest:.6g} are beyond the 16-bit float range (±{HALF_MAX:g})"
+            remedy = ""
         self.payload_dtype = "f4"
-        self.payload_note = (f"payload values up to {largest:.6g} are beyond the 16-bit float range (±{HALF_MAX:g}): "
-                             "the cache uses 32-bit floats instead")
+        self.payload_note = f"{problem}: the cache uses 32-bit floats instead" + (f" ({remedy})" if remedy else "")
         self.notes.append(self.payload_note)
         warnings.warn(self.payload_note, RuntimeWarning, stacklevel=3)
 
@@ -175,7 +196,7 @@ class CachedRenderer:
             # compiled by the driver when first drawn: draw every phase once here, untimed
             for _ in range(max(1, int(self.runtime.phase_cycle))):
                 self._frame(None)
-            if self._check_half:
+            if self._check_payload:
                 self._settle_payload()
             self.runtime.reset()
             self._warm = True
@@ -220,7 +241,7 @@ class CachedRenderer:
         (``clear``, each pass, ``queries``: the runtime waits for the GPU after each) and of the
         read-back (``read-back``); the frame time is then that of the staged frame."""
         index = check_frame_index(self.session, index)
-        if self._check_half:  # decide the payload precision first, on an untimed frame
+        if self._check_payload:  # decide the payload precision first, on an untimed frame
             self.render_frame(index)
         saved = self.runtime.period
         self.runtime.period = 2 ** 30

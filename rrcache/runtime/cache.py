@@ -53,7 +53,7 @@ query; it includes overdraw among missed fragments), ``covered`` the number of v
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import moderngl
 import numpy as np
@@ -75,6 +75,12 @@ ALGORITHMS = {
 }
 
 PAYLOAD_DTYPES = ("f2", "f4")
+#: the payload formats the runtime can hold: the compiler's (above) and ``u8``, 8-bit unsigned
+#: normalised (RGBA8), which only an amortized variant with a known range of its values writes
+#: (it encodes into [0, 1]: rrcache.compiler.amortize); ``payload_decode`` turns it back
+RUNTIME_PAYLOAD_DTYPES = PAYLOAD_DTYPES + ("u8",)
+_TEXTURE_DTYPE = {"f2": "f2", "f4": "f4", "u8": "f1"}
+_PAYLOAD_BYTES = {"f2": 2, "f4": 4, "u8": 1}
 
 # The cache's run-time parameters, given here once: every caller that does not choose one
 # (the harness, the profiler's settings, the command line, a variant's manifest) takes these.
@@ -165,14 +171,19 @@ class CacheRuntime:
         threshold: Optional[float] = None,
         fast_period: int = DEFAULT_FAST_PERIOD,
         spread: float = DEFAULT_SPREAD,
+        payload_decode: Optional[tuple[Sequence[float], Sequence[float]]] = None,
     ):
         if algorithm not in ALGORITHMS:
             raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
         missing = [p for p in self.required_passes(algorithm, programs) if p not in programs]
         if missing:
             raise ValueError(f"{algorithm} needs programs for passes {missing}")
-        if payload_dtype not in PAYLOAD_DTYPES:
-            raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES}, not {payload_dtype!r}")
+        if payload_dtype not in RUNTIME_PAYLOAD_DTYPES:
+            raise ValueError(f"payload_dtype must be one of {RUNTIME_PAYLOAD_DTYPES}, not {payload_dtype!r}")
+        # (offset, span) per channel: what the passes wrote is (value - offset) / span, which
+        # read_payload undoes (None: the values themselves)
+        self.payload_decode = None if payload_decode is None else tuple(
+            np.asarray(v, np.float32).reshape(4) for v in payload_decode)
         if refresh not in REFRESH_MODES:
             raise ValueError(f"refresh must be one of {REFRESH_MODES}, not {refresh!r}")
         if block not in BLOCK_SIZES:
@@ -289,7 +300,7 @@ class CacheRuntime:
             self.color = ctx.texture((w, h), 4, dtype=self._color_dtype)
             packed = self.depth_channel is not None
             channels = self.payload_components + (1 if packed else 0)
-            self._payload = [ctx.texture((w, h), channels, dtype=self.payload_dtype) for _ in range(2)]
+            self._payload = [ctx.texture((w, h), channels, dtype=_TEXTURE_DTYPE[self.payload_dtype]) for _ in range(2)]
             # packed: the inverse depth is the payload's channel depth_channel, no texture of its own
             self._invdepth = [] if packed else [ctx.texture((w, h), 1, dtype="f4") for _ in range(2)]
             # adaptive refresh: each entry's volatility, written after the inverse depth
@@ -343,7 +354,7 @@ class CacheRuntime:
         """Memory per pixel of the cache's targets (depth, colour, two payloads, two inverse
         depths) plus the colour and depth read back (41): what :meth:`resize` checks first."""
         packed = getattr(self, "depth_channel", None) is not None
-        payload = (self.payload_components + (1 if packed else 0)) * (4 if self.payload_dtype == "f4" else 2)
+        payload = (self.payload_components + (1 if packed else 0)) * _PAYLOAD_BYTES[self.payload_dtype]
         state = 2 * 4 if getattr(self, "adaptive", False) else 0
         return 4 + bytes_per_texel(self.color_format) + 2 * payload + (0 if packed else 2 * 4) + state + 41
 
@@ -517,6 +528,9 @@ class CacheRuntime:
         :meth:`read_inverse_depth` > 0."""
         payload = self._read(self._payload[1 - self._index], self.payload_components + (self.depth_channel is not None))
         payload = payload[..., :self.payload_components]
+        if self.payload_decode is not None:
+            offset, span = self.payload_decode
+            payload = payload * span[:self.payload_components] + offset[:self.payload_components]
         if self.payload_components < 4:
             payload = np.concatenate([payload, np.zeros(payload.shape[:2] + (4 - self.payload_components,), np.float32)], axis=-1)
         return payload

@@ -35,7 +35,7 @@ from rrcache.errors import RRCacheError
 from rrcache.gl.formats import bytes_per_texel
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.runtime import glsl as G
-from rrcache.runtime.cache import CacheRuntime
+from rrcache.runtime.cache import PAYLOAD_DTYPES, CacheRuntime
 from rrcache.runtime.multi_glsl import suffixed
 from rrcache.runtime.refresh import refresh_uniforms
 
@@ -85,6 +85,8 @@ class MultiCacheRuntime(CacheRuntime):
         if len(comps) != k or any(c not in (1, 2, 3, 4) for c in comps):
             raise ValueError(f"payload_components must be {k} counts of 1 to 4 (one per node), "
                              f"not {payload_components!r}")
+        if kwargs.get("payload_dtype", "f4") not in PAYLOAD_DTYPES:
+            raise ValueError(f"a multi-node cache holds payloads of {PAYLOAD_DTYPES}, not {kwargs['payload_dtype']!r}")
         target_budget(ctx, algorithm, k)
         # per-node three-pass layout: programs "hit_j" and "node_j" per node, in the order they run
         self.node_passes = [name for name in programs if name.startswith("node_")]
