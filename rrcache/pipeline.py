@@ -131,7 +131,7 @@ def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Varia
         part = selection.parts[0]
         variant = instance_amortized(work.shader, part.estimator, algorithm, samples=part.samples,
                                      blend=part.blend, phase=part.phase, history=part.history,
-                                     vertex=work.vertex)
+                                     filter=part.filter, payload_dtype=part.payload, vertex=work.vertex)
         # an amortized variant does not use the refresh rule: the period is the runtime's default
         return variant, DEFAULT_PERIOD
     raise RRCacheError(f"no variant for a selection of kind {selection.kind!r}", "selection",

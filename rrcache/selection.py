@@ -78,11 +78,15 @@ class AmortizedLoop:
     """Part ``amortize``: estimator ``estimator`` (a loop id such as ``e1``, see
     :mod:`rrcache.analysis.estimators`) evaluated at ``samples`` (m) of its iterations per frame
     where the cache hits, blended with the reprojected estimate by ``blend`` (λ in [0, 1));
-    ``history`` ``blend`` or ``slots`` and ``phase`` ``frame`` or ``pixel`` as in
+    ``history`` ``blend`` or ``slots``, ``phase`` ``frame`` or ``pixel``, ``filter`` (how the
+    previous frame's estimate is resampled) and ``payload`` (``f4``, ``f2``, or ``u8``: the slots
+    in 8 bits by the range of the terms) as in
     :func:`rrcache.compiler.amortize.instance_amortized`. ``text`` is the loop, for people.
 
     >>> AmortizedLoop("e1", 4, 0.6).describe()
     'e1 m=4 λ=0.6'
+    >>> AmortizedLoop("e1", 4, 0.6, "slots", filter="catmull-rom-y", payload="u8").describe()
+    'e1 m=4 λ=0.6 slots/frame catmull-rom-y u8'
     """
 
     KIND: ClassVar[str] = "amortize"
@@ -93,17 +97,22 @@ class AmortizedLoop:
     history: str = "blend"
     phase: str = "frame"
     text: Optional[str] = field(default=None, compare=False)
+    filter: str = "bilinear"
+    payload: str = "f4"
 
     def key(self) -> tuple:
-        return (self.KIND, self.estimator, int(self.samples), float(self.blend), self.history, self.phase)
+        return (self.KIND, self.estimator, int(self.samples), float(self.blend), self.history, self.phase,
+                self.filter, self.payload)
 
     def describe(self) -> str:
         extra = "" if (self.history, self.phase) == ("blend", "frame") else f" {self.history}/{self.phase}"
+        extra += "" if self.filter == "bilinear" else f" {self.filter}"
+        extra += "" if self.payload == "f4" else f" {self.payload}"
         return f"{self.estimator} m={self.samples} λ={self.blend:g}{extra}"
 
     @classmethod
     def from_json(cls, data: dict, where: str) -> "AmortizedLoop":
-        _only(data, ("kind", "estimator", "samples", "blend", "history", "phase", "text"), where)
+        _only(data, ("kind", "estimator", "samples", "blend", "history", "phase", "text", "filter", "payload"), where)
         estimator = data.get("estimator")
         if not isinstance(estimator, str) or not estimator:
             raise RRCacheError("must be an estimator id (a string such as 'e1')", f"{where}.estimator")
@@ -121,8 +130,16 @@ class AmortizedLoop:
         text = data.get("text")
         if text is not None and not isinstance(text, str):
             raise RRCacheError("must be a string or null", f"{where}.text")
-        return cls(estimator, samples, float(blend), history, phase, text)
+        filter_, payload = data.get("filter", "bilinear"), data.get("payload", "f4")
+        if filter_ not in FILTERS:
+            raise RRCacheError(f"must be one of {', '.join(FILTERS)}", f"{where}.filter")
+        if payload not in ("f4", "f2", "u8"):
+            raise RRCacheError("must be 'f4', 'f2' or 'u8'", f"{where}.payload")
+        return cls(estimator, samples, float(blend), history, phase, text, filter_, payload)
 
+
+#: the cache's reconstruction filters (their GLSL: rrcache.runtime.glsl), named by selections
+FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge")
 
 #: the components one payload texel holds (RGBA)
 PAYLOAD_COMPONENTS = 4
@@ -224,7 +241,13 @@ def _only(data: dict, keys: tuple, where: str) -> None:
 
 def parts_to_json(parts) -> list:
     """The parts as JSON objects, each with its ``kind`` first."""
-    return [{"kind": p.KIND, **dataclasses.asdict(p)} for p in parts]
+    return [{"kind": p.KIND, **{k: v for k, v in dataclasses.asdict(p).items()
+                                if not (k, v) in _DEFAULT_FIELDS}} for p in parts]
+
+
+#: fields whose default value is left out of the JSON (added after documents were written with
+#: their default behaviour)
+_DEFAULT_FIELDS = {("filter", "bilinear"), ("payload", "f4")}
 
 
 def parts_from_json(data, where: str) -> tuple:

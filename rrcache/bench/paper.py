@@ -236,13 +236,25 @@ def _measure_selections(prof, work, session, frames, settings: BenchSettings, pr
 PAPER_SHARE, PAPER_BLEND = 4, 0.6
 
 
+#: the amortized settings the bench measures at the paper's m and λ: (history, filter, payload)
+AMORTIZED_SETTINGS = (("blend", "bilinear", "f4"), ("slots", "bilinear", "f4"), ("slots", "catmull-rom-y", "u8"))
+
+
+def _amortized_label(history: str, filter_: str, payload: str) -> str:
+    if history == "blend":
+        return "amortized sampling (Nehab 2007 §6)"
+    extra = "" if (filter_, payload) == ("bilinear", "f4") else f", {'8-bit' if payload == 'u8' else payload}, {filter_}"
+    return f"amortized sampling (per-subset slots{extra})"
+
+
 def _amortized_rows(prof, work, session, frames, settings: BenchSettings, progress) -> list[MethodRow]:
     """Each trained estimator of the profile at the paper's setting (N/4 of its N terms per frame,
     at least 1, blend λ = 3/5), measured beside the original as the selections are (error against
     the original; ``rrcache bench-amortize`` measures against a many-sample reference): the
     paper's single running estimate (``blend`` history) and, where the N/m subset sums fit in the
     payload, the same m and λ with one reprojected sum per subset (``slots``, exact on a still
-    image; :mod:`rrcache.compiler.amortize`)."""
+    image; :mod:`rrcache.compiler.amortize`), and where the terms' range is known, the slots in
+    8 bits resampled with Catmull-Rom down the screen (:data:`AMORTIZED_SETTINGS`)."""
     from rrcache.harness.cached import compare
     from rrcache.pipeline import variant_for_selection
     from rrcache.selection import AmortizedLoop, slots_fit
@@ -252,23 +264,28 @@ def _amortized_rows(prof, work, session, frames, settings: BenchSettings, progre
         if not est.trained:
             continue
         m = max(1, est.samples // PAPER_SHARE)
-        for history in ("blend", "slots"):
-            sel = Selection((AmortizedLoop(est.id, m, PAPER_BLEND, history=history),), 0.0, float("nan"), 1.0,
-                            algorithm=prof.algorithm)
+        for history, filter_, payload in AMORTIZED_SETTINGS:
+            sel = Selection((AmortizedLoop(est.id, m, PAPER_BLEND, history=history, filter=filter_, payload=payload),),
+                            0.0, float("nan"), 1.0, algorithm=prof.algorithm)
             if history == "slots":
                 why = (slots_fit(est.samples, m, est.components) if est.components
                        else "the profile does not record its accumulators' components (written before them)")
                 if why:
                     _say(progress, f"amortized {sel.describe()}: not measured ({why})", None, None)
                     continue
-            variant, period = variant_for_selection(work, sel)
+            try:
+                variant, period = variant_for_selection(work, sel)
+            except RRCacheError as err:  # an 8-bit payload needs the terms' range
+                _say(progress, f"amortized {sel.describe()}: not measured ({err.message})", None, None)
+                continue
             _say(progress, f"amortized {sel.describe()}", None, None)
             runs = [compare(variant, session, work.prepared, frames, period=period, **prof.settings.cache_options())
                     for _ in range(settings.repeats)]
             first = runs[0]
-            rows.append(MethodRow(f"amortized sampling ({'Nehab 2007 §6' if history == 'blend' else 'per-subset slots'})",
-                                  f"{est.id}: {m} of {est.samples} per frame, λ={PAPER_BLEND:g}"
-                                  + ("" if history == "blend" else ", slots"),
+            setting = f"{est.id}: {m} of {est.samples} per frame, λ={PAPER_BLEND:g}" + (
+                "" if history == "blend" else ", slots") + (
+                "" if (filter_, payload) == ("bilinear", "f4") else f", {payload}, {filter_}")
+            rows.append(MethodRow(_amortized_label(history, filter_, payload), setting,
                                   float(statistics.median(r.speedup for r in runs)),
                                   first.mean_error, _cap(first.psnr), float(statistics.median(r.ms_per_frame for r in runs)),
                                   float(statistics.median(r.original_ms_per_frame for r in runs)),

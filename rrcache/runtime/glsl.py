@@ -45,8 +45,7 @@ from __future__ import annotations
 from typing import Optional
 
 from rrcache.runtime.refresh import REFRESH_GLSL
-
-FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge")
+from rrcache.selection import FILTERS  # the names; a selection record names one
 
 # Names the runtime binds. Kept in one place so the compiler and the runtime agree.
 PREV_PAYLOAD = "rr_prevPayload"
