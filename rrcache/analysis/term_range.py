@@ -28,8 +28,9 @@ The ranges of expressions are computed conservatively (every rule is a true boun
 - the loop index: ``start + k·step``, ``k = 0..N-1``; the index of an inner loop with a constant
   header that its body does not write likewise (in the inner loop's own condition and step, its
   exit value too);
-- ``const`` variables with a folded value (:mod:`rrcache.glsl.constfold`): their value (a
-  ``const`` array: the hull of its elements, whatever the index);
+- ``const`` variables with a folded value (:mod:`rrcache.glsl.constfold`): their value; fields,
+  swizzles and indices of one select from it, any index standing for every element
+  (``TAPS[i].weight``: the hull of every element's ``weight``);
 - built-ins: ``fract step smoothstep`` → [0, 1]; ``sin cos`` → [-1, 1]; ``normalize`` → [-1, 1]
   (or [0, 1] for a non-negative argument); ``clamp min max abs sign floor ceil trunc round
   roundEven mod`` (a positive divisor) ``exp exp2 log log2 sqrt inversesqrt`` (on their domain)
@@ -61,6 +62,7 @@ from typing import Callable, Optional, Sequence
 from rrcache.glsl import ast as A
 from rrcache.glsl.constfold import const_value
 from rrcache.glsl.printer import print_expr
+from rrcache.glsl.types import swizzle_indices
 from rrcache.glsl.writes import lvalue_root, out_qualifiers
 
 __all__ = ["term_range", "signed_term", "Interval"]
@@ -456,10 +458,12 @@ class _Body:
     def _field(self, e: A.Field) -> Interval:
         if isinstance(e.obj, A.Call) and _is_texture(e.obj):
             raise _Unknown(_texture_reason(self.text(e)))
-        return self.eval(e.obj)
+        known = _const_hull(e)
+        return known if known is not None else self.eval(e.obj)
 
     def _index(self, e: A.Index) -> Interval:
-        return self.eval(e.obj)
+        known = _const_hull(e)
+        return known if known is not None else self.eval(e.obj)
 
     def _length(self, e: A.Length) -> Interval:
         v = const_value(e)
@@ -506,6 +510,50 @@ class _Body:
 
     def arg(self, e: A.Call, k: int) -> Interval:
         return self.eval(e.args[k])
+
+
+def _possible(e: A.Expr) -> Optional[list]:
+    """The values ``e`` may take when it selects from a ``const`` value by fields, swizzles and
+    indices (any index: every element), e.g. ``TAPS[i].weight``; None when it does not."""
+    v = const_value(e)
+    if v is not None:
+        return [v]
+    if isinstance(e, A.Index):
+        objs = _possible(e.obj)
+        if objs is None or not all(isinstance(o, tuple) for o in objs):
+            return None
+        return [x for o in objs for x in o]
+    if isinstance(e, A.Field):
+        objs, t = _possible(e.obj), e.obj.type
+        if objs is None or t is None or t.dims or t.is_matrix:
+            return None
+        if t.base == "struct":
+            names = [name for name, _ in t.fields]
+            if e.name not in names or not all(isinstance(o, tuple) for o in objs):
+                return None
+            return [o[names.index(e.name)] for o in objs]
+        try:
+            picks = swizzle_indices(e.name)
+        except ValueError:
+            return None
+        out = []
+        for o in objs:
+            comps = list(o) if isinstance(o, tuple) else [o]
+            if any(k >= len(comps) for k in picks):
+                return None
+            out.extend(comps[k] for k in picks)
+        return out
+    return None
+
+
+def _const_hull(e: A.Expr) -> Optional[Interval]:
+    vals = _possible(e)
+    if vals is None:
+        return None
+    flat = _flatten(vals)
+    if not flat or not all(isinstance(v, (int, float)) for v in flat):
+        return None
+    return float(min(flat)), float(max(flat))
 
 
 def _written(node: A.Node):
