@@ -405,7 +405,7 @@ class _Pragma:
     loc: Any = field(default=None, compare=False)
 
 
-_PRAGMA_HEAD = re.compile(r"rrcache\s+estimator(?![\w.])(.*)\Z", re.S)
+_PRAGMA_HEAD = re.compile(r"\s+".join(map(re.escape, PRAGMA.split())) + r"(?![\w.])(.*)\Z", re.S)
 _NUMBER = r"[+-]?\s*(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?[fF]?"
 _RANGE = re.compile(rf"\s*range\s*\(\s*({_NUMBER})\s*,\s*({_NUMBER})\s*\)\s*\Z")
 _RANGE_HINT = ("write '#pragma rrcache estimator range(LO, HI)' with number literals LO < HI, e.g. "
@@ -489,11 +489,6 @@ def _marking(loop, pragmas: list[_Pragma], loops: list) -> list[_Pragma]:
         if (loc.line, loc.col or 0) == first:
             out.append(p)
     return out
-
-
-def _marked(loop, pragmas: list[_Pragma], loops: list) -> bool:
-    """Whether a pragma line precedes ``loop`` with no other loop of the same file in between."""
-    return bool(_marking(loop, pragmas, loops))
 
 
 def _declared_range(marks: list[_Pragma]) -> Optional[tuple[float, float]]:
