@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 from click.testing import CliRunner
@@ -67,7 +68,9 @@ def test_cli_nodes_json_lists_estimators(tmp_path):
     doc = json.loads(out.output)
     assert doc["estimators"] == [{"id": "e1", "line": 12, "column": 5, "samples": 12,
                                   "text": "for (int i = 1; i <= 12; i += 1)",
-                                  "accumulators": ["acc", "wsum"], "pragma": False}]
+                                  "accumulators": ["acc", "wsum"], "pragma": False,
+                                  "term_range": [0.0, pytest.approx(math.exp(-0.1))],
+                                  "range_source": "analysis"}]
     assert doc["not_estimators"] == []
     text = CliRunner().invoke(main, ["nodes", str(path)]).output
     assert "estimator e1" in text and "12 samples" in text

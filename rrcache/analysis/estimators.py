@@ -25,6 +25,16 @@ bound must still be constant). Its amortized variant at ``m = N, λ = 0`` is the
 so a run at that setting shows the marked loop is computed right; whether its terms are really
 independent is the author's promise.
 
+Each estimator has a *term range* (``term_range``): a hull ``(lo, hi)`` that every iteration's
+contribution to every component of every accumulator lies in (for ``acc -= t`` the
+contribution is ``-t``), for payloads that must encode subset sums in a fixed range. The
+interval analysis of :mod:`rrcache.analysis.term_range` proves one where it can
+(``range_source == "analysis"``; else ``range_reason`` names the sub-expression without a known
+range); ``#pragma rrcache estimator range(LO, HI)`` (number literals, ``LO < HI``) marks the loop
+like the bare pragma and declares the range, which wins over the proven one
+(``range_source == "pragma"``: the author's promise, checked at run time by the caller). A
+malformed ``rrcache estimator`` pragma raises :class:`~rrcache.errors.GLSLError` at its line.
+
 Ids are ``e1``, ``e2``, ... for the loops of ``main`` in program order (every loop counts, so an
 id does not change when another loop stops qualifying).
 
@@ -40,6 +50,7 @@ id does not change when another loop stops qualifying).
 """
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
@@ -48,11 +59,14 @@ from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
 from rrcache.glsl.ast import walk
+from rrcache.analysis.term_range import signed_term, term_range
+from rrcache.errors import GLSLError, printable
 from rrcache.glsl.rewrite import paused_gc
 from rrcache.glsl.writes import written_roots
 
 __all__ = ["Estimator", "NotEstimator", "EstimatorTable", "find_estimators", "estimator_loops",
-           "loop_header", "display_name", "ACCUMULATOR_TYPES", "MAX_SAMPLES", "PRAGMA"]
+           "loop_header", "display_name", "parse_pragma", "ACCUMULATOR_TYPES", "MAX_SAMPLES",
+           "PRAGMA"]
 
 #: accumulator types and their component counts
 ACCUMULATOR_TYPES = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
@@ -71,7 +85,13 @@ class Estimator:
     """A loop that sums ``samples`` independent terms into ``accumulators`` (names, with their
     GLSL types in ``types``). ``start``/``step`` give the index values ``start + k * step``,
     ``k = 0..samples-1``; ``index`` is the loop variable. ``pragma``: marked by
-    ``#pragma rrcache estimator`` rather than proven."""
+    ``#pragma rrcache estimator`` rather than proven.
+
+    ``term_range``: a hull ``(lo, hi)`` of every iteration's contribution to every component of
+    every accumulator (``acc -= t`` contributes ``-t``), None when not known; ``range_source``:
+    ``"pragma"`` (declared by ``#pragma rrcache estimator range(LO, HI)``, which wins) or
+    ``"analysis"`` (proven), None when unknown; ``range_reason``: why there is none, naming the
+    sub-expression as the user wrote it ("" when there is one)."""
 
     id: str
     line: Optional[int]
@@ -85,15 +105,23 @@ class Estimator:
     step: int
     pragma: bool = False
     loop: Any = field(default=None, repr=False, compare=False)
+    term_range: Optional[tuple[float, float]] = None
+    range_source: Optional[str] = None
+    range_reason: str = ""
 
     @property
     def components(self) -> int:
         return sum(ACCUMULATOR_TYPES[t] for t in self.types)
 
     def to_json(self) -> dict:
-        return {"id": self.id, "line": self.line, "column": self.column, "samples": self.samples,
-                "text": display_name(self.text), "accumulators": [display_name(a) for a in self.accumulators],
-                "pragma": self.pragma}
+        out = {"id": self.id, "line": self.line, "column": self.column, "samples": self.samples,
+               "text": display_name(self.text), "accumulators": [display_name(a) for a in self.accumulators],
+               "pragma": self.pragma}
+        out["term_range"] = list(self.term_range) if self.term_range is not None else None
+        out["range_source"] = self.range_source
+        if self.term_range is None:
+            out["range_reason"] = self.range_reason
+        return out
 
 
 @dataclass
@@ -267,17 +295,8 @@ def _mentions(node, names: set[str]) -> bool:
 
 def _accumulation(e: A.Assign, accs: set[str]) -> Optional[A.Expr]:
     """The term of ``acc += t`` / ``acc -= t`` / ``acc = acc ± t`` (None when ``e`` is not one)."""
-    if not isinstance(e.target, A.Ident) or e.target.name not in accs:
-        return None
-    if e.op in ("+=", "-="):
-        return e.value
-    if e.op == "=" and isinstance(e.value, A.Binary) and e.value.op in ("+", "-"):
-        v = e.value
-        if isinstance(v.left, A.Ident) and v.left.name == e.target.name:
-            return v.right
-        if v.op == "+" and isinstance(v.right, A.Ident) and v.right.name == e.target.name:
-            return v.left
-    return None
+    st = signed_term(e, accs)
+    return None if st is None else st[1]
 
 
 def _type_name(ident: A.Ident) -> Optional[str]:
@@ -376,11 +395,62 @@ def display_name(text: str) -> str:
     return _INLINED_NAME.sub(lambda m: m.group(1), text)
 
 
-def _pragma_lines(shader) -> list[tuple[str, int]]:
+@dataclass(frozen=True)
+class _Pragma:
+    """One ``#pragma rrcache estimator`` line, with the range it declares (or None)."""
+
+    file: str
+    line: int
+    range: Optional[tuple[float, float]]
+    loc: Any = field(default=None, compare=False)
+
+
+_PRAGMA_HEAD = re.compile(r"\s+".join(map(re.escape, PRAGMA.split())) + r"(?![\w.])(.*)\Z", re.S)
+_NUMBER = r"[+-]?\s*(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?[fF]?"
+_RANGE = re.compile(rf"\s*range\s*\(\s*({_NUMBER})\s*,\s*({_NUMBER})\s*\)\s*\Z")
+_RANGE_HINT = ("write '#pragma rrcache estimator range(LO, HI)' with number literals LO < HI, e.g. "
+               "range(0.0, 1.0) or range(-1, 1), or '#pragma rrcache estimator' alone")
+
+
+def parse_pragma(text: str, loc=None) -> Optional[tuple[bool, Optional[tuple[float, float]]]]:
+    """What a ``#pragma`` text (after ``#pragma``) says about estimators: None when it is not an
+    ``rrcache estimator`` pragma, ``(True, None)`` for the bare one, ``(True, (lo, hi))`` for
+    ``rrcache estimator range(LO, HI)``. Anything else after ``rrcache estimator`` raises
+    :class:`~rrcache.errors.GLSLError` at ``loc`` (the pragma's place) with the right syntax.
+
+    >>> parse_pragma("rrcache estimator range(-0.5, 2)")
+    (True, (-0.5, 2.0))
+    >>> parse_pragma("rrcache  estimator"), parse_pragma("optimize(on)")
+    ((True, None), None)
+    """
+    m = _PRAGMA_HEAD.match(str(text).strip())
+    if m is None:
+        return None
+    rest = m.group(1).strip()
+    if not rest:
+        return True, None
+    shown = printable(" ".join(str(text).split()))
+    r = _RANGE.match(rest)
+    if r is None:
+        raise GLSLError(f"malformed '#pragma {shown}': expected range(LO, HI) after "
+                        "'rrcache estimator'", loc, hint=_RANGE_HINT)
+    lo, hi = (float(g.replace(" ", "").replace("\t", "").rstrip("fF")) for g in r.groups())
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise GLSLError(f"malformed '#pragma {shown}': the range's ends must be finite", loc,
+                        hint=_RANGE_HINT)
+    if not lo < hi:
+        raise GLSLError(f"malformed '#pragma {shown}': LO ({lo:g}) must be below HI ({hi:g})", loc,
+                        hint=_RANGE_HINT)
+    return True, (lo, hi)
+
+
+def _pragmas(shader) -> list[_Pragma]:
+    """The ``#pragma rrcache estimator`` lines of ``shader`` (a malformed one raises)."""
     out = []
     for text, loc in getattr(shader, "pragmas", None) or []:
-        if " ".join(str(text).split()) == PRAGMA and loc is not None:
-            out.append((loc.file, loc.line))
+        parsed = parse_pragma(text, loc)
+        if parsed is not None and loc is not None:
+            out.append(_Pragma(loc.file, loc.line, parsed[1], loc))
     return out
 
 
@@ -404,20 +474,31 @@ def _loop_text(loop) -> str:
     return "do ... while"
 
 
-def _marked(loop, pragmas: list[tuple[str, int]], loops: list) -> bool:
-    """Whether a pragma line precedes ``loop`` with no other loop of the same file in between."""
+def _marking(loop, pragmas: list[_Pragma], loops: list) -> list[_Pragma]:
+    """The pragma lines that precede ``loop`` with no other loop of the same file in between."""
     loc = loop.loc
     if loc is None or not pragmas:
-        return False
-    for file, line in pragmas:
-        if loc.file != file or loc.line <= line:
+        return []
+    out = []
+    for p in pragmas:
+        if loc.file != p.file or loc.line <= p.line:
             continue
         # the first loop after the pragma is the one it marks
         first = min((other.loc.line, other.loc.col or 0) for other, _ in loops
-                    if other.loc is not None and other.loc.file == file and other.loc.line > line)
+                    if other.loc is not None and other.loc.file == p.file and other.loc.line > p.line)
         if (loc.line, loc.col or 0) == first:
-            return True
-    return False
+            out.append(p)
+    return out
+
+
+def _declared_range(marks: list[_Pragma]) -> Optional[tuple[float, float]]:
+    ranges = [p for p in marks if p.range is not None]
+    if len({p.range for p in ranges}) > 1:
+        first, second = ranges[0], ranges[1]
+        raise GLSLError(f"two different ranges declared for one loop (the other at line {first.line})",
+                        second.loc,
+                        hint="keep one '#pragma rrcache estimator range(LO, HI)' before the loop")
+    return ranges[0].range if ranges else None
 
 
 @deep
@@ -430,19 +511,31 @@ def find_estimators(shader, inlined: Any = None) -> EstimatorTable:
         if inlined is None:
             inlined = inline_calls(shader)
         consts = _const_values(getattr(shader, "info", None))
-        pragmas = _pragma_lines(shader)
+        pragmas = _pragmas(shader)
         loops = estimator_loops(inlined.unit)
         found, rejected = [], []
         for k, (loop, depth) in enumerate(loops, start=1):
             loc = loop.loc
             line, column = (loc.line, loc.col) if loc is not None else (None, None)
             text = _loop_text(loop)
-            pragma = _marked(loop, pragmas, loops)
+            marks = _marking(loop, pragmas, loops)
+            declared = _declared_range(marks)
+            pragma = bool(marks)
             header, accs, types, why = classify(loop, depth, consts, pragma)
             if why:
                 rejected.append(NotEstimator(f"e{k}", line, column, text, why))
                 continue
             index, start, step, n = header
-            found.append(Estimator(f"e{k}", line, column, n, text, accs, types, index, start, step,
-                                   pragma, loop))
+            est = Estimator(f"e{k}", line, column, n, text, accs, types, index, start, step, pragma, loop)
+            if declared is not None:
+                est.term_range, est.range_source = declared, "pragma"
+            else:
+                proven, reason = term_range(loop, index, start, step, n, accs,
+                                            header=lambda inner: loop_header(inner, consts)[0],
+                                            display=display_name)
+                if proven is not None:
+                    est.term_range, est.range_source = proven, "analysis"
+                else:
+                    est.range_reason = reason
+            found.append(est)
         return EstimatorTable(inlined, found, rejected)
