@@ -119,6 +119,21 @@ def test_multi_node_cache_refuses_u8(gl_ctx):
         MultiCacheRuntime(gl_ctx, {}, "three-pass", (8, 8), period=(2, 3), payload_dtype="u8")
 
 
+def test_bench_amortize_u8_on_the_temple(gl_ctx, tmp_path):
+    """The PCF term (a bilinear mix of shadow comparisons) is proven in [0, 1], so the slots go
+    in 8 bits; the run says so and measures both errors."""
+    out = CliRunner().invoke(cli, [
+        "bench-amortize", str(ROOT / "shaders" / "pcf_shadows.glsl"), str(ROOT / "sessions" / "temple.json"),
+        "--estimator", "e1", "--samples", "4", "--lambda", "0.6", "--history", "slots", "--payload", "u8",
+        "--filter", "catmull-rom-y", "--reference", "PCF_SAMPLES=64", "--frames", "4", "--repeats", "1",
+        "--error-every", "2", "--resolution", "64x48", "--json"])
+    assert out.exit_code == 0, out.output
+    doc = json.loads(out.output[out.output.index("{"):])
+    assert doc["payload"] == "u8" and "payload_note" not in doc
+    assert (doc["history"], doc["filter"]) == ("slots", "catmull-rom-y")
+    assert doc["error_frames"] == 2 and 0 < doc["original_error"] and 0 < doc["amortized_error"]
+
+
 def test_instance_u8_only_for_an_estimator(tmp_path):
     out = CliRunner().invoke(cli, ["instance", str(ROOT / "shaders" / "pcf_shadows.glsl"), "--node", "n1",
                                    "--payload", "u8", "--out", str(tmp_path / "o")])
