@@ -573,3 +573,19 @@ def test_the_estimator_record_keeps_the_text_as_written():
     [est] = find_estimators(shader).estimators
     assert "_rr_" in est.text
     assert _record(est).text == "for (int i = 0; i < 8; i++)"
+
+
+def test_a_malformed_range_pragma_stops_the_profile_before_training(tmp_path):
+    """The profiler used to skip the estimators of a shader the analysis refused; a malformed
+    pragma is the user's error and is said, at its place, before anything is trained."""
+    shader = tmp_path / "bad.frag"
+    shader.write_text("#version 330\nin vec2 v_texcoord; out vec4 c;\nvoid main() {\n  float s = 0.0;\n"
+                      "  #pragma rrcache estimator range(1, 0)\n"
+                      "  for (int i = 0; i < 4; i++) s += sin(v_texcoord.x * float(i));\n  c = vec4(s);\n}\n")
+    session = tmp_path / "s.json"
+    session.write_text(json.dumps(SESSION))
+    run = subprocess.run([sys.executable, "-m", "rrcache", "profile", str(shader), str(session),
+                          "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 2, run.stderr
+    assert f"{shader}:5:" in run.stderr and "range(1, 0)" in run.stderr
+    assert not (tmp_path / "out" / "profile.sqlite").exists()

@@ -23,8 +23,10 @@ when it has a ``precision`` statement or tests ``GL_ES`` (as ES sketch tools run
 desktop GLSL 1.10.
 
 The JSON also has ``estimators``: the loops that sum independent samples (``{"id", "line",
-"column", "samples", "text", "accumulators", "pragma"}``, see :mod:`rrcache.analysis.estimators`;
-``#pragma rrcache estimator`` before a loop marks one the analysis cannot prove) and
+"column", "samples", "text", "accumulators", "pragma", "term_range", "range_source"}`` and
+``"range_reason"`` when the range is not known, see :mod:`rrcache.analysis.estimators`;
+``#pragma rrcache estimator`` before a loop marks one the analysis cannot prove, and ``#pragma
+rrcache estimator range(LO, HI)`` also declares the range of its terms) and
 ``not_estimators``, the other loops with the reason. The text table lists the estimators after
 the nodes (with ``--all``, the other loops too).
 """
@@ -139,7 +141,9 @@ def format_estimators(estimators, show_all: bool) -> str:
     lines = []
     for e in estimators.estimators:
         accs = ", ".join(display_name(a) for a in e.accumulators)
-        lines.append(f"estimator {e.id}  {e.line}:{e.column}  {e.samples} samples into {accs}"
+        terms = (f"terms in [{e.term_range[0]:g}, {e.term_range[1]:g}]"
+                 + (" (declared)" if e.range_source == "pragma" else "")) if e.term_range else "terms unbounded"
+        lines.append(f"estimator {e.id}  {e.line}:{e.column}  {e.samples} samples into {accs}, {terms}"
                      f"{'  (pragma)' if e.pragma else ''}  {_short(display_name(e.text))}")
     if show_all:
         for r in estimators.rejected:

@@ -37,7 +37,7 @@ from typing import Optional
 
 import numpy as np
 
-from rrcache.errors import RRCacheError
+from rrcache.errors import GLSLError, RRCacheError
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
@@ -69,17 +69,29 @@ def _slots_record(est) -> Optional[HistoryRuns]:
                             f"component(s) within the payload's {PAYLOAD_COMPONENTS}")
 
 
+def estimator_table(work):
+    """The estimators of ``work.shader`` (:func:`rrcache.analysis.estimators.find_estimators`),
+    None where the analysis cannot take the shader; a malformed ``#pragma rrcache estimator``
+    is the user's error and raises (:func:`rrcache.profiler.run.profile` asks first, before any
+    training)."""
+    from rrcache.analysis.estimators import find_estimators
+
+    try:
+        return find_estimators(work.shader)
+    except GLSLError:
+        raise
+    except RRCacheError:
+        return None
+
+
 def train_estimators(work, session, settings, store, result, progress: Optional[ProgressFn] = None,
                      clock=time.perf_counter) -> list[EstimatorProfile]:
     """Train every estimator of ``work`` the budget allows, each history at its m (module
     docstring), and return their records, trained or with a ``note`` saying why not. ``result``
     is the nodes' :class:`~rrcache.profiler.train.TrainingResult` (its plan, algorithm and
     original time)."""
-    from rrcache.analysis.estimators import find_estimators
-
-    try:
-        table = find_estimators(work.shader)
-    except RRCacheError:
+    table = estimator_table(work)
+    if table is None:
         return []
     found = sorted(table.estimators, key=lambda e: -int(e.samples))
     records = [_record(e) for e in found]

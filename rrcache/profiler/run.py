@@ -68,6 +68,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     session = load_session(session_path)
     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
     resolved = (settings or TrainingSettings()).resolved(session)
+    from rrcache.profiler.amortize import estimator_table
+
+    estimator_table(work)  # a malformed '#pragma rrcache estimator': said before anything is trained
     out = Path(out_dir) if out_dir is not None else default_out_dir(shader_path, session_path)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the output path is a file, not a folder", str(out), hint="give a folder with --out")
