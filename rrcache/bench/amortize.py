@@ -185,7 +185,8 @@ def write_images(out_dir: str, shader, session, result: AmortizedRun, kept: dict
         panels = [(_defines_label(also), kept["also"])] if "also" in kept else []
         panels += [(f"original ({result.total} of {result.total})", kept["original"]),
                    (f"amortized {result.samples} of {result.total}, λ = {result.blend:g}, {result.history}"
-                    + ("" if result.filter == "bilinear" else f", {result.filter}"),
+                    + ("" if result.filter == "bilinear" else f", {result.filter}")
+                    + (", 8-bit" if result.payload == "u8" else ""),
                     kept["amortized"])]
         path = os.path.join(out_dir, "comparison.png")
         write_sheet(path, panels, kept["reference"], mask, window_of=len(panels) - 2,
