@@ -589,3 +589,38 @@ def test_a_malformed_range_pragma_stops_the_profile_before_training(tmp_path):
     assert run.returncode == 2, run.stderr
     assert f"{shader}:5:" in run.stderr and "range(1, 0)" in run.stderr
     assert not (tmp_path / "out" / "profile.sqlite").exists()
+
+
+# a term in [0, 1] whatever the inputs (0.5 + 0.5 sin): the analysis proves it, so the slots are
+# trained and offered in 8 bits
+BOUNDED = SHADER.replace(
+    "shade += max(dot(nrm, d), 0.0) * (0.6 + 0.4 * wave(p, 2.0 + 0.3 * float(i)));",
+    "shade += 0.5 + 0.5 * sin(dot(d, p) * (2.0 + 0.3 * float(i)));")
+
+
+def test_slots_of_a_bounded_term_are_trained_and_offered_in_8_bits(tmp_path):
+    from rrcache.harness.cached import CachedRenderer
+    from rrcache.pipeline import load_for_session, variant_for_selection
+    from rrcache.session import load_session
+
+    assert BOUNDED != SHADER
+    shader, session = _scene(tmp_path)
+    shader.write_text(BOUNDED)
+    prof = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False))
+    est = prof.estimators[0]
+    assert est.trained and est.slots.trained and est.slots.payload == "u8"
+    assert all(e > 0 for e in est.slots.errors)
+    slots = [o for o in prof.amortized_options() if o.parts[0].history == "slots"]
+    blend = [o for o in prof.amortized_options() if o.parts[0].history == "blend"]
+    assert slots and all(o.parts[0].payload == "u8" for o in slots) and all(o.parts[0].payload == "f4" for o in blend)
+    assert "u8" in slots[0].describe()
+    # the document keeps it, and the chosen option compiles and runs in 8 bits
+    assert load_profile(tmp_path / "out") == prof
+    loaded = load_session(session)
+    work = load_for_session(str(shader), loaded)
+    variant, period = variant_for_selection(work, slots[0])
+    assert variant.payload_dtype == "u8"
+    with CachedRenderer(variant, loaded, work.prepared, period=period) as cached:
+        for index in range(3):
+            cached.render_frame(index)
+        assert cached.payload_dtype == "u8" and cached.payload_note is None

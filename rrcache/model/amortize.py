@@ -382,7 +382,8 @@ class AmortizeModel:
     ``error`` (:class:`AmortizeErrorFit` for ``blend``, :class:`SlotsErrorFit` for ``slots``) and
     ``time`` fits, ``hit_rate`` h (the timing runs'), ``pixels`` P (mean covered pixels per
     frame), ``psnr`` (a :class:`~rrcache.model.psnr.PsnrFit` or None), ``text`` (the loop),
-    ``history``, ``components`` (the accumulators' payload components; None: not recorded)."""
+    ``history``, ``components`` (the accumulators' payload components; None: not recorded),
+    ``payload`` (the payload format its runs used, which its options compile with)."""
 
     estimator: str
     total: int
@@ -394,6 +395,7 @@ class AmortizeModel:
     text: Optional[str] = None
     history: str = "blend"
     components: Optional[int] = None
+    payload: str = "f4"
 
     def sample_counts(self) -> list[int]:
         """The m this history is offered at: :func:`sample_counts` for ``blend``; for ``slots``
@@ -418,7 +420,7 @@ class AmortizeModel:
             for lam in BLEND_GRID:
                 err = max(float(self.error.predict(m, lam)), 0.0)
                 sel = Selection((AmortizedLoop(self.estimator, int(m), float(round(lam, 6)), self.history,
-                                               text=self.text),),
+                                               text=self.text, payload=self.payload),),
                                 err, ms, float(original_ms) / ms if ms > 0 else math.inf)
                 if self.psnr is not None:
                     sel = sel.replace(predicted_psnr=float(self.psnr.predict(err)) if err > 0 else None)

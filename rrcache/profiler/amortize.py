@@ -7,7 +7,9 @@ the same windows (:mod:`rrcache.profiler.plan`) and with the same algorithm. Eac
 :func:`rrcache.model.amortize.training_samples` (for 16 terms m = 1, 4, 8) and ``slots`` (the
 N/m subset sums kept apart) at every m where they fit the payload
 (:func:`rrcache.selection.slots_fit`: for 16 terms of one component m = 4 and 8; none for a
-prime N or four components), the only m it is offered at. Per history:
+prime N or four components), the only m it is offered at, in 8 bits where the range of the
+terms is known (:func:`slots_payload`; its runs are stored apart, :func:`store_history`). Per
+history:
 
 1. **Error runs.** Per trained m one compiled variant serves every blend (λ is the runtime's
    ``blend``): the training frames are rendered in order from an empty cache at each λ of
@@ -59,11 +61,25 @@ def _record(est) -> EstimatorProfile:
                             components=int(est.components))
 
 
+def slots_payload(est) -> str:
+    """The slots' payload format the profiler trains and offers: ``u8`` (8 bits,
+    :mod:`rrcache.compiler.payload_encoding`) where the range of the estimator's terms is known
+    (proven by the analysis or declared with the pragma), else ``f4``."""
+    return "u8" if getattr(est, "term_range", None) is not None else "f4"
+
+
+def store_history(history: str, payload: str = "f4") -> str:
+    """The store's history key of a history's runs: ``slots`` runs in 8 bits are kept apart
+    (``slots/u8``) from float ones, so a store trained before the 8-bit payload is not read as
+    8-bit runs."""
+    return history if payload == "f4" else f"{history}/{payload}"
+
+
 def _slots_record(est) -> Optional[HistoryRuns]:
     """The slots history's record before training: None for an estimator that is not trained at
     all; a note when the slots fit no m (:func:`rrcache.selection.slots_fit`)."""
     if training_samples(int(est.samples), "slots", int(est.components)):
-        return HistoryRuns()
+        return HistoryRuns(payload=slots_payload(est))
     n = int(est.samples)
     return HistoryRuns(note=f"not offered: no m < N dividing N = {n} keeps the N/m sums of {int(est.components)} "
                             f"component(s) within the payload's {PAYLOAD_COMPONENTS}")
@@ -123,7 +139,8 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             rec.note = f"not trained: its accumulators need {est.components} payload components (at most 4)"
             continue
         spent = store.spent_s() + data.spent_s(store)
-        started = any(data.rows(store, est.id, kind, history) for kind in ("error", "timing") for history in HISTORIES)
+        started = any(data.rows(store, est.id, kind, store_history(history, _payload(est, history)))
+                      for kind in ("error", "timing") for history in HISTORIES)
         if k > 0 and not started and spent >= settings.budget_s:
             rec.note = "not reached within the training budget (--budget)"
             continue
@@ -134,8 +151,9 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
                               for _, ms_list in plans)
         for history, ms_list in plans:
             target = rec.runs(history)
+            key = store_history(history, _payload(est, history))
             try:
-                if refs is None and _missing_errors(store, est.id, ms_list, history):
+                if refs is None and _missing_errors(store, est.id, ms_list, key):
                     state["total"] += len(frames)  # the reference frames, rendered once for all
                     refs = _references(work, session, settings, plan, frames, step)
                 _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock, history)
@@ -144,8 +162,12 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             except RRCacheError as err:  # a variant that does not compile or run: say why, go on
                 target.note = f"not trained: {err}"
                 continue
-            _fit(target, store, result.original_ms, est.id, int(est.samples), history)
+            _fit(target, store, result.original_ms, est.id, int(est.samples), history, key)
     return records
+
+
+def _payload(est, history: str) -> str:
+    return slots_payload(est) if history == "slots" else "f4"
 
 
 def _missing_errors(store, eid: str, ms_list, history: str = "blend") -> bool:
@@ -166,16 +188,18 @@ def _variant(work, est, algorithm: str, m: int, history: str = "blend"):
     from rrcache.compiler.amortize import instance_amortized
 
     return instance_amortized(work.shader, est.id, algorithm, samples=m, blend=0.0, history=history,
-                              vertex=work.vertex)
+                              payload_dtype=_payload(est, history), vertex=work.vertex)
 
 
 def _label(est, m: int, history: str) -> str:
-    return f"{est.id} m={m}" + (" slots" if history == "slots" else "")
+    payload = _payload(est, history)
+    return f"{est.id} m={m}" + (" slots" if history == "slots" else "") + ("" if payload == "f4" else f" {payload}")
 
 
 def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock,
                 history: str = "blend") -> None:
-    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error", history)}
+    key = store_history(history, _payload(est, history))
+    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error", key)}
     for m in ms_list:
         todo = [lam for lam in TRAIN_BLENDS if (m, round(lam, 6)) not in have]
         if not todo:
@@ -203,13 +227,14 @@ def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, r
                 rate = hits / (hits + misses) if hits + misses else 0.0
                 wall = clock() - start + extra
                 extra = 0.0
-                data.add_rows(store, [(est.id, history, "error", int(m), float(lam), -1, float(np.mean(errs)),
+                data.add_rows(store, [(est.id, key, "error", int(m), float(lam), -1, float(np.mean(errs)),
                                        float(np.mean(psnrs)), rate, hits, misses, 0.0, 0.0, wall)])
 
 
 def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
                  history: str = "blend") -> None:
-    have = {r["samples"] for r in data.rows(store, est.id, "timing", history)}
+    key = store_history(history, _payload(est, history))
+    have = {r["samples"] for r in data.rows(store, est.id, "timing", key)}
     todo = [m for m in ms_list if m not in have]
     if not todo or not timing:
         return
@@ -228,17 +253,18 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
                     out.append((index, got, ref.ms))
                     step(f"{_label(est, m, history)} timing", 3)
             wall = (clock() - start) / max(1, len(out))
-            data.add_rows(store, [(est.id, history, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0,
+            data.add_rows(store, [(est.id, key, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0,
                                    int(got.hits or 0), int(got.misses or 0), float(got.ms), float(ref_ms), wall)
                                   for index, got, ref_ms in out])
 
 
-def _fit(rec, store, original_ms: float, estimator: str, total: int, history: str = "blend") -> None:
+def _fit(rec, store, original_ms: float, estimator: str, total: int, history: str = "blend",
+         key: Optional[str] = None) -> None:
     """The models of one history of an estimator from its stored runs (module docstring, step
-    3), into ``rec`` (the :class:`EstimatorProfile` for ``blend``, its :class:`HistoryRuns`
-    for ``slots``)."""
-    errors = data.rows(store, estimator, "error", history)
-    timed = data.rows(store, estimator, "timing", history)
+    3; ``key``: the store's history key, :func:`store_history`), into ``rec`` (the
+    :class:`EstimatorProfile` for ``blend``, its :class:`HistoryRuns` for ``slots``)."""
+    errors = data.rows(store, estimator, "error", key or history)
+    timed = data.rows(store, estimator, "timing", key or history)
     if not errors or not timed:
         rec.note = "not trained: runs missing"
         return

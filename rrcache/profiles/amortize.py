@@ -80,6 +80,9 @@ class HistoryRuns:
     time_fit: dict = field(default_factory=dict)
     hit_rate: Optional[float] = _r(minimum=0, maximum=1)
     pixels: Optional[float] = _r(minimum=0)
+    #: the payload the runs used: ``u8`` (the slots in 8 bits, where the terms' range is known;
+    #: rrcache.profiler.amortize.slots_payload) or ``f4`` (documents from before it: f4)
+    payload: str = "f4"
 
 
 @dataclass
@@ -139,7 +142,7 @@ class EstimatorProfile:
         tf = AmortizeTimeFit(**{k: runs.time_fit[k] for k in ("fixed_ms", "t_sample", "rms", "n", "quality")})
         psnr = fit_psnr(runs.errors, runs.psnrs) if runs.errors else None
         return AmortizeModel(self.id, int(self.samples), ef, tf, float(runs.hit_rate or 0.0), float(runs.pixels or 0.0),
-                             psnr, self.text, history, self.components)
+                             psnr, self.text, history, self.components, getattr(runs, "payload", "f4"))
 
     def models(self) -> list:
         """The trained histories' models, blend first."""
