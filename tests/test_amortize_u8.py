@@ -11,33 +11,15 @@ import pytest
 from click.testing import CliRunner
 
 from estimator_corpus import ESTIMATORS
+from test_compiler_amortize import _setup
 from rrcache.cli import cli
 from rrcache.compiler.amortize import instance_amortized
 from rrcache.errors import RRCacheError
-from rrcache.glsl.frontend import load_shader
 from rrcache.harness.cached import CachedRenderer, compare
-from rrcache.harness.prepare import prepare_file
-from rrcache.session import load_session
 
 ROOT = Path(__file__).resolve().parent.parent
 # "blur": each term is bump() = 0.5 + 0.5 sin(.) cos(.), in [0, 1]; 8 terms, 2 per frame: 4 slots
 BLUR, BLUR_RANGE = ESTIMATORS["blur"][0], (0.0, 1.0)
-
-
-def _setup(tmp_path, source, moving=True, frames=5):
-    shader = tmp_path / "shader.frag"
-    shader.write_text(source)
-    keys = [{"frame": 0, "eye": [0, 0.4, 3.0], "target": [0, 0, 0], "up": [0, 1, 0]}]
-    if moving:
-        keys.append({"frame": frames - 1, "eye": [0.5, 0.5, 2.9], "target": [0, 0, 0], "up": [0, 1, 0]})
-    doc = {"rrcache_session": 1, "resolution": [48, 48], "frames": frames,
-           "camera": {"fov": 45, "near": 0.5, "far": 10, "keyframes": keys},
-           "objects": [{"procedural": {"type": "torus", "major_radius": 0.9, "minor_radius": 0.4,
-                                       "major_segments": 24, "minor_segments": 12}}]}
-    path = tmp_path / "session.json"
-    path.write_text(json.dumps(doc))
-    session = load_session(path)
-    return load_shader(str(shader)), prepare_file(str(shader), session), session
 
 
 def _payloads(variant, session, prepared, frames):
@@ -51,7 +33,7 @@ def _payloads(variant, session, prepared, frames):
 
 @pytest.mark.parametrize("algorithm", ["three-pass", "two-pass", "one-pass"])
 def test_u8_slots_match_the_float_slots_to_a_step(gl_ctx, tmp_path, algorithm):
-    loaded, prepared, session = _setup(tmp_path, BLUR)
+    loaded, prepared, session = _setup(tmp_path, BLUR, frames=5)
     f4 = instance_amortized(loaded, "e1", algorithm, samples=2, blend=0.6, history="slots")
     u8 = instance_amortized(loaded, "e1", algorithm, samples=2, blend=0.6, history="slots", payload_dtype="u8",
                             term_range=BLUR_RANGE)
@@ -71,7 +53,7 @@ def test_u8_slots_match_the_float_slots_to_a_step(gl_ctx, tmp_path, algorithm):
 
 
 def test_u8_slots_on_a_still_camera_are_the_original_to_rounding(gl_ctx, tmp_path):
-    loaded, prepared, session = _setup(tmp_path, BLUR, moving=False)
+    loaded, prepared, session = _setup(tmp_path, BLUR, moving=False, frames=5)
     u8 = instance_amortized(loaded, "e1", "two-pass", samples=2, blend=0.0, history="slots", payload_dtype="u8",
                             term_range=BLUR_RANGE)
     result = compare(u8, session, prepared, range(5), period=1000)
@@ -82,7 +64,7 @@ def test_u8_slots_on_a_still_camera_are_the_original_to_rounding(gl_ctx, tmp_pat
 
 
 def test_a_range_that_does_not_hold_keeps_floats_with_a_note(gl_ctx, tmp_path):
-    loaded, prepared, session = _setup(tmp_path, BLUR)
+    loaded, prepared, session = _setup(tmp_path, BLUR, frames=5)
     narrow = instance_amortized(loaded, "e1", "two-pass", samples=2, blend=0.6, history="slots",
                                 payload_dtype="u8", term_range=(0.0, 0.25))
     f4 = instance_amortized(loaded, "e1", "two-pass", samples=2, blend=0.6, history="slots")
