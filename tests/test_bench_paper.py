@@ -241,3 +241,20 @@ def test_effective_session_fits_the_size_and_keeps_the_aspect(tmp_path):
     assert paper._effective_session(scene, paper.BenchSettings(), tmp_path / "out") == str(session)
     assert paper._effective_session(scene, paper.BenchSettings(resolution=(640, 480), frames=99),
                                     tmp_path / "out") == str(session)
+
+
+def test_the_scene_table_shows_several_nodes_and_an_estimator():
+    """A selection of several nodes (each at its own Δn) and an amortized one both get their row
+    (the bench stopped at writing bench.md when Marble's e2 cached two nodes)."""
+    from rrcache.bench.paper_report import scene_markdown
+    from rrcache.selection import AmortizedLoop
+
+    pair = Selection((CachedNode("n1", 50, text="noise(p)"), CachedNode("n2", 4, text="albedo * light")),
+                     0.01, 2.0, 3.0).replace(label="e2", max_error=0.0036, measured_speedup=3.1, measured_error=0.003,
+                                             measured_psnr=44.0)
+    amort = Selection((AmortizedLoop("e1", 4, 0.6, "slots", text="for (int i = 0; i < 16; i++)", payload="u8"),),
+                      0.001, 2.0, 2.0).replace(label="e1", max_error=0.0005, measured_speedup=2.2)
+    scene = paper.SceneResult("temple", "s.glsl", "s.json", (64, 48), 10, 100, 5, selections=[amort, pair])
+    text = scene_markdown(scene)
+    assert "| e2 | 0.0036 | `noise(p) + albedo * light` | 50 + 4 | 3.10× |" in text
+    assert "| e1 | 0.0005 | `e1 m=4 λ=0.6 slots/frame u8: for (int i = 0; i < 16; i++)` | – | 2.20× |" in text

@@ -39,6 +39,17 @@ def _methods(rows, title: str) -> list[str]:
     return lines + [""]
 
 
+def _what(r) -> tuple[str, str]:
+    """The node and Δn cells of a selection: an estimator at m samples and λ has no Δn; several
+    nodes show each expression and period, in part order."""
+    if r.kind == "amortize":
+        return _code(f"{r.describe()}: {r.parts[0].text}"), "–"
+    if r.multi:
+        return (_code(" + ".join(p.text or p.node for p in r.parts), limit=110),
+                " + ".join(str(p) for p in r.periods))
+    return _code(r.text if r.parts else None), _f(r.period, "d")
+
+
 def scene_markdown(s) -> str:
     w, h = s.resolution
     lines = [f"### {s.name}", "",
@@ -49,10 +60,9 @@ def scene_markdown(s) -> str:
         lines += ["| level | max error | node | Δn | speed-up | mean error | PSNR dB | hit rate | predicted speed-up |",
                   "|---|---|---|---|---|---|---|---|---|"]
         for r in s.selections:
-            amortized = r.kind == "amortize"  # an estimator at m samples and λ: no node, no Δn
-            what = _code(f"{r.describe()}: {r.parts[0].text}" if amortized else (r.text if r.parts else None))
+            what, period = _what(r)
             lines.append(f"| {r.label} | {_f(r.max_error, '.4f')} | {what} | "
-                         f"{_f(None if amortized else r.period, 'd')} | {_f(r.measured_speedup, '.2f')}× | {_f(r.measured_error, '.4f')} | "
+                         f"{period} | {_f(r.measured_speedup, '.2f')}× | {_f(r.measured_error, '.4f')} | "
                          f"{_f(r.measured_psnr, '.1f')} | "
                          f"{_f(r.hit_rate, '.3f')} | {_f(r.predicted_speedup, '.2f')}× |")
         lines.append("")
