@@ -70,11 +70,25 @@ def test_a_range_that_does_not_hold_keeps_floats_with_a_note(gl_ctx, tmp_path):
     f4 = instance_amortized(loaded, "e1", "two-pass", samples=2, blend=0.6, history="slots")
     with pytest.warns(RuntimeWarning, match="outside the range"):
         got, dtype, note = _payloads(narrow, session, prepared, range(3))
-    assert dtype == "f4" and "pragma rrcache estimator range" in note
+    assert dtype == "f4" and "the term range given for the loop at" in note
     want, _, _ = _payloads(f4, session, prepared, range(3))
     for (p, mask, img), (q, _, img_f4) in zip(got, want):
         # stored encoded in floats: decoded, the same values as the float variant's
         assert np.allclose(p[mask], q[mask], atol=1e-5) and np.allclose(img[mask], img_f4[mask], atol=1e-5)
+
+
+def test_a_declared_range_that_does_not_hold_names_the_pragma(gl_ctx, tmp_path):
+    source = BLUR.replace("    for (int i = 0; i < 8; i++) {", "    #pragma rrcache estimator range(0.0, 0.25)\n"
+                                                                "    for (int i = 0; i < 8; i++) {")
+    assert source != BLUR
+    loaded, prepared, session = _setup(tmp_path, source, frames=5)
+    variant = instance_amortized(loaded, "e1", "two-pass", samples=2, blend=0.6, history="slots", payload_dtype="u8")
+    assert variant.amortized["range_source"] == "pragma"
+    with pytest.warns(RuntimeWarning, match="outside the range"):
+        _, dtype, note = _payloads(variant, session, prepared, range(2))
+    line = source.splitlines().index("    for (int i = 0; i < 8; i++) {") + 1
+    assert dtype == "f4" and "#pragma rrcache estimator range(LO, HI)' before the loop at" in note
+    assert f"shader.frag:{line}:" in note
 
 
 def test_u8_needs_the_slots_history_and_a_range(tmp_path):

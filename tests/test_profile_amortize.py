@@ -624,3 +624,33 @@ def test_slots_of_a_bounded_term_are_trained_and_offered_in_8_bits(tmp_path):
         for index in range(3):
             cached.render_frame(index)
         assert cached.payload_dtype == "u8" and cached.payload_note is None
+
+
+def test_slots_whose_declared_range_does_not_hold_are_trained_in_floats(tmp_path):
+    """The first frames in floats show the values leave the declared range: the slots are
+    trained (and offered) in 32 bits, said so, and no 8-bit row is stored."""
+    from rrcache.profiles import amortize as data
+    from rrcache.profiles.store import read_store
+
+    narrow = BOUNDED.replace("    for (int i = 0; i < 8; i++) {",
+                             "    #pragma rrcache estimator range(0.0, 0.1)\n    for (int i = 0; i < 8; i++) {")
+    assert narrow != BOUNDED
+    shader, session = _scene(tmp_path)
+    shader.write_text(narrow)
+    events = []
+    with pytest.warns(RuntimeWarning, match="outside the range"):
+        prof = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, validate=False),
+                       progress=events.append)
+    est = prof.estimators[0]
+    assert est.slots.trained and est.slots.payload == "f4"
+    assert all(o.parts[0].payload == "f4" for o in prof.amortized_options())
+    assert any("slots in 32 bits" in e.detail for e in events if e.stage == "amortize")
+    store = read_store(tmp_path / "out" / "profile.sqlite")
+    assert data.rows(store, "e1", "error", "slots") and not data.rows(store, "e1", "error", "slots/u8")
+    # a document that says another payload is refused at its key
+    doc = json.loads((tmp_path / "out" / "profile.json").read_text())
+    doc["estimators"][0]["slots"]["payload"] = "u4"
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / "profile.json").write_text(json.dumps(doc))
+    with pytest.raises(Exception, match=r"estimators\[0\]\.slots\.payload"):
+        load_profile(tmp_path / "bad")

@@ -353,14 +353,32 @@ def test_two_different_declared_ranges_for_one_loop_are_refused():
                   "    for (int i = 0; i < 4; i++) s += 0.5;")
     with pytest.raises(GLSLError, match="two different ranges"):
         find_estimators(parse_shader(src, "two.frag"))
+    # the error is at the pragma that differs from the first, not at a repeat of it
+    src = _shader("    #pragma rrcache estimator range(0, 1)\n    #pragma rrcache estimator range(0, 1)\n"
+                  "    #pragma rrcache estimator range(0, 2)\n    for (int i = 0; i < 4; i++) s += 0.5;")
+    with pytest.raises(GLSLError) as err:
+        find_estimators(parse_shader(src, "three.frag"))
+    first = src.splitlines().index("    #pragma rrcache estimator range(0, 1)") + 1
+    assert err.value.loc.line == first + 2 and f"at line {first})" in err.value.message
+
+
+def test_a_bound_beyond_32_bit_floats_is_unknown():
+    r, _, why = _range("    for (int i = 0; i < 4; i++) s += exp(float(i) * 30.0);")
+    assert r is None and "32-bit" in why
 
 
 def test_parse_pragma():
     assert parse_pragma("rrcache estimator") == (True, None)
     assert parse_pragma("rrcache estimator range(-1, +1.5f)") == (True, (-1.0, 1.5))
     assert parse_pragma("rrcache estimator range(- 2.5e-1, .5)") == (True, (-0.25, 0.5))
-    assert parse_pragma("rrcache other") is None and parse_pragma("optimize(off)") is None
-    assert parse_pragma("rrcache estimators") is None
+    assert parse_pragma("optimize(off)") is None and parse_pragma("STDGL invariant(all)") is None
+    # our own pragmas misspelt are said, not ignored (the loop would silently lose its range)
+    for bad in ("rrcache other", "rrcache estimators", "rrcache estimatorrange(0, 1)"):
+        with pytest.raises(GLSLError, match="unknown '#pragma rrcache"):
+            parse_pragma(bad)
+    # a 32-bit float holds the ends
+    with pytest.raises(GLSLError, match="32-bit"):
+        parse_pragma("rrcache estimator range(0, 1e39)")
 
 
 def test_integer_wrap_around_is_unknown():

@@ -50,7 +50,6 @@ id does not change when another loop stops qualifying).
 """
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass, field
 from typing import Any, Optional
@@ -59,7 +58,7 @@ from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
 from rrcache.glsl.ast import walk
-from rrcache.analysis.term_range import signed_term, term_range
+from rrcache.analysis.term_range import FLT_MAX, signed_term, term_range
 from rrcache.errors import GLSLError, printable
 from rrcache.glsl.rewrite import paused_gc
 from rrcache.glsl.writes import written_roots
@@ -425,6 +424,9 @@ def parse_pragma(text: str, loc=None) -> Optional[tuple[bool, Optional[tuple[flo
     """
     m = _PRAGMA_HEAD.match(str(text).strip())
     if m is None:
+        words = str(text).split()
+        if words and words[0] == "rrcache":  # ours, misspelt: said, not silently ignored
+            raise GLSLError(f"unknown '#pragma {printable(' '.join(words))}'", loc, hint=_RANGE_HINT)
         return None
     rest = m.group(1).strip()
     if not rest:
@@ -435,9 +437,9 @@ def parse_pragma(text: str, loc=None) -> Optional[tuple[bool, Optional[tuple[flo
         raise GLSLError(f"malformed '#pragma {shown}': expected range(LO, HI) after "
                         "'rrcache estimator'", loc, hint=_RANGE_HINT)
     lo, hi = (float(g.replace(" ", "").replace("\t", "").rstrip("fF")) for g in r.groups())
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise GLSLError(f"malformed '#pragma {shown}': the range's ends must be finite", loc,
-                        hint=_RANGE_HINT)
+    if not (abs(lo) <= FLT_MAX and abs(hi) <= FLT_MAX):
+        raise GLSLError(f"malformed '#pragma {shown}': the range's ends must be finite 32-bit floats "
+                        f"(|x| <= {FLT_MAX:g})", loc, hint=_RANGE_HINT)
     if not lo < hi:
         raise GLSLError(f"malformed '#pragma {shown}': LO ({lo:g}) must be below HI ({hi:g})", loc,
                         hint=_RANGE_HINT)
@@ -494,7 +496,8 @@ def _marking(loop, pragmas: list[_Pragma], loops: list) -> list[_Pragma]:
 def _declared_range(marks: list[_Pragma]) -> Optional[tuple[float, float]]:
     ranges = [p for p in marks if p.range is not None]
     if len({p.range for p in ranges}) > 1:
-        first, second = ranges[0], ranges[1]
+        first = ranges[0]
+        second = next(p for p in ranges if p.range != first.range)
         raise GLSLError(f"two different ranges declared for one loop (the other at line {first.line})",
                         second.loc,
                         hint="keep one '#pragma rrcache estimator range(LO, HI)' before the loop")

@@ -41,8 +41,11 @@ The ranges of expressions are computed conservatively (every rule is a true boun
   built-ins) is unknown, as is an integer expression whose range leaves its type's values (it
   would wrap around).
 
-The values are taken to be finite numbers (a NaN or an infinity has no range) computed exactly;
-float32 rounding may go a few ulps beyond a bound.
+The bounds are those of exact arithmetic on finite values (a NaN or an infinity has no range,
+and an interval beyond ±FLT_MAX, an infinity in 32 bits, is unknown). The GPU's float32 rounding
+can leave them by an amount that grows with the intermediate values, not with the bound
+(``(5.0 * fract(x) + 1.0e8) - 1.0e8`` is bounded by [0, 5] here and can be 8 in 32 bits): the
+8-bit payload's check of its first frames (:mod:`rrcache.harness.cached`) is the guard.
 
 >>> from rrcache.glsl.frontend import parse_shader
 >>> from rrcache.analysis.estimators import find_estimators
@@ -65,12 +68,14 @@ from rrcache.glsl.printer import print_expr
 from rrcache.glsl.types import swizzle_indices
 from rrcache.glsl.writes import lvalue_root, out_qualifiers
 
-__all__ = ["term_range", "signed_term", "Interval"]
+__all__ = ["term_range", "signed_term", "Interval", "FLT_MAX"]
 
 Interval = tuple[float, float]
 #: loop header parser: ``(index, start, step, samples)`` of a constant-bound ``for``, else None
 HeaderFn = Callable[[A.For], Optional[tuple[str, int, int, int]]]
 
+#: the largest finite 32-bit float
+FLT_MAX = 3.4028234663852886e38
 _INT32 = (-2.0 ** 31, 2.0 ** 31 - 1)
 _UINT32 = (0.0, 2.0 ** 32 - 1)
 _BOOL: Interval = (0.0, 1.0)
@@ -322,11 +327,12 @@ class _Body:
     # ---- expressions
 
     def finite(self, r: Interval, e: A.Node, base: Optional[str] = None) -> Interval:
-        """``r`` as floats; unknown when it is not finite, or when it leaves the values of the
-        integer type ``base`` (``int``/``uint`` arithmetic wraps)."""
+        """``r`` as floats; unknown when it is not finite as a 32-bit float (the GPU's: beyond
+        ±FLT_MAX it is an infinity there), or when it leaves the values of the integer type
+        ``base`` (``int``/``uint`` arithmetic wraps)."""
         lo, hi = r
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            raise _Unknown(f"`{self.text(e)}` has no finite bound")
+        if not (abs(lo) <= FLT_MAX and abs(hi) <= FLT_MAX):
+            raise _Unknown(f"`{self.text(e)}` has no finite bound (as a 32-bit float)")
         limits = _INT32 if base == "int" else _UINT32 if base == "uint" else None
         if limits is not None and (lo < limits[0] or hi > limits[1]):
             raise _Unknown(f"`{self.text(e)}` may wrap around (a 32-bit {base} holds "

@@ -282,10 +282,11 @@ def _amortized_rows(prof, work, session, frames, settings: BenchSettings, progre
             runs = [compare(variant, session, work.prepared, frames, period=period, **prof.settings.cache_options())
                     for _ in range(settings.repeats)]
             first = runs[0]
+            used = first.payload_dtype  # f4 where an 8-bit payload's range did not hold
             setting = f"{est.id}: {m} of {est.samples} per frame, λ={PAPER_BLEND:g}" + (
                 "" if history == "blend" else ", slots") + (
-                "" if (filter_, payload) == ("bilinear", "f4") else f", {payload}, {filter_}")
-            rows.append(MethodRow(_amortized_label(history, filter_, payload), setting,
+                "" if (filter_, used) == ("bilinear", "f4") else f", {used}, {filter_}")
+            rows.append(MethodRow(_amortized_label(history, filter_, used), setting,
                                   float(statistics.median(r.speedup for r in runs)),
                                   first.mean_error, _cap(first.psnr), float(statistics.median(r.ms_per_frame for r in runs)),
                                   float(statistics.median(r.original_ms_per_frame for r in runs)),
@@ -449,7 +450,8 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
     if medium.kind != "cache":  # an amortized estimator or several nodes: the algorithms and limit are one node's
-        what = "amortized sampling" if medium.kind == "amortize" else "several cached nodes"
+        what = ("amortized sampling" if medium.kind == "amortize" else "several cached nodes" if medium.multi
+                else f"a selection of kind {medium.kind}")
         result.notes.append(f"the {medium.label} selection is {medium.describe()} ({what}): the "
                             "algorithms and the all-hit limit are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:

@@ -535,7 +535,9 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         node_loc=loop_loc, shader_path=loc.path, vertex_path=getattr(vertex, "path", None),
         amortized={"estimator": est.id, "samples": samples, "of": est.samples, "lambda": float(blend),
                    "phase": phase, "cycle": cycle, "history": history, "accumulators": [display_name(a) for a in est.accumulators],
-                   **({"payload_encoding": encoding.to_json()} if encoding is not None else {})})
+                   **({"payload_encoding": encoding.to_json(),
+                       "range_source": "argument" if term_range is not None else est.range_source}
+                      if encoding is not None else {})})
 
 
 def _encoding(est: Estimator, samples: int, components: int, history: str, payload_dtype: str,

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from rrcache.analysis.term_range import FLT_MAX
 from rrcache.glsl import ast as A
 
 __all__ = ["PayloadEncoding", "slots_encoding", "encoding_glsl", "encoded", "decoded", "ENCODED_DTYPE"]
@@ -56,9 +57,12 @@ def slots_encoding(term_range: tuple[float, float], samples: int, slots: int, co
     used = slots * components
     if used > 4:
         raise ValueError(f"{slots} slots of {components} component(s) do not fit in 4 channels")
+    if max(abs(samples * lo), abs(samples * hi), samples * (hi - lo)) > FLT_MAX:
+        raise ValueError(f"{samples} terms in [{lo:g}, {hi:g}] sum beyond the 32-bit float range")
     offset = [samples * lo] * used + [0.0] * (4 - used)
-    # a constant term (lo = hi): every slot is samples * lo, stored as 0
-    span = [samples * (hi - lo) if hi > lo else 1.0] * used + [1.0] * (4 - used)
+    # a constant term (lo = hi, or a span too small for its inverse to be a 32-bit float):
+    # every slot is samples * lo, stored as 0
+    span = [samples * (hi - lo) if samples * (hi - lo) > 1e-30 else 1.0] * used + [1.0] * (4 - used)
     return PayloadEncoding(tuple(offset), tuple(span))
 
 

@@ -64,6 +64,18 @@ class CachedFrame:
     cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
 
 
+def _range_remedy(variant) -> str:
+    """What to do when an 8-bit payload's range did not hold, by where the range came from."""
+    source = (getattr(variant, "amortized", None) or {}).get("range_source")
+    loop = f"the loop at {variant.node_loc}" if getattr(variant, "node_loc", None) else "the loop"
+    if source == "pragma":
+        return f"check the range declared with '#pragma rrcache estimator range(LO, HI)' before {loop}"
+    if source == "analysis":
+        return (f"the analysis's bound on the terms of {loop} did not hold in 32-bit floats; declare a wider "
+                "range with '#pragma rrcache estimator range(LO, HI)' before it")
+    return f"the term range given for {loop} does not hold"
+
+
 class CachedRenderer:
     """Renders frames of ``session`` with ``variant`` (a compiled :class:`Variant`).
 
@@ -154,7 +166,7 @@ class CachedRenderer:
             low, high = offset[:c], offset[:c] + span[:c]
             problem = (f"{outside.size} payload value(s) are outside the range the 8-bit payload encodes "
                        f"([{float(low.min()):g}, {float(high.max()):g}]: the terms' range times the samples per slot)")
-            remedy = "check the range in '#pragma rrcache estimator range(LO, HI)'"
+            remedy = _range_remedy(self.variant)
         else:
             values = np.concatenate([np.abs(p[covered]).ravel() for p in payloads])
             finite = values[np.isfinite(values)]

@@ -139,8 +139,9 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             rec.note = f"not trained: its accumulators need {est.components} payload components (at most 4)"
             continue
         spent = store.spent_s() + data.spent_s(store)
-        started = any(data.rows(store, est.id, kind, store_history(history, _payload(est, history)))
-                      for kind in ("error", "timing") for history in HISTORIES)
+        started = any(data.rows(store, est.id, kind, store_history(history, payload))
+                      for kind in ("error", "timing") for history in HISTORIES
+                      for payload in {"f4", _payload(est, history)})
         if k > 0 and not started and spent >= settings.budget_s:
             rec.note = "not reached within the training budget (--budget)"
             continue
@@ -151,19 +152,44 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
                               for _, ms_list in plans)
         for history, ms_list in plans:
             target = rec.runs(history)
-            key = store_history(history, _payload(est, history))
+            payload = _payload(est, history)
             try:
-                if refs is None and _missing_errors(store, est.id, ms_list, key):
+                if refs is None and _missing_errors(store, est.id, ms_list, store_history(history, payload)):
                     state["total"] += len(frames)  # the reference frames, rendered once for all
                     refs = _references(work, session, settings, plan, frames, step)
-                _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock, history)
-                _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
-                             history)
+                try:
+                    _runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, timing, full, step,
+                          clock, history, payload)
+                except _PayloadFallback as err:  # the 8-bit range did not hold on the GPU: train in floats
+                    payload = target.payload = "f4"
+                    if progress is not None:
+                        progress(ProgressEvent("amortize", state["done"], state["total"], f"{err}; slots in 32 bits"))
+                    _runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, timing, full, step,
+                          clock, history, payload)
             except RRCacheError as err:  # a variant that does not compile or run: say why, go on
                 target.note = f"not trained: {err}"
                 continue
-            _fit(target, store, result.original_ms, est.id, int(est.samples), history, key)
+            _fit(target, store, result.original_ms, est.id, int(est.samples), history, store_history(history, payload))
     return records
+
+
+class _PayloadFallback(RRCacheError):
+    """The renderer kept a float payload where an 8-bit one was asked for (its values left the
+    terms' range): no row was stored, the history trains again in floats."""
+
+
+def _runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, timing, full, step, clock,
+          history: str, payload: str) -> None:
+    """One history's error and timing runs in ``payload`` (those not stored yet)."""
+    _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock, history, payload)
+    _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock, history,
+                 payload)
+
+
+def _settled(cached, payload: str) -> None:
+    """Raise :class:`_PayloadFallback` when ``cached`` (after its first frame) did not keep ``payload``."""
+    if cached.payload_dtype != payload:
+        raise _PayloadFallback(cached.payload_note or f"the cache kept {cached.payload_dtype}, not {payload}")
 
 
 def _payload(est, history: str) -> str:
@@ -184,28 +210,27 @@ def _references(work, session, settings, plan, frames, step) -> list:
     return refs
 
 
-def _variant(work, est, algorithm: str, m: int, history: str = "blend"):
+def _variant(work, est, algorithm: str, m: int, history: str = "blend", payload: str = "f4"):
     from rrcache.compiler.amortize import instance_amortized
 
     return instance_amortized(work.shader, est.id, algorithm, samples=m, blend=0.0, history=history,
-                              payload_dtype=_payload(est, history), vertex=work.vertex)
+                              payload_dtype=payload, vertex=work.vertex)
 
 
-def _label(est, m: int, history: str) -> str:
-    payload = _payload(est, history)
+def _label(est, m: int, history: str, payload: str = "f4") -> str:
     return f"{est.id} m={m}" + (" slots" if history == "slots" else "") + ("" if payload == "f4" else f" {payload}")
 
 
 def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock,
-                history: str = "blend") -> None:
-    key = store_history(history, _payload(est, history))
+                history: str = "blend", payload: str = "f4") -> None:
+    key = store_history(history, payload)
     have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error", key)}
     for m in ms_list:
         todo = [lam for lam in TRAIN_BLENDS if (m, round(lam, 6)) not in have]
         if not todo:
             continue
         built = clock()
-        with CachedRenderer(_variant(work, est, algorithm, m, history), session, work.prepared, settings.resolution,
+        with CachedRenderer(_variant(work, est, algorithm, m, history, payload), session, work.prepared, settings.resolution,
                             period=DEFAULT_PERIOD, window=plan.error_window, **settings.cache_options()) as cached:
             extra = clock() - built
             for lam in todo:
@@ -215,7 +240,8 @@ def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, r
                 errs, psnrs, hits, misses = [], [], 0, 0
                 for i, ref in enumerate(refs):
                     got = cached.render_frame(ref.index)
-                    step(f"{_label(est, m, history)} λ={lam:g}")
+                    _settled(cached, payload)
+                    step(f"{_label(est, m, history, payload)} λ={lam:g}")
                     if i == 0:
                         continue  # the first frame has no cache
                     errs.append(float(mean_l2(got.image, ref.image, ref.mask)[0]))
@@ -232,8 +258,8 @@ def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, r
 
 
 def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
-                 history: str = "blend") -> None:
-    key = store_history(history, _payload(est, history))
+                 history: str = "blend", payload: str = "f4") -> None:
+    key = store_history(history, payload)
     have = {r["samples"] for r in data.rows(store, est.id, "timing", key)}
     todo = [m for m in ms_list if m not in have]
     if not todo or not timing:
@@ -242,7 +268,7 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
     with Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt) as original:
         for m in todo:
             start = clock()
-            with CachedRenderer(_variant(work, est, algorithm, m, history), session, work.prepared, full,
+            with CachedRenderer(_variant(work, est, algorithm, m, history, payload), session, work.prepared, full,
                                 period=DEFAULT_PERIOD, window=plan.timing_window, color_format=fmt,
                                 **settings.cache_options()) as cached:
                 # (the renderer's first frame draws every phase program once, untimed: a phase's
@@ -250,8 +276,9 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
                 out = []
                 for index in timing:
                     got, ref = timed_beside(cached, original, index)
+                    _settled(cached, payload)
                     out.append((index, got, ref.ms))
-                    step(f"{_label(est, m, history)} timing", 3)
+                    step(f"{_label(est, m, history, payload)} timing", 3)
             wall = (clock() - start) / max(1, len(out))
             data.add_rows(store, [(est.id, key, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0,
                                    int(got.hits or 0), int(got.misses or 0), float(got.ms), float(ref_ms), wall)

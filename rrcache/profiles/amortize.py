@@ -57,6 +57,10 @@ def _r(default=None, minimum=None, maximum=None, factory=None):
     return field(default=default, metadata=meta)
 
 
+#: the payloads a slots history is trained in (``HistoryRuns.payload``)
+SLOTS_PAYLOADS = ("f4", "u8")
+
+
 @dataclass
 class HistoryRuns:
     """One more history's runs and models of an estimator (``EstimatorProfile.slots``): the

@@ -35,7 +35,7 @@ from typing import Any, Optional
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json
 from rrcache.model.sets import SetOption
-from rrcache.profiles.amortize import EstimatorProfile
+from rrcache.profiles.amortize import SLOTS_PAYLOADS, EstimatorProfile
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.selection import AmortizedLoop, Selection, parts_from_json
 
@@ -659,6 +659,8 @@ def _check_models(prof: "Profile", file: str) -> None:
     for i, est in enumerate(prof.estimators):
         _check_estimator(est, f"estimators[{i}]", "blend", file)
         if est.slots is not None:
+            if est.slots.payload not in SLOTS_PAYLOADS:
+                raise _fail(file, f"estimators[{i}].slots.payload", f"must be one of {', '.join(SLOTS_PAYLOADS)}")
             _check_estimator(est.slots, f"estimators[{i}].slots", "slots", file)
 
 
