@@ -614,6 +614,13 @@ def test_slots_of_a_bounded_term_are_trained_and_offered_in_8_bits(tmp_path):
     blend = [o for o in prof.amortized_options() if o.parts[0].history == "blend"]
     assert slots and all(o.parts[0].payload == "u8" for o in slots) and all(o.parts[0].payload == "f4" for o in blend)
     assert "u8" in slots[0].describe()
+    # the record's JSON and rrcache select's words name the payload
+    from rrcache.cli.select import _history
+    from rrcache.selection import parts_from_json, parts_to_json
+
+    assert parts_to_json(slots[0].parts)[0]["payload"] == "u8"
+    assert parts_from_json(parts_to_json(slots[0].parts), "parts") == slots[0].parts
+    assert "in 8 bits" in _history(slots[0].parts[0])
     # the document keeps it, and the chosen option compiles and runs in 8 bits
     assert load_profile(tmp_path / "out") == prof
     loaded = load_session(session)

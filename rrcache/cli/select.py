@@ -12,8 +12,8 @@ PSNR against the original of at least that many dB (the PSNR model of :mod:`rrca
 "predicted_psnr", "predicted_psnr_uncertainty", "exact", "visible_artifacts"}`` (node null: the
 original shader is the best choice; PSNR null with ``exact`` true: the original's image; an
 amortized estimator adds ``"kind": "amortize", "estimator", "samples", "of", "blend", "history"``
-(``blend``: the paper's running estimate; ``slots``: the N/m subset sums kept apart) and
-``"phase"`` with node null);
+(``blend``: the paper's running estimate; ``slots``: the N/m subset sums kept apart),
+``"phase"``, ``"filter"`` and ``"payload"`` (``u8``: the slots in 8 bits) with node null);
 ``--out`` writes the chosen variant's shader files.
 """
 from __future__ import annotations
@@ -50,7 +50,7 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
             part = choice.parts[0]
             data = {"node": None, "period": None, "kind": "amortize", "estimator": part.estimator,
                     "samples": part.samples, "of": prof.estimator(part.estimator).samples, "blend": part.blend,
-                    "history": part.history, "phase": part.phase,
+                    "history": part.history, "phase": part.phase, "filter": part.filter, "payload": part.payload,
                     "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
                     "predicted_speedup": float(choice.predicted_speedup),
                     "predicted_speedup_range": list(choice.predicted_speedup_range),
@@ -104,5 +104,6 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
 def _history(part) -> str:
     """How the amortized choice keeps its history, in words."""
     if part.history == "slots":
-        return "slots history (the N/m subset sums kept apart, each blended with its own)"
+        return ("slots history (the N/m subset sums kept apart, each blended with its own"
+                + (", in 8 bits by the terms' range)" if part.payload == "u8" else ")"))
     return "blend history (one running estimate)"
