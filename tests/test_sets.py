@@ -259,3 +259,39 @@ def test_the_tradeoff_plot_shows_sets(tiny, tmp_path):
         prof.sets = []
     png = next(p for p in paths if str(p).endswith(".png"))
     assert open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_bench_keeps_a_set_only_where_it_beats_the_single_choice(tiny):
+    """The bench profiles without validation and measures the selections itself; it applies the
+    profiler's keep-faster rule to its own measurements (Marble's two-node e4 measured 2.78x
+    beside a 3.47x single node in a full bench). The rule is checked here with given speed-ups
+    standing for the bench's measurements (tests/test_bench_paper.py runs the real ones)."""
+    from rrcache.bench.paper import sets_beat_singles
+    from rrcache.profiler.sets import single_choices
+
+    prof, work, _session, _folder = tiny
+    albedo = _by_text(work, "mix(vec3(0.9")
+    wave = next(n for n in prof.trained_nodes if n.text.startswith("0.0625 * wave"))
+    option = SetOption([albedo, wave.id], [8, 4], trained=True, trained_error=0.001, trained_ms=0.5,
+                       trained_psnr=45.0)
+    back = Profile.from_json(prof.to_json())
+    back.sets = [option]
+    single = single_choices(back)["e3"]  # (on this tiny scene, the original shader)
+    assert not single.multi
+    pair = option.selection(float(back.original_ms), label="e3", max_error=single.max_error)
+    assert pair.multi
+
+    def measured(speedup):
+        def measure(sel):
+            return sel.with_measurement(0.001, 45.0, 1.0, speedup, speedup, 0.9, 10, (speedup,) * 3)
+        return measure
+
+    seen = []
+    slow_pair = measured(1.5)(pair)
+    out = sets_beat_singles(back, [slow_pair], lambda s: seen.append(s.label) or measured(2.0)(s))
+    assert seen == ["e3~single"] and out[0].key == single.key and out[0].label == "e3"
+    assert "measured 1.50×, below the single-node choice's 2.00×" in out[0].fallback
+    fast_pair = measured(2.5)(pair)
+    assert sets_beat_singles(back, [fast_pair], measured(2.0)) == [fast_pair]
+    # no set: nothing measured again
+    assert sets_beat_singles(back, [measured(2.0)(single)], lambda s: 1 / 0)[0].key == single.key

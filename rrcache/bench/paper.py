@@ -212,24 +212,50 @@ def _measure_selections(prof, work, session, frames, settings: BenchSettings, pr
     from rrcache.pipeline import variant_for_selection
 
     options = prof.settings.cache_options()
-    rows = []
-    for sel in prof.selections:
+
+    def measure(sel: Selection) -> Selection:
         _say(progress, f"selection {sel.label}", None, None)
         if not sel.parts:
-            rows.append(sel.replace(measured_error=0.0, measured_psnr=PSNR_CAP, measured_speedup=1.0,
-                                    measured_ms=None, measured_original_ms=None, hit_rate=None, frames=0,
-                                    speedups=()))
-            continue
+            return sel.replace(measured_error=0.0, measured_psnr=PSNR_CAP, measured_speedup=1.0,
+                               measured_ms=None, measured_original_ms=None, hit_rate=None, frames=0, speedups=())
         variant, period = variant_for_selection(work, sel)
         runs = [compare(variant, session, work.prepared, frames, period=period, **options)
                 for _ in range(settings.repeats)]
         first = runs[0]
         speedups = [r.speedup for r in runs]
-        rows.append(sel.with_measurement(
+        return sel.with_measurement(
             first.mean_error, _cap(first.psnr), float(statistics.median(r.ms_per_frame for r in runs)),
             float(statistics.median(r.original_ms_per_frame for r in runs)), float(statistics.median(speedups)),
-            first.hit_rate, len(first.frames), speedups))
-    return rows
+            first.hit_rate, len(first.frames), speedups)
+
+    return sets_beat_singles(prof, [measure(sel) for sel in prof.selections], measure)
+
+
+def sets_beat_singles(prof, rows: list, measure: Callable[[Selection], Selection]) -> list:
+    """The profiler's rule for sets of nodes (:func:`rrcache.profiler.sets.keep_faster`), with
+    the bench's own measurements (the bench profiles without validation, where that rule runs):
+    a level whose selection is a set is measured again with the single-node choice it displaced
+    (``measure``), and the set stands only where it measured at least as fast; otherwise the
+    single choice stands, its ``fallback`` saying what the set measured."""
+    from rrcache.profiler.sets import single_choices
+
+    if not any(r.multi for r in rows):
+        return rows
+    singles = single_choices(prof)
+    out = []
+    for row in rows:
+        single = singles.get(row.label)
+        if not row.multi or single is None:
+            out.append(row)
+            continue
+        alt = measure(single.replace(label=f"{row.label}~single")).replace(label=row.label)
+        mine, theirs = float(row.measured_speedup or 0.0), float(alt.measured_speedup or 1.0)
+        if mine < theirs:
+            out.append(alt.replace(fallback=f"{row.describe()} measured {mine:.2f}×, below the single-node "
+                                            f"choice's {theirs:.2f}×: {alt.describe()} stands"))
+        else:
+            out.append(row)
+    return out
 
 
 #: the paper's amortized setting (Nehab et al. 2007 §7.3: 4 of 16 PCF samples per frame, λ = 3/5)
@@ -434,6 +460,7 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         return result
 
     result.selections = _measure_selections(prof, work, session, frames, settings, progress)
+    result.notes += [f"{s.label}: {s.fallback}" for s in result.selections if s.fallback]
     try:
         result.amortized = _amortized_rows(prof, work, session, frames, settings, progress)
     except RRCacheError as err:

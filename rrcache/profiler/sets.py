@@ -279,6 +279,17 @@ def _node_hits(cached, frame) -> Optional[np.ndarray]:
     return np.full(len(cached.runtime.period), frame.hits / frame.covered_pixels)
 
 
+def single_choices(prof) -> dict:
+    """Label → the selection each level makes with the profile's sets left out (the single-node
+    choice a set displaced)."""
+    saved = prof.sets
+    prof.sets = []
+    try:
+        return {s.label: s for s in prof.threshold_selections()}
+    finally:
+        prof.sets = saved
+
+
 def keep_faster(prof, work, session, settings, store, measured: list, progress=None, window=None) -> list:
     """After validation: each level whose selection is a set is measured again with the choice
     it displaced (the single-node choice at the level, validated the same way, as
@@ -292,13 +303,7 @@ def keep_faster(prof, work, session, settings, store, measured: list, progress=N
         return measured
     from rrcache.profiler.validate import validate
 
-    saved = prof.sets
-    prof.sets = []
-    try:
-        singles = prof.threshold_selections()
-    finally:
-        prof.sets = saved
-    by_label = {s.label: s for s in singles}
+    by_label = single_choices(prof)
     out = []
     for sel in measured:
         single = by_label.get(sel.label)
