@@ -266,8 +266,7 @@ def test_the_bench_keeps_a_set_only_where_it_beats_the_single_choice(tiny):
     profiler's keep-faster rule to its own measurements (Marble's two-node e4 measured 2.78x
     beside a 3.47x single node in a full bench). The rule is checked here with given speed-ups
     standing for the bench's measurements (tests/test_bench_paper.py runs the real ones)."""
-    from rrcache.bench.paper import sets_beat_singles
-    from rrcache.profiler.sets import single_choices
+    from rrcache.profiler.sets import prefer_singles, single_choices
 
     prof, work, _session, _folder = tiny
     albedo = _by_text(work, "mix(vec3(0.9")
@@ -288,10 +287,10 @@ def test_the_bench_keeps_a_set_only_where_it_beats_the_single_choice(tiny):
 
     seen = []
     slow_pair = measured(1.5)(pair)
-    out = sets_beat_singles(back, [slow_pair], lambda s: seen.append(s.label) or measured(2.0)(s))
+    out = prefer_singles(back, [slow_pair], lambda s: seen.append(s.label) or measured(2.0)(s))
     assert seen == ["e3~single"] and out[0].key == single.key and out[0].label == "e3"
-    assert "measured 1.50×, below the single-node choice's 2.00×" in out[0].fallback
+    assert "measured 1.50× (1.50–1.50), below the single-node choice's 2.00×" in out[0].fallback
     fast_pair = measured(2.5)(pair)
-    assert sets_beat_singles(back, [fast_pair], measured(2.0)) == [fast_pair]
+    assert prefer_singles(back, [fast_pair], measured(2.0)) == [fast_pair]
     # no set: nothing measured again
-    assert sets_beat_singles(back, [measured(2.0)(single)], lambda s: 1 / 0)[0].key == single.key
+    assert prefer_singles(back, [measured(2.0)(single)], lambda s: 1 / 0)[0].key == single.key

@@ -228,34 +228,11 @@ def _measure_selections(prof, work, session, frames, settings: BenchSettings, pr
             float(statistics.median(r.original_ms_per_frame for r in runs)), float(statistics.median(speedups)),
             first.hit_rate, len(first.frames), speedups)
 
-    return sets_beat_singles(prof, [measure(sel) for sel in prof.selections], measure)
+    # the profiler's rule for sets of nodes (rrcache.profiler.sets.keep_faster), on the bench's
+    # own measurements: the bench profiles without validation, where that rule runs
+    from rrcache.profiler.sets import prefer_singles
 
-
-def sets_beat_singles(prof, rows: list, measure: Callable[[Selection], Selection]) -> list:
-    """The profiler's rule for sets of nodes (:func:`rrcache.profiler.sets.keep_faster`), with
-    the bench's own measurements (the bench profiles without validation, where that rule runs):
-    a level whose selection is a set is measured again with the single-node choice it displaced
-    (``measure``), and the set stands only where it measured at least as fast; otherwise the
-    single choice stands, its ``fallback`` saying what the set measured."""
-    from rrcache.profiler.sets import single_choices
-
-    if not any(r.multi for r in rows):
-        return rows
-    singles = single_choices(prof)
-    out = []
-    for row in rows:
-        single = singles.get(row.label)
-        if not row.multi or single is None:
-            out.append(row)
-            continue
-        alt = measure(single.replace(label=f"{row.label}~single")).replace(label=row.label)
-        mine, theirs = float(row.measured_speedup or 0.0), float(alt.measured_speedup or 1.0)
-        if mine < theirs:
-            out.append(alt.replace(fallback=f"{row.describe()} measured {mine:.2f}×, below the single-node "
-                                            f"choice's {theirs:.2f}×: {alt.describe()} stands"))
-        else:
-            out.append(row)
-    return out
+    return prefer_singles(prof, [measure(sel) for sel in prof.selections], measure)
 
 
 #: the paper's amortized setting (Nehab et al. 2007 §7.3: 4 of 16 PCF samples per frame, λ = 3/5)

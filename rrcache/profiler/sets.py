@@ -299,29 +299,44 @@ def keep_faster(prof, work, session, settings, store, measured: list, progress=N
     (one sample per timing frame) against the single node's model, and on Marble one that
     training put at 2.23× measured 1.70–1.94× beside a single choice measured at 2.34–2.92×:
     a set must beat what it displaced where it counts, in the validation."""
-    if not any(s.multi for s in measured):
-        return measured
     from rrcache.profiler.validate import validate
 
-    by_label = single_choices(prof)
+    def measure(sel):
+        return validate(work, session, settings, store, [sel], progress, window, candidates=prof.front_candidates)[0]
+
+    def decided(row, stood) -> None:
+        if stood is not row:
+            store.add_validation(row.replace(label=f"{row.label}~set"))
+        store.add_validation(stood)
+
+    return prefer_singles(prof, measured, measure, decided)
+
+
+def prefer_singles(prof, rows: list, measure, decided=None) -> list:
+    """The rule of :func:`keep_faster` with any measurement: each measured set in ``rows`` is
+    measured again as the single-node choice it displaced (``measure(selection)``, labelled
+    ``<label>~single``) and stands only where its speed-up is at least that one's; otherwise the
+    single choice stands, its ``fallback`` saying what the set measured. ``decided(set_row,
+    standing_row)`` is called for each set measured again. The bench uses it with its own
+    measurements (it profiles without validation)."""
+    if not any(r.multi for r in rows):
+        return rows
+    singles = single_choices(prof)
     out = []
-    for sel in measured:
-        single = by_label.get(sel.label)
-        if not sel.multi or single is None or not sel.measured:
-            out.append(sel)
+    for row in rows:
+        single = singles.get(row.label)
+        if not row.multi or single is None or not row.measured:
+            out.append(row)
             continue
-        label = sel.label
-        alt = validate(work, session, settings, store, [single.replace(label=f"{label}~single")], progress, window,
-                       candidates=prof.front_candidates)[0].replace(label=label)
-        mine, theirs = float(sel.measured_speedup or 0.0), float(alt.measured_speedup or 1.0)
+        alt = measure(single.replace(label=f"{row.label}~single")).replace(label=row.label)
+        mine, theirs = float(row.measured_speedup or 0.0), float(alt.measured_speedup or 1.0)
+        stood = row
         if mine < theirs:
-            lo, hi = sel.speedup_range or (mine, mine)
-            alt = alt.replace(fallback=f"{sel.describe()} measured {mine:.2f}× ({lo:.2f}–{hi:.2f}), below the "
-                                       f"single-node choice's {theirs:.2f}×: {alt.describe()} stands")
-            store.add_validation(sel.replace(label=f"{label}~set"))
-            store.add_validation(alt)
-            out.append(alt)
-        else:
-            store.add_validation(sel)
-            out.append(sel)
+            lo, hi = row.speedup_range or (mine, mine)
+            stood = alt.replace(fallback=f"{row.describe()} measured {mine:.2f}× ({lo:.2f}–{hi:.2f}), below the "
+                                         f"single-node choice's {theirs:.2f}×: {alt.describe()} stands")
+        if decided is not None:
+            decided(row, stood)
+        out.append(stood)
     return out
+
