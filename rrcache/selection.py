@@ -133,13 +133,17 @@ class AmortizedLoop:
         filter_, payload = data.get("filter", "bilinear"), data.get("payload", "f4")
         if filter_ not in FILTERS:
             raise RRCacheError(f"must be one of {', '.join(FILTERS)}", f"{where}.filter")
-        if payload not in ("f4", "f2", "u8"):
-            raise RRCacheError("must be 'f4', 'f2' or 'u8'", f"{where}.payload")
+        if payload not in AMORTIZE_PAYLOADS:
+            raise RRCacheError(f"must be one of {', '.join(AMORTIZE_PAYLOADS)}", f"{where}.payload")
         return cls(estimator, samples, float(blend), history, phase, text, filter_, payload)
 
 
 #: the cache's reconstruction filters (their GLSL: rrcache.runtime.glsl), named by selections
 FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge")
+
+#: the payload formats of an amortized choice: 32- or 16-bit floats, or ``u8`` (the slots in 8 bits
+#: by the range of the estimator's terms, rrcache.compiler.payload_encoding)
+AMORTIZE_PAYLOADS = ("f4", "f2", "u8")
 
 #: the components one payload texel holds (RGBA)
 PAYLOAD_COMPONENTS = 4

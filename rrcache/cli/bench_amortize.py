@@ -19,6 +19,7 @@ from rich.console import Console
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
 from rrcache.runtime.glsl import FILTERS
+from rrcache.selection import AMORTIZE_PAYLOADS
 
 
 @click.command("bench-amortize")
@@ -32,7 +33,7 @@ from rrcache.runtime.glsl import FILTERS
 @click.option("--filter", "filter_", type=click.Choice(list(FILTERS)),
               default="bilinear", show_default=True, help="How the previous frame's estimate is resampled.")
 @click.option("--phase", type=click.Choice(["frame", "pixel"]), default="frame", show_default=True)
-@click.option("--payload", type=click.Choice(["f4", "f2", "u8"]), default="f4", show_default=True,
+@click.option("--payload", type=click.Choice(AMORTIZE_PAYLOADS), default="f4", show_default=True,
               help="The cache's payload format: 32- or 16-bit floats, or u8, 8 bits by the range of the "
                    "estimator's terms (slots history only; rrcache.compiler.payload_encoding).")
 @click.option("--algorithm", type=click.Choice(["three-pass", "two-pass", "one-pass"]), default="two-pass",

@@ -20,6 +20,7 @@ import click
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse_defines, vert_option
 from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
+from rrcache.selection import AMORTIZE_PAYLOADS
 
 
 @click.command("instance")
@@ -37,7 +38,7 @@ from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
               help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default="three-pass", show_default=True)
 @click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
-@click.option("--payload", type=click.Choice(["f4", "f2", "u8"]), default="f4", show_default=True,
+@click.option("--payload", type=click.Choice(AMORTIZE_PAYLOADS), default="f4", show_default=True,
               help="32- or 16-bit floats; u8 (with --estimator and --history slots): 8 bits by the range of "
                    "the estimator's terms.")
 @click.option("--session", type=click.Path(dir_okay=False), default=None,

@@ -76,9 +76,9 @@ from rrcache.compiler.outputs import cache_init, cache_writes, float_lit, set_co
 from rrcache.compiler.passes import PASS_SPECS, PassUnit, runtime_snippets
 from rrcache.compiler.prune import prune
 from rrcache.compiler.variant import PassSource, Variant
-from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.cache import ALGORITHMS
 from rrcache.runtime.glsl import AMORTIZE_GLSL, AMORTIZE_PIXEL_GLSL, FILTERS
-from rrcache.selection import slots_fit
+from rrcache.selection import AMORTIZE_PAYLOADS, slots_fit
 
 __all__ = ["instance_amortized", "LocatedLoop", "HISTORIES", "PHASES", "prepare_loop", "subset_indices"]
 
@@ -488,8 +488,8 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
     if filter not in FILTERS:
         raise ValueError(f"filter must be one of {FILTERS}, not {filter!r}")
-    if payload_dtype not in PAYLOAD_DTYPES + (ENCODED_DTYPE,):
-        raise ValueError(f"payload_dtype must be one of {PAYLOAD_DTYPES + (ENCODED_DTYPE,)}, not {payload_dtype!r}")
+    if payload_dtype not in AMORTIZE_PAYLOADS:
+        raise ValueError(f"payload_dtype must be one of {AMORTIZE_PAYLOADS}, not {payload_dtype!r}")
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise ValueError(f"samples must be a positive int, not {samples!r}")
     if phase not in PHASES:
@@ -551,9 +551,9 @@ def _encoding(est: Estimator, samples: int, components: int, history: str, paylo
         raise RRCacheError(f"estimator {est.id}: an 8-bit payload needs the slots history (the blend history "
                            "stores the accumulators' start value too, whose range is not known)", where,
                            hint="use --history slots, or a float payload (f4, f2)")
-    source = term_range if term_range is not None else getattr(est, "term_range", None)
+    source = term_range if term_range is not None else est.term_range
     if source is None:
-        why = getattr(est, "range_reason", "") or "the analysis could not bound its terms"
+        why = est.range_reason or "the analysis could not bound its terms"
         raise RRCacheError(f"estimator {est.id}: an 8-bit payload needs the range of the loop's terms: {why}",
                            where, hint="declare it with '#pragma rrcache estimator range(LO, HI)' on a line "
                                        "before the loop, or use a float payload (f4, f2)")
