@@ -263,3 +263,18 @@ def test_an_error_from_an_off_branch_carries_the_hint(capsys, tmp_path):
     code, _, err = run(capsys, "nodes", str(path))
     assert code == 2 and "n.frag:4:" in err and "MODEL_VERTEX_NORMAL" in err and "--session" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_sort_by_cost_orders_rows_costliest_first_and_names_the_unit(capsys, shader_file):
+    code, out, _ = run(capsys, "nodes", shader_file, "--sort", "cost")
+    assert code == 0
+    rows = [line.split() for line in out.splitlines()[1:] if line[:1] == "n"]
+    costs = [int(r[3]) for r in rows]
+    assert len(costs) > 2 and costs == sorted(costs, reverse=True)
+    assert "cost: the static estimate" in out and "rrcache/analysis/cost.py" in out
+    _, by_id, _ = run(capsys, "nodes", shader_file)
+    assert sorted(out.splitlines()) == sorted(by_id.splitlines())  # the same rows, reordered
+    _, js, _ = run(capsys, "nodes", shader_file, "--json", "--all", "--sort", "cost")
+    doc = json.loads(js)
+    assert [n["cost"] for n in doc["nodes"]] == sorted((n["cost"] for n in doc["nodes"]), reverse=True)
+    assert [x["cost"] for x in doc["excluded"]] == sorted((x["cost"] for x in doc["excluded"]), reverse=True)

@@ -58,16 +58,29 @@ def _chain(chain: list[str], width: int = 36) -> str:
     return text if len(text) <= width else "..." + text[-(width - 3):]
 
 
-def format_table(table, show_all: bool) -> str:
+#: the orders ``--sort`` offers: id (source order of the analysis), cost (costliest first), line
+SORT_KEYS = {
+    "id": lambda n: int(n.id[1:]),
+    "cost": lambda n: (-n.cost, int(n.id[1:])),
+    "line": lambda n: (str(getattr(n, "file", None) or ""), n.line, n.column, int(n.id[1:])),
+}
+
+#: what the cost column counts, for the table's last lines
+COST_UNIT = ("cost: the static estimate of the work one cache hit saves per pixel, in units of one scalar "
+             "add or multiply (a sin costs 8, a texture fetch 16 or more), see rrcache/analysis/cost.py")
+
+
+def format_table(table, show_all: bool, sort: str = "id") -> str:
     """The readable text table of a :class:`NodeTable` (with ``show_all``, the nodes left out
-    too, in id order, with their reason)."""
+    too, with their reason), in the order ``sort`` names (:data:`SORT_KEYS`)."""
     restricted = any(n.invalid for n in table.nodes)
     header = ["id", "type", "line:col", "cost"] + (["reason"] if show_all else []) + (
         ["algorithms"] if restricted else []) + ["inlined from", "expression"]
     entries = [(n, "final" if n.final else "") for n in table.nodes]
     if show_all:
         entries += [(x, x.reason) for x in table.excluded]
-        entries.sort(key=lambda p: int(p[0].id[1:]))
+    key = SORT_KEYS[sort]
+    entries.sort(key=lambda p: key(p[0]))
     rows = [header]
     main_path = getattr(table.shader, "path", None)
     for n, reason in entries:
@@ -93,6 +106,7 @@ def format_table(table, show_all: bool) -> str:
         lines.append(f"not {a}: {why}")
     if not show_all and any(n.final for n in table.nodes):
         lines.append("* the final colour")
+    lines.append(COST_UNIT)
     lines.append(f"{counts['listed']} cacheable nodes" + (f"; left out: {left}" if left else "")
                  + ("" if show_all or not left else " (--all lists them)"))
     return "\n".join(lines)
@@ -166,7 +180,9 @@ def format_estimators(estimators, show_all: bool) -> str:
               help="Apply the MODEL_VERTEX_* defines of this session's meshes, as `rrcache render` "
                    "and `rrcache profile` do (node ids depend on the defines).")
 @vert_option
-def command(shader, as_json, show_all, define, max_unroll, include_dirs, session, vert):
+@click.option("--sort", type=click.Choice(tuple(SORT_KEYS)), default="id", show_default=True,
+              help="Order of the rows (and of the JSON's node lists): id, cost (costliest first) or line.")
+def command(shader, as_json, show_all, define, max_unroll, include_dirs, session, vert, sort):
     """List the nodes of SHADER that a reprojection cache can hold."""
     defines = parse_defines(define)
     loaded_session = None
@@ -194,13 +210,17 @@ def command(shader, as_json, show_all, define, max_unroll, include_dirs, session
         doc = table.to_json(shader)
         if not show_all:
             doc["excluded"] = []
+        if sort != "id":
+            order = {n.id: i for i, n in enumerate(sorted([*table.nodes, *table.excluded], key=SORT_KEYS[sort]))}
+            for name in ("nodes", "excluded"):
+                doc[name] = sorted(doc[name], key=lambda d: order.get(d.get("id"), len(order)))
         doc["language"] = {"version": loaded.version, "profile": loaded.profile, "es": loaded.es,
                            "assumed": loaded.assumed is not None, "text": loaded.language}
         doc["hint"] = mesh_hint
         doc.update(estimators.to_json())
         click.echo(json.dumps(doc, indent=2))
     else:
-        click.echo(format_table(table, show_all))
+        click.echo(format_table(table, show_all, sort))
         lines = format_estimators(estimators, show_all)
         if lines:
             click.echo(lines)
