@@ -78,11 +78,17 @@ def test_chart_draws_a_point_per_prediction(browser, demo):
 
 
 def test_hover_shows_the_tooltip_and_click_the_node(browser, demo, tmp_path):
-    node = demo.trained_nodes[0]
-    index = [n.id for n in demo.trained_nodes].index(node.id)
-    period = 8  # the 8th point of the path: Δn = 8 (points are Δn = 1..50, all with error > 0 here)
-    selector = f'#chart .pt[data-node="{index}"][data-point="{period - 1}"]'
-    x, y = _center(browser, selector)
+    # the 8th point of a path is Δn = 8 (points are Δn = 1..50, all with error > 0 here); two nodes
+    # whose curves coincide draw points on top of each other, so hover the first node whose point
+    # is the topmost element at its own centre (the one a user's mouse reaches)
+    for index, node in enumerate(demo.trained_nodes):
+        period = 8
+        selector = f'#chart .pt[data-node="{index}"][data-point="{period - 1}"]'
+        x, y = _center(browser, selector)
+        if browser.evaluate(f"document.elementFromPoint({x}, {y}) === document.querySelector({json.dumps(selector)})"):
+            break
+    else:
+        pytest.fail("every node's Δn = 8 point is covered by another node's point")
     browser.mouse("move", x, y)
     tip = browser.evaluate("[getComputedStyle(document.getElementById('tooltip')).display,"
                            " document.getElementById('tooltip').textContent]")
