@@ -86,7 +86,7 @@ from rrcache.glsl.printer import memo_printer, print_expr
 from rrcache.glsl.ast import children, iter_exprs
 from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
-from rrcache.glsl.writes import out_qualifiers, written_roots
+from rrcache.glsl.defuse import out_qualifiers, written_roots
 from rrcache.analysis.cost import CACHE_LOOKUP_COST, loop_trips, op_cost
 from rrcache.analysis.loops import Constants, global_scalars
 from rrcache.analysis.pipeline import analyse

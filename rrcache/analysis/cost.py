@@ -46,6 +46,7 @@ from __future__ import annotations
 from rrcache.glsl import ast as A
 
 from rrcache.glsl.ast import walk
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.analysis.loops import counted_loop
 
 __all__ = ["ADD", "MUL", "DIV", "SQRT", "TRANSCENDENTAL", "TEXTURE", "USER_CALL",
@@ -88,13 +89,10 @@ def _dot(n: int) -> int:
     return 2 * n - 1
 
 
-def op_cost(e: A.Expr) -> int:
-    """The cost of the operation at ``e`` alone (its operands not included).
+class _OpCost(NodeVisitor):
+    """The cost of the operation at an expression alone (its operands not included)."""
 
-    >>> op_cost(A.Binary("/", A.Ident("a"), A.Ident("b")))   # untyped: one component
-    4
-    """
-    if isinstance(e, A.Binary):
+    def visit_Binary(self, e: A.Binary) -> int:
         if e.op == "*":
             lt, rt = getattr(e.left, "type", None), getattr(e.right, "type", None)
             if lt is not None and rt is not None and (lt.is_matrix or rt.is_matrix):
@@ -110,13 +108,30 @@ def op_cost(e: A.Expr) -> int:
         if e.op in ("<", ">", "<=", ">=", "==", "!="):
             return max(_components(e.left), _components(e.right))
         return 1
-    if isinstance(e, A.Unary):
+
+    def visit_Unary(self, e: A.Unary) -> int:
         return _components(e) if e.op == "-" else (0 if e.op == "+" else 1)
-    if isinstance(e, A.Ternary):
+
+    def visit_Ternary(self, e: A.Ternary) -> int:
         return _components(e)
-    if isinstance(e, A.Call):
+
+    def visit_Call(self, e: A.Call) -> int:
         return _call_cost(e)
-    return 0
+
+    def generic_visit(self, e) -> int:
+        return 0
+
+
+def op_cost(e: A.Expr) -> int:
+    """The cost of the operation at ``e`` alone (its operands not included).
+
+    >>> op_cost(A.Binary("/", A.Ident("a"), A.Ident("b")))   # untyped: one component
+    4
+    """
+    return _OP_COST.visit(e)
+
+
+_OP_COST = _OpCost()
 
 
 def _call_cost(e: A.Call) -> int:

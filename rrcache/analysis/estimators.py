@@ -63,7 +63,7 @@ from rrcache.analysis.loops import Constants, counted_loop, global_scalars
 from rrcache.analysis.term_range import FLT_MAX, signed_term, term_range
 from rrcache.errors import GLSLError, printable
 from rrcache.glsl.rewrite import paused_gc
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import written_roots
 
 __all__ = ["Estimator", "NotEstimator", "EstimatorTable", "find_estimators", "estimator_loops",
            "loop_header", "display_name", "parse_pragma", "ACCUMULATOR_TYPES", "MAX_SAMPLES",

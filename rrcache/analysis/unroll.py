@@ -51,7 +51,7 @@ from rrcache.glsl.semantic import check
 from rrcache.glsl.ast import walk
 from rrcache.glsl.rewrite import InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped
 from rrcache.glsl.visitor import NodeVisitor
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import written_roots
 from rrcache.analysis.loops import Constants, body_exits, counted_loop, global_scalars, scalar
 
 __all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL",
