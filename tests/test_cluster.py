@@ -136,3 +136,22 @@ def test_the_default_path_imports_no_dask(tmp_path):
             "assert not bad, bad\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_a_scheduler_and_workers_started_apart(tmp_path, monkeypatch):
+    from farm import local_farm
+
+    from rrcache.cluster.client import SCHEDULER_ENV, connect
+    from rrcache.cluster.executor import DaskRuns
+
+    with local_farm(tmp_path / "farm", env={"RRCACHE_HOST_LOCK": str(tmp_path / "host.lock")}) as address:
+        monkeypatch.setenv(SCHEDULER_ENV, address)
+        said = []
+        with connect(announce=said.append) as c:
+            c.client.wait_for_workers(2, timeout=60)
+            runs = DaskRuns(c)
+            name = runs.open("sleepy", cluster_runs.Sleepy())
+            done = list(runs.map(name, [(0.2, "error"), (0.2, "timing"), (0.2, "error")]))
+            runs.close()
+        assert f"scheduler {address}" in said[0]
+    assert len(done) == 3 and all(p.result["pixel"] == [64, 128, 191, 255] for _, p in done)
