@@ -241,9 +241,8 @@ class RenderCacheRenderer:
 
         # sampling: the priority image dithered under what prediction left of the budget
         block_budget = (self.budget - len(predicted) * s.block * s.block) // (s.block * s.block)
-        prio = block_priority(priority, s.block)
-        prio[predicted] = 0.0
-        reactive = dither(prio, self._order, block_budget, float(self._rng.random()))
+        reactive = dither(block_priority(priority, s.block), self._order, block_budget, float(self._rng.random()),
+                          excluded=predicted)
         chosen = np.union1d(predicted, reactive)
         self._requests = blocks_to_pixels(chosen, self.size, s.block)
         clock("sampling")

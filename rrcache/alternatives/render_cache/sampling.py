@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import Optional
 
 import numpy as np
 
@@ -77,46 +78,49 @@ def block_priority(priority: np.ndarray, block: int) -> np.ndarray:
     return padded.reshape(gh, block, gw, block).sum(axis=(1, 3)).reshape(-1)
 
 
-def scaled(priority: np.ndarray, budget: float, iterations: int = 16) -> np.ndarray:
+def scaled(priority: np.ndarray, budget: float, excluded: Optional[np.ndarray] = None,
+           iterations: int = 64) -> np.ndarray:
     """``priority`` scaled to sum to ``budget`` with no entry above 1 (the excess is spread over the
-    others). Zero everywhere (nothing asks for samples): spread evenly."""
+    others) and 0 at the ``excluded`` indices. Zero everywhere else (nothing asks for samples):
+    spread evenly; a budget that covers every entry asking for samples: those get 1 and the rest
+    is spread over the others."""
     p = np.maximum(np.asarray(priority, np.float64), 0.0)
-    n = p.size
+    allowed = np.ones(p.size, bool)
+    if excluded is not None and len(excluded):
+        allowed[excluded] = False
+        p[excluded] = 0.0
+    n = int(allowed.sum())
     if n == 0 or budget <= 0:
-        return np.zeros(n)
+        return np.zeros(p.size)
     if budget >= n:
-        return np.ones(n)
-    total = p.sum()
-    if not total > 0:
-        p = np.ones(n)
-        total = float(n)
-    p = p * (budget / total)
+        return allowed.astype(np.float64)
+    asking = p > 0
+    wanting = int(asking.sum())
+    if budget >= wanting:
+        return np.where(asking, 1.0, np.where(allowed, (budget - wanting) / max(1, n - wanting), 0.0))
+    p *= budget / p.sum()
     for _ in range(iterations):
-        full = p >= 1.0
         if not (p > 1.0).any():
             break
+        full = p >= 1.0
         p[full] = 1.0
         rest = ~full
-        remaining = budget - full.sum()
-        s = p[rest].sum()
-        if remaining <= 0 or not s > 0:
-            p[rest] = 0.0
-            break
-        p[rest] *= remaining / s
+        p[rest] *= (budget - full.sum()) / p[rest].sum()
     return np.minimum(p, 1.0)
 
 
-def dither(priority: np.ndarray, order: np.ndarray, budget: int, phase: float = 0.5) -> np.ndarray:
+def dither(priority: np.ndarray, order: np.ndarray, budget: int, phase: float = 0.5,
+           excluded: Optional[np.ndarray] = None) -> np.ndarray:
     """The blocks chosen (flat indices, in curve order) for a block ``priority`` (flat) and a
-    ``budget`` of blocks; ``phase`` in [0, 1) shifts where the running sum crosses integers."""
+    ``budget`` of blocks, never one of ``excluded``; ``phase`` in [0, 1) shifts where the running
+    sum crosses integers."""
     budget = int(budget)
     if budget <= 0:
         return np.zeros(0, np.int64)
-    p = scaled(priority, budget)[order]
+    p = scaled(priority, budget, excluded)[order]
     crossings = np.floor(np.cumsum(p) + phase)
     chosen = np.diff(crossings, prepend=np.floor(phase)) > 0
-    picked = order[chosen]
-    return picked[:budget]
+    return order[chosen][:budget]
 
 
 def predicted_requests(occupied: np.ndarray, quarter: tuple[int, int], size: tuple[int, int], block: int,

@@ -183,8 +183,8 @@ class SampleShader:
         view_projection = cam.projection(w / h) @ cam.view
         self._id_fbo.use()
         self._id_fbo.viewport = (0, 0, w, h)
+        self._id_fbo.depth_mask = False  # before the clear: keep the shaded depth
         self._id_fbo.clear(0.0, 0.0, 0.0, 0.0)
-        self._id_fbo.depth_mask = False
         ctx.disable(moderngl.CULL_FACE)
         ctx.depth_func = "<="
         for k, vao in self._id_vaos:
