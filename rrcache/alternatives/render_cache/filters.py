@@ -104,6 +104,22 @@ def depth_cull(depth: np.ndarray, has_point: np.ndarray, tolerance: float,
     return keep
 
 
+def _gather7(a: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """The 7×7 sums of planes ``a`` (``C×H×W``) at the pixels ``(rows, cols)`` only: ``C×n``."""
+    p = np.zeros(a.shape[:-2] + (a.shape[-2] + 6, a.shape[-1] + 6), a.dtype)
+    p[..., 3:-3, 3:-3] = a
+    out = np.zeros(a.shape[:-2] + (len(rows),), np.float32)
+    for dy in range(7):
+        for dx in range(7):
+            out += p[..., rows + dy, cols + dx]
+    return out
+
+
+#: below this share of the pixels needing it, the prefilter sums each pixel's 49 neighbours
+#: directly; above, it filters the band of rows that holds them
+SPARSE_PREFILTER = 0.01
+
+
 def reconstruct(colors: np.ndarray, keep: np.ndarray, ages: np.ndarray, previous: np.ndarray,
                 min_points: int = 1, smooth: bool = False,
                 clock: Optional[Callable[[str], None]] = None) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -122,24 +138,35 @@ def reconstruct(colors: np.ndarray, keep: np.ndarray, ages: np.ndarray, previous
     w3 = weighted3(stack)
     found = w3[3] > 0 if min_points <= 1 else box3(v) >= min_points
     use3 = found if smooth else found & ~keep
-    image = np.where(keep, colors, previous) if not smooth else previous.copy()
-    at = np.nonzero(use3)
-    image[(slice(None),) + at] = w3[(slice(None, 3),) + at] / w3[(3,) + at]
-    priority = np.where(keep, ages * np.float32(1.0 / 255.0), np.float32(1.0))
+    need7 = ~found & ~keep
+    # the image as a blend (measured 2-3× faster here than masked copies): the interpolated colour
+    # where the 3×3 filter is used, plus the point's colour where there is one (``colors`` is zero
+    # elsewhere), then the previous frame's colour where neither filled the pixel
+    weight = np.maximum(w3[3], np.float32(1e-30))
+    image = np.divide(w3[:3], weight, out=w3[:3])
+    image *= use3.astype(np.float32)
+    if not smooth:
+        image += colors
+    np.copyto(image, previous, where=need7 if not smooth else ~found)
+    priority = ages * np.float32(1.0 / 255.0)
+    np.copyto(priority, np.float32(1.0), where=~keep)
     if clock is not None:
         clock("interpolate")
-    need7 = ~found & ~keep
+    rows, cols = np.nonzero(need7)
     prefiltered = 0
-    if need7.any():
-        rows = np.flatnonzero(need7.any(axis=1))
+    if len(rows) and len(rows) <= SPARSE_PREFILTER * keep.size:
+        sums = _gather7(stack, rows, cols)
+        fill = sums[3] > 0
+        image[:, rows[fill], cols[fill]] = sums[:3, fill] / sums[3, fill]
+        prefiltered = int(fill.sum())
+    elif len(rows):
         sums, first = box7(stack, rows)
         band = need7[first:first + sums.shape[1]] & (sums[3] > 0)
-        at = np.nonzero(band)
-        image[(slice(None), at[0] + first, at[1])] = sums[(slice(None, 3),) + at] / sums[(3,) + at]
-        prefiltered = int(at[0].size)
+        np.divide(sums[:3], np.maximum(sums[3], np.float32(1e-30)), out=sums[:3])
+        np.copyto(image[:, first:first + sums.shape[1]], sums[:3], where=band)
+        prefiltered = int(np.count_nonzero(band))
     if clock is not None:
         clock("prefilter")
-    counts = {"point": 0 if smooth else int(keep.sum()), "interpolated": int(np.count_nonzero(use3)),
-              "prefiltered": prefiltered, "empty": int(need7.sum()) - prefiltered}
+    counts = {"point": 0 if smooth else int(np.count_nonzero(keep)), "interpolated": int(np.count_nonzero(use3)),
+              "prefiltered": prefiltered, "empty": len(rows) - prefiltered}
     return image, priority, counts
-
