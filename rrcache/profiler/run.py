@@ -248,8 +248,6 @@ def _verdict(ceiling) -> dict:
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    from rrcache.pipeline import variant_for_selection
-
     out.mkdir(parents=True, exist_ok=True)
     kept = []
     for sel in prof.selections:
@@ -258,13 +256,7 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
             for old in folder.iterdir():
                 if old.is_file():
                     old.unlink()
-        if not sel.parts:
-            prof.write_variant(sel, folder)
-        else:
-            variant, period = variant_for_selection(work, sel)
-            from rrcache.profiler.adaptive import runtime_kwargs
-
-            variant.write(folder, period=period, runtime=dict(prof.settings.cache_options(), **runtime_kwargs(sel)))
+        prof.write_variant(sel, folder, work=work)
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out

@@ -455,28 +455,15 @@ class Profile:
         model = self.estimator(part.estimator).model(part.history)
         return model.psnr if model is not None else None
 
-    def write_variant(self, choice: Selection, out_dir) -> list[str]:
+    def write_variant(self, choice: Selection, out_dir, work=None) -> list[str]:
         """Write the shader files of ``choice`` into ``out_dir``: the variant's passes and
-        ``manifest.json`` (recording the period it runs with); for the original shader only a
-        ``manifest.json`` saying so. The shader is loaded again and must still have the profiled
-        hash."""
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        if not choice.parts:
-            note = (self.verdict["answer"] if self.verdict is not None else
-                    choice.fallback or "no cached variant is predicted to beat the original at this error")
-            path = out / "manifest.json"
-            path.write_text(json.dumps({"rrcache_selection": 1, "node": None, "shader": self.shader,
-                                        "note": note}, indent=2) + "\n")
-            return [str(path)]
-        from rrcache.pipeline import load_for_session, variant_for_selection
-        from rrcache.session import load_session
+        ``manifest.json`` (recording the period and every cache option it runs with); for the
+        original shader only a ``manifest.json`` saying so. The shader is loaded again (unless
+        ``work`` is the profiled one) and must still have the profiled hash
+        (:func:`rrcache.profiles.choice.write`, the one writer of a profile's choices)."""
+        from rrcache.profiles.choice import write
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines, self.include_dirs,
-                                vertex=self.vertex)
-        check_same_shader(self, work)
-        variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
-        return variant.write(out, period=period, runtime=self.settings.cache_options())
+        return write(self, choice, out_dir, work)
 
     # ------------------------------------------------------------------ the document
     def to_json(self) -> dict:
@@ -742,27 +729,6 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
 
 
 # ---------------------------------------------------------------------- reading
-def check_same_shader(prof: Profile, work) -> None:
-    """Raise unless ``work`` (the shader loaded again for profile ``prof``) has the profiled hash;
-    the error says which file changed, or that none did (never blames an edit that did not
-    happen)."""
-    from rrcache.glsl.frontend import describe_change
-
-    if work.hash == prof.shader_hash:
-        return
-    what = describe_change(prof.shader_files or None, work.shader, prof.defines)
-    vertex_hash = work.vertex.hash if work.vertex is not None else None
-    if prof.vertex_hash is not None and vertex_hash != prof.vertex_hash:
-        changed = f"the vertex shader '{work.vertex.path if work.vertex is not None else prof.vertex}' changed"
-        what = changed if what.startswith("no shader file changed") else f"{what}; {changed}"
-    if what.startswith("no shader file changed") or what.startswith("the record predates"):
-        raise RRCacheError(f"the shader's hash differs from the profile's, though {what}" if what.startswith("no ")
-                           else f"the shader's hash differs from the profile's: {what}",
-                           str(prof.shader), hint="run 'rrcache profile' again to make a profile for it")
-    raise RRCacheError(f"the shader changed since it was profiled: {what}", str(prof.shader),
-                       hint="run 'rrcache profile' again, or restore the file")
-
-
 def algorithm_line(prof: Profile) -> str:
     """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
     0.377, three-pass 0.41 of the original's time)'."""

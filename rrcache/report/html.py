@@ -40,6 +40,23 @@ def _e(value) -> str:
     return html.escape(str(value), quote=True)
 
 
+#: what the data block's JSON spells as escapes: the HTML parser reads a script's text looking
+#: for ``</script`` and, after ``<!--``, for ``<script`` (the "script data escaped" states), so a
+#: shader comment ``<!--<script>`` left raw made the parser swallow the report's own script
+_SCRIPT_ESCAPES = {ord("<"): "\\u003c", ord(">"): "\\u003e", ord("&"): "\\u0026"}
+
+
+def script_json(data) -> str:
+    """``data`` as JSON safe inside ``<script type="application/json">``: no ``<``, ``>`` or ``&``
+    appears raw (nor any non-ASCII character), so no text from a shader, a file name or a session
+    can end or disable the script element; ``JSON.parse`` reads the escapes back as the same text.
+
+    >>> print(script_json({"text": "<!--<script>a && b</script>"}))
+    {"text":"\\u003c!--\\u003cscript\\u003ea \\u0026\\u0026 b\\u003c/script\\u003e"}
+    """
+    return json.dumps(data, separators=(",", ":"), allow_nan=False).translate(_SCRIPT_ESCAPES)
+
+
 def _f(value, digits: int = 4, suffix: str = "") -> str:
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
@@ -280,7 +297,7 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         data.update(chart_data(prof))
     else:
         data.update({"nodes": [], "front": [], "original_ms": float(prof.original_ms), "selections": []})
-    payload = json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    payload = script_json(data)
     name = Path(prof.shader).name
     sections = [
         "<h2>Summary</h2>", _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
