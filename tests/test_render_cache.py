@@ -330,3 +330,53 @@ def test_bad_settings_are_refused_with_the_knob_named():
                          (dict(min_points=0), "min_points"), (dict(predict_share=2), "predict_share")):
         with pytest.raises(RRCacheError, match=word):
             RenderCacheSettings(**kwargs).checked()
+
+
+# ---------------------------------------------------------------- the command
+def _cli_files(tmp_path):
+    (tmp_path / "lighting.glsl").write_text(LIGHTING)
+    (tmp_path / "shader.frag").write_text(SHADER)
+    (tmp_path / "moving.json").write_text(json.dumps(_session(True, True)))
+    return tmp_path / "shader.frag", tmp_path / "moving.json"
+
+
+def test_render_method_render_cache_json_and_images(gl_ctx, tmp_path, capsys):
+    from rrcache.cli import main
+
+    shader, session = _cli_files(tmp_path)
+    main(["render", str(shader), str(session), "--method", "render-cache", "--samples", "0.1", "--json",
+          "--color-format", "rgba32f"])
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["method"] == "render-cache" and doc["samples"] == 0.1 and doc["frames"] == 6
+    assert doc["budget_pixels"] == math.floor(0.1 * 48 * 36) and 0 < doc["shaded_pixels"] <= doc["budget_pixels"]
+    assert 0 < doc["mean_error"] < 0.1 and doc["psnr"] > 15 and doc["speedup"] > 0
+    assert set(doc["stage_ms"]) >= {"shade", "z-buffer", "sampling"} and doc["color_format"] == "rgba32f"
+    assert "hit_rate" not in doc and doc["settings"]["block"] == 2
+    out = tmp_path / "frames"
+    main(["render", str(shader), str(session), "--method", "render-cache", "--samples", "1", "--frames", "2",
+          "--out", str(out)])
+    text = capsys.readouterr().out
+    assert "speed-up" in text and "budget 1728 pixels" in text and "ms per stage" in text
+    assert (out / "frame_0001.exr").is_file() and (out / "original_0001.png").is_file()
+    import OpenImageIO as oiio
+
+    # every pixel shaded: the frame written is the original's
+    frame, original = (oiio.ImageBuf(str(out / f"{n}_0001.png")).get_pixels() for n in ("frame", "original"))
+    assert frame.shape == (36, 48, 4) and np.array_equal(frame, original)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--method", "render-cache", "--samples", "0"], "samples=0.0 is not a share"),
+    (["--method", "render-cache", "--samples", "nan"], "is not a share"),
+    (["--method", "render-cache", "--node", "n1"], "--node chooses a reprojection-cache variant"),
+    (["--samples", "0.05"], "give it with --method render-cache"),
+])
+def test_render_method_bad_input_is_one_line_exit_2(tmp_path, capsys, args, message):
+    from rrcache.cli import main
+
+    shader, session = _cli_files(tmp_path)
+    with pytest.raises(SystemExit) as info:
+        main(["render", str(shader), str(session), "--frames", "2"] + args)
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and "Traceback" not in err

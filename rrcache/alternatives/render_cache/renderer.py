@@ -56,6 +56,7 @@ from rrcache.alternatives.render_cache.sampling import (block_priority, blocks_t
                                                         hilbert_order, predicted_requests)
 from rrcache.alternatives.render_cache.settings import RenderCacheSettings
 from rrcache.alternatives.render_cache.shading import SampleShader
+from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.gl.resources import GLScope
 from rrcache.harness.renderer import FrameResult, check_frame_index, session_background
 
@@ -87,10 +88,12 @@ class RenderCacheFrame(FrameResult):
 
 class RenderCacheRenderer:
     """Renders frames of ``session`` through the render cache in front of ``prepared`` at ``size``
-    (default: the session's) with ``settings`` (see the module docstring)."""
+    (default: the session's) with ``settings`` (see the module docstring); the renderer shades into
+    ``color_format`` (:mod:`rrcache.gl.formats`), the points and the image are float32."""
 
     def __init__(self, prepared, session, size: Optional[tuple[int, int]] = None,
-                 settings: RenderCacheSettings = RenderCacheSettings(), ctx: Optional[moderngl.Context] = None):
+                 settings: RenderCacheSettings = RenderCacheSettings(), ctx: Optional[moderngl.Context] = None,
+                 color_format: str = ERROR_FORMAT):
         self.settings = settings.checked()
         self.session = session
         self.size = tuple(int(v) for v in (size or session.resolution))
@@ -105,7 +108,7 @@ class RenderCacheRenderer:
         self._rng = np.random.default_rng(settings.seed)
         self._scope = GLScope()
         try:
-            self.shader = SampleShader(prepared, session, self.size, ctx)
+            self.shader = SampleShader(prepared, session, self.size, ctx, color_format)
             self.ctx = self.shader.ctx
             self.notes = self.shader.notes
             self._display = self._scope.own(self.ctx.texture(self.size, 3, dtype="f4"))
@@ -260,8 +263,9 @@ class RenderCacheRenderer:
         """Render frame ``index`` (frames in order; a jump is a cold start). The first call renders
         once untimed (llvmpipe compiles the shader then) and starts over."""
         index = check_frame_index(self.session, index)
-        if not self._warm:
+        if not self._warm:  # compiles the user's shader, and the mask pass on a masked frame
             self._frame(index, {})
+            self.shader.shade(index, np.zeros(1, np.int64))
             self._reset()
             self._warm = True
         stages: dict = {}

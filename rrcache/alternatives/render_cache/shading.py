@@ -2,7 +2,8 @@
 
 :class:`SampleShader` draws the session's objects with the unchanged shader (the harness's
 program, drawer and generated vertex shader, as :class:`~rrcache.harness.renderer.Renderer` does)
-into an RGBA32F target and a depth texture, after a *mask pass*: a full-screen triangle at depth
+into a colour target (``color_format``, RGBA32F by default, as the harness's renderers) and a
+depth texture, after a *mask pass*: a full-screen triangle at depth
 0 that discards at the requested pixels, so everywhere else the depth test fails before the
 fragment shader runs (llvmpipe tests depth early, in blocks: docs/render_cache.md measures what a
 scattered mask costs against a full frame). The colour and depth at the requested pixels are read
@@ -32,6 +33,7 @@ import moderngl
 import numpy as np
 
 from rrcache.gl.context import get_context
+from rrcache.gl.formats import ERROR_FORMAT, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size, target_guard
 from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
@@ -99,8 +101,11 @@ class SampleShader:
     """Shades requested pixels of ``session`` frames with ``prepared`` at ``size`` (see the module
     docstring). GL objects are released by :meth:`release` (or a ``with`` block)."""
 
-    def __init__(self, prepared, session, size: tuple[int, int], ctx: Optional[moderngl.Context] = None):
+    def __init__(self, prepared, session, size: tuple[int, int], ctx: Optional[moderngl.Context] = None,
+                 color_format: str = ERROR_FORMAT):
         self.ctx = ctx or get_context()
+        self.color_format = color_format
+        self._dtype = color_dtype(color_format)
         self.session = session
         self.size = tuple(int(v) for v in size)
         self.moving = moving_objects(session)
@@ -124,7 +129,7 @@ class SampleShader:
         self.drawer.add_program(self.program)
         self.notes = self.drawer.notes
         with target_guard(size, "resolution"):
-            self._color = scope.own(ctx.texture(size, 4, dtype="f4"))
+            self._color = scope.own(ctx.texture(size, 4, dtype=self._dtype))
             self._depth = scope.own(ctx.depth_texture(size))
             self.fbo = scope.own(ctx.framebuffer([self._color], self._depth))
             self._mask = scope.own(ctx.texture(size, 1, dtype="u1"))
@@ -173,7 +178,7 @@ class SampleShader:
         objects = np.full(len(pixels), -1, np.int16)
         if self.moving:
             objects = self._object_ids(frame, pixels)
-        color = np.frombuffer(self._color.read(), np.float32).reshape(-1, 4)[pixels, :3]
+        color = texture_floats(self._color.read(), self._dtype, (h * w, 4))[pixels, :3]
         depth = np.frombuffer(self._depth.read(), np.float32)[pixels]
         return Samples(frame, pixels, color, depth, objects)
 

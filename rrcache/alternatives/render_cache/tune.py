@@ -22,6 +22,7 @@ from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.render_cache.renderer import STAGES, RenderCacheRenderer
 from rrcache.alternatives.render_cache.settings import RenderCacheSettings
 from rrcache.alternatives.search import SearchResult, match_scale
+from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.harness.cached import Comparison
 from rrcache.harness.renderer import Renderer
 
@@ -30,17 +31,18 @@ MIN_SAMPLES, MAX_SAMPLES = 0.002, 0.5
 
 
 def compare(prepared, session, frames, settings: RenderCacheSettings, size=None, original: Optional[Renderer] = None,
-            on_frame: Optional[Callable] = None):
+            on_frame: Optional[Callable] = None, color_format: str = ERROR_FORMAT):
     """The render cache at ``settings`` against the original over consecutive ``frames``: a
     :class:`~rrcache.harness.cached.Comparison` (first frame left out of the summary) with
     ``stages`` (median ms per stage over the summarised frames), ``shaded`` (median pixels shaded
     per summarised frame) and ``budget`` added. ``on_frame(row, frame, reference)`` is called per
     frame (the render cache's :class:`~rrcache.alternatives.render_cache.renderer.RenderCacheFrame`
-    and the original's frame)."""
+    and the original's frame). Both draw into ``color_format`` (``original``, when given, is
+    used as it is)."""
     own = original is None
-    ref = Renderer(prepared, session, size) if own else original
+    ref = Renderer(prepared, session, size, color_format=color_format) if own else original
     try:
-        with RenderCacheRenderer(prepared, session, size, settings) as rc:
+        with RenderCacheRenderer(prepared, session, size, settings, color_format=color_format) as rc:
             seen: list = []
 
             def keep(row, got, reference):
@@ -55,6 +57,7 @@ def compare(prepared, session, frames, settings: RenderCacheSettings, size=None,
         if own:
             ref.release()
     steady = seen[1:] or seen
+    result.color_format = color_format
     return RenderCacheComparison(
         **{f.name: getattr(result, f.name) for f in fields(Comparison) if f.name != "skip_first"}, skip_first=1,
         settings=settings, budget=budget, shaded=float(statistics.median(f.shaded for f in steady)),
