@@ -5,6 +5,8 @@ costs llvmpipe, and the tiled against the untiled z-buffer.
     python -m rrcache.bench.render_cache equal-time --choice marble=n2442:50 --out OUT
     python -m rrcache.bench.render_cache mask --scene marble --out OUT
     python -m rrcache.bench.render_cache zbuffer --scene marble --out OUT
+    python -m rrcache.bench.render_cache sweep --scene marble --config block=1 --config block=2 --out OUT
+    python -m rrcache.bench.render_cache projection --scene marble --out OUT
 
 ``equal-time``: per scene, the reprojection cache's choice (``--choice NAME=NODE:PERIOD[+NODE:PERIOD]
 [@ALGORITHM]``: a bench profile's medium selection, e.g. from ``rrcache bench``'s table) measured
@@ -22,6 +24,16 @@ density (single pixels, 2×2 or 4×4 blocks) against the whole frame, side by si
 
 ``zbuffer``: the z-buffer of a real point cache (the scene's first frames through the render cache)
 untiled and bucket-sorted into tiles first (the paper's §3.2), side by side, repeated.
+
+``projection``: where the projection and z-buffer of a real point cache run fastest here: numpy
+(what the render cache uses), GL points drawn with the depth test, and a GL 4.3 compute shader
+with image atomics (two passes: nearest depth, then the owner), side by side, repeated; every
+variant checked to find the same nearest depth per pixel.
+
+``sweep``: the render cache's own settings compared: each ``--config`` (settings given as
+``key=value,...``) at each ``--shares`` share, beside the original over the first ``--frames``
+frames: error and speed-up per point (``sweep.json``, ``sweep.png``: error against frame time),
+which is how its defaults were chosen (docs/render_cache.md).
 
 Timings are ratios measured side by side in one run; the machine's load is recorded beside them.
 """
@@ -90,16 +102,17 @@ class SceneComparison:
     wall_s: float = 0.0
 
 
-def _sizes(scene) -> str:
-    """The session the comparison runs: the scene's own, or chess as ``rrcache bench`` runs it."""
+def _sizes(scene, out) -> str:
+    """The session the comparison runs: the scene's own, or chess as ``rrcache bench`` runs it
+    (a scaled copy in ``out/sessions``)."""
     from rrcache.session import load_session
 
     if scene.name not in SCENE_SIZES:
         return scene.session
     size, frames = SCENE_SIZES[scene.name]
     session = load_session(scene.session)
-    out = Path(os.environ.get("TMPDIR", "/tmp")) / "rrcache-render-cache-bench" / f"{scene.name}.json"
-    return str(scaled_session(scene.session, out, size, min(frames, session.frames)))
+    return str(scaled_session(scene.session, Path(out) / "sessions" / f"{scene.name}.json", size,
+                              min(frames, session.frames)))
 
 
 def _load() -> str:
@@ -109,7 +122,7 @@ def _load() -> str:
         return "unknown"
 
 
-def equal_time(scene, choice: Choice, search_frames: int = 24, sheet_frame: Optional[int] = None,
+def equal_time(scene, choice: Choice, out, search_frames: int = 24, sheet_frame: Optional[int] = None,
                progress=print) -> tuple[SceneComparison, dict]:
     """The equal-time comparison of one scene (see the module docstring); returns it and the
     sheet frame's images (method → H×W×4)."""
@@ -119,7 +132,7 @@ def equal_time(scene, choice: Choice, search_frames: int = 24, sheet_frame: Opti
     from rrcache.session import load_session
 
     started = time.time()
-    session = load_session(_sizes(scene))
+    session = load_session(_sizes(scene, out))
     work = load_for_session(scene.shader, session)
     frames = list(range(session.frames))
     keep = frames[len(frames) // 2] if sheet_frame is None else min(int(sheet_frame), frames[-1])
@@ -237,14 +250,15 @@ def _write(out: Path, results: list, images: dict) -> None:
     contact_sheet(results, images, out / "contact_sheet.png")
 
 
-def mask_cost(scene, densities=(0.01, 0.03, 0.1, 0.3), blocks=(1, 2, 4), repeats: int = 5, frame: int = 10) -> dict:
+def mask_cost(scene, out, densities=(0.01, 0.03, 0.1, 0.3), blocks=(1, 2, 4), repeats: int = 5,
+              frame: int = 10) -> dict:
     """The renderer's frame through sample masks against the whole frame (see the module docstring)."""
     from rrcache.alternatives.render_cache.sampling import blocks_to_pixels, grid_size
     from rrcache.alternatives.render_cache.shading import SampleShader
     from rrcache.harness.prepare import prepare_file
     from rrcache.session import load_session
 
-    session = load_session(_sizes(scene))
+    session = load_session(_sizes(scene, out))
     prepared = prepare_file(scene.shader, session)
     rng = np.random.default_rng(0)
     rows = []
@@ -275,14 +289,14 @@ def mask_cost(scene, densities=(0.01, 0.03, 0.1, 0.3), blocks=(1, 2, 4), repeats
             "rows": rows}
 
 
-def zbuffer_cost(scene, tiles=(16, 32, 64), repeats: int = 9, frames: int = 8, samples: float = 0.03) -> dict:
+def zbuffer_cost(scene, out, tiles=(16, 32, 64), repeats: int = 9, frames: int = 8, samples: float = 0.03) -> dict:
     """The z-buffer of a real point cache, untiled and tiled (see the module docstring)."""
     from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.harness.prepare import prepare_file
     from rrcache.session import load_session
 
-    session = load_session(_sizes(scene))
+    session = load_session(_sizes(scene, out))
     prepared = prepare_file(scene.shader, session)
     with RenderCacheRenderer(prepared, session, settings=RenderCacheSettings(samples=samples)) as rc:
         for i in range(frames):
@@ -309,6 +323,213 @@ def zbuffer_cost(scene, tiles=(16, 32, 64), repeats: int = 9, frames: int = 8, s
             "zbuffer_ms": {name: statistics.median(t) for name, t in times.items()}}
 
 
+_POINTS_VERTEX = """#version 330 core
+in vec3 a_position;
+uniform mat4 rr_viewProjection;
+out float v_slot;
+void main() {
+    gl_Position = rr_viewProjection * vec4(a_position, 1.0);
+    gl_PointSize = 1.0;
+    v_slot = float(gl_VertexID);
+}
+"""
+_POINTS_FRAGMENT = """#version 330 core
+in float v_slot;
+out vec4 rr_out;
+void main() { rr_out = vec4(v_slot); }
+"""
+_COMPUTE = """#version 430
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) buffer Points { vec4 p[]; };
+layout(r32ui, binding = 0) uniform uimage2D rr_depth;
+layout(r32i, binding = 1) uniform iimage2D rr_owner;
+uniform mat4 rr_screen;
+uniform int rr_count;
+uniform int rr_pass;
+uniform ivec2 rr_size;
+void main() {
+    int i = int(gl_GlobalInvocationID.x);
+    if (i >= rr_count) return;
+    vec4 c = rr_screen * vec4(p[i].xyz, 1.0);
+    if (!(c.w > 0.0)) return;
+    ivec2 px = ivec2(floor(c.xy / c.w));
+    if (px.x < 0 || px.y < 0 || px.x >= rr_size.x || px.y >= rr_size.y) return;
+    uint d = floatBitsToUint(c.w);
+    if (rr_pass == 0) imageAtomicMin(rr_depth, px, d);
+    else if (imageLoad(rr_depth, px).x == d) imageStore(rr_owner, px, ivec4(i));
+}
+"""
+
+
+def projection_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float = 0.03) -> dict:
+    """numpy, GL points and a compute shader projecting and z-buffering one point cache (see the
+    module docstring)."""
+    import moderngl
+
+    from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
+    from rrcache.alternatives.render_cache.projection import zbuffer
+    from rrcache.gl.resources import GLScope
+    from rrcache.harness.prepare import prepare_file
+    from rrcache.session import load_session
+
+    session = load_session(_sizes(scene, out))
+    prepared = prepare_file(scene.shader, session)
+    with RenderCacheRenderer(prepared, session, settings=RenderCacheSettings(samples=samples)) as rc, GLScope() as scope:
+        for i in range(frames):
+            rc.render_frame(i)
+        ctx, cache, (w, h) = rc.ctx, rc.cache, rc.size
+        if rc.shader.moving:
+            raise RRCacheError("the projection comparison takes a scene whose objects stand still", scene.name)
+        live = np.flatnonzero(cache.live())
+        points = np.stack([cache.x[live], cache.y[live], cache.z[live]], axis=1).astype(np.float32)
+        cam = session.camera_at(frames - 1)
+        view_projection = cam.projection(w / h) @ cam.view
+        screen, moving = rc._matrices(frames - 1)
+
+        def numpy_way():
+            pix, depth, slots = rc.projector.project(cache, screen, rc.size, moving)
+            return zbuffer(pix, depth, slots, w * h)[1]
+
+        program = scope.own(ctx.program(vertex_shader=_POINTS_VERTEX, fragment_shader=_POINTS_FRAGMENT))
+        program["rr_viewProjection"].write(view_projection.T.astype("f4").tobytes())
+        vbo = scope.own(ctx.buffer(points.tobytes()))
+        vao = scope.own(ctx.vertex_array(program, [(vbo, "3f", "a_position")]))
+        target = scope.own(ctx.texture((w, h), 4, dtype="f4"))
+        depth_texture = scope.own(ctx.depth_texture((w, h)))
+        fbo = scope.own(ctx.framebuffer([target], depth_texture))
+
+        def points_way():
+            fbo.use()
+            fbo.viewport = (0, 0, w, h)
+            fbo.clear(depth=1.0)
+            ctx.enable(moderngl.DEPTH_TEST)
+            ctx.depth_func = "<"
+            vao.render(moderngl.POINTS)
+            ctx.finish()
+
+        variants = [("numpy (project + z-buffer)", numpy_way), ("GL points, depth test", points_way)]
+        if ctx.version_code >= 430:
+            compute = scope.own(ctx.compute_shader(_COMPUTE))
+            compute["rr_screen"].write(screen_matrix4(screen).T.astype("f4").tobytes())
+            compute["rr_count"].value = len(points)
+            compute["rr_size"].value = (w, h)
+            ssbo = scope.own(ctx.buffer(np.c_[points, np.ones(len(points), np.float32)].astype(np.float32).tobytes()))
+            depth_image = scope.own(ctx.texture((w, h), 1, dtype="u4"))
+            owner_image = scope.own(ctx.texture((w, h), 1, dtype="i4"))
+            far = np.full(w * h, 0xFFFFFFFF, np.uint32).tobytes()
+            nobody = np.full(w * h, -1, np.int32).tobytes()
+            groups = (len(points) + 63) // 64
+
+            def compute_way():
+                ssbo.bind_to_storage_buffer(0)
+                depth_image.bind_to_image(0, read=True, write=True)
+                owner_image.bind_to_image(1, read=False, write=True)
+                depth_image.write(far)
+                owner_image.write(nobody)
+                compute["rr_pass"].value = 0
+                compute.run(groups)
+                ctx.memory_barrier()
+                compute["rr_pass"].value = 1
+                compute.run(groups)
+                ctx.finish()
+                return np.frombuffer(depth_image.read(), np.uint32).view(np.float32)
+
+            variants.append(("GL compute, image atomics", compute_way))
+            expected = numpy_way()
+            got = compute_way()
+            found = np.where(got.view(np.uint32) == 0xFFFFFFFF, np.inf, got)
+            if not np.allclose(found, expected, rtol=1e-5, equal_nan=True):
+                raise AssertionError("the compute shader's z-buffer differs from numpy's")
+        for _, fn in variants:
+            fn()
+        times = {name: [] for name, _ in variants}
+        for _ in range(repeats):
+            for name, fn in variants:
+                start = time.perf_counter()
+                fn()
+                times[name].append((time.perf_counter() - start) * 1000.0)
+    return {"scene": scene.name, "resolution": [w, h], "points": int(len(points)), "load": _load(),
+            "ms": {name: statistics.median(t) for name, t in times.items()}}
+
+
+def screen_matrix4(screen: np.ndarray) -> np.ndarray:
+    """The 3×4 screen matrix as a 4×4 whose third row is zero (the compute shader's ``c.w`` is row 4)."""
+    m = np.zeros((4, 4))
+    m[0], m[1], m[3] = screen[0], screen[1], screen[2]
+    return m
+
+
+def _config(text: str) -> dict:
+    """``block=1,points_per_pixel=2`` → the settings' keyword arguments (typed as the defaults)."""
+    from rrcache.alternatives.render_cache import RenderCacheSettings
+
+    defaults = RenderCacheSettings()
+    out = {}
+    for item in filter(None, (t.strip() for t in text.split(","))):
+        key, _, value = item.partition("=")
+        if not hasattr(defaults, key):
+            raise RRCacheError(f"{key!r} is not a render cache setting", "--config")
+        kind = type(getattr(defaults, key))
+        out[key] = value.lower() in ("1", "true", "yes") if kind is bool else kind(value)
+    return out
+
+
+def sweep(scene, out, configs: list, shares, frames: int = 40) -> dict:
+    """Each config at each share beside the original (see the module docstring)."""
+    from rrcache.alternatives.render_cache import RenderCacheSettings
+    from rrcache.alternatives.render_cache.tune import compare
+    from rrcache.harness.prepare import prepare_file
+    from rrcache.harness.renderer import Renderer
+    from rrcache.session import load_session
+
+    session = load_session(_sizes(scene, out))
+    prepared = prepare_file(scene.shader, session)
+    indices = list(range(min(frames, session.frames)))
+    points = []
+    with Renderer(prepared, session) as original:
+        for config in configs:
+            for share in shares:
+                settings = RenderCacheSettings(**dict(config, samples=float(share))).checked()
+                r = compare(prepared, session, indices, settings, original=original)
+                points.append(dict(config=config, samples=share, speedup=r.speedup, mean_error=r.mean_error,
+                                   psnr=r.psnr, ms=r.ms_per_frame, original_ms=r.original_ms_per_frame,
+                                   stages=r.stages))
+                print(f"{scene.name} {config} {share:g}: {r.speedup:.2f}× error {r.mean_error:.4f} "
+                      f"{r.psnr:.1f} dB", flush=True)
+    return {"scene": scene.name, "resolution": list(session.resolution), "frames": len(indices), "load": _load(),
+            "points": points}
+
+
+def _sweep_plot(doc: dict, path) -> None:
+    from rrcache.report.agg import agg_pyplot
+
+    plt = agg_pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=110)
+    try:
+        configs = []
+        for p in doc["points"]:
+            if p["config"] not in configs:
+                configs.append(p["config"])
+        for config in configs:
+            pts = [p for p in doc["points"] if p["config"] == config]
+            label = ", ".join(f"{k}={v}" for k, v in config.items()) or "defaults"
+            ax.plot([1 / p["speedup"] for p in pts], [p["mean_error"] for p in pts], "o-", label=label)
+            for p in pts:
+                ax.annotate(f"{p['samples']:g}", (1 / p["speedup"], p["mean_error"]), fontsize=6,
+                            textcoords="offset points", xytext=(3, 3))
+        ax.set_xlabel("frame time / original frame time")
+        ax.set_ylabel("mean RGB L2 error")
+        w, h = doc["resolution"]
+        ax.set_title(f"render cache settings on {doc['scene']} ({w}×{h}, {doc['frames']} frames; labels: share)",
+                     fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(path)
+    finally:
+        plt.close(fig)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m rrcache.bench.render_cache", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="what", required=True)
@@ -318,10 +539,14 @@ def main(argv=None) -> int:
     eq.add_argument("--search-frames", type=int, default=24)
     eq.add_argument("--sheet-frame", type=int, default=None)
     eq.add_argument("--out", required=True)
-    for name in ("mask", "zbuffer"):
+    for name in ("mask", "zbuffer", "sweep", "projection"):
         p = sub.add_parser(name)
         p.add_argument("--scene", default="marble")
         p.add_argument("--out", required=True)
+        if name == "sweep":
+            p.add_argument("--config", action="append", default=None, metavar="KEY=VALUE,...")
+            p.add_argument("--shares", default="0.005,0.01,0.02,0.04,0.08")
+            p.add_argument("--frames", type=int, default=40)
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -332,15 +557,21 @@ def main(argv=None) -> int:
             if not sep:
                 parser.error(f"--choice {item!r}: give NAME=NODE:PERIOD")
             (scene,) = resolve_scenes(name)
-            result, shots = equal_time(scene, Choice.parse(spec), args.search_frames, args.sheet_frame)
+            result, shots = equal_time(scene, Choice.parse(spec), out, args.search_frames, args.sheet_frame)
             results.append(result)
             images[result.name] = shots
             _write(out, results, images)
             print(f"{result.name}: done in {result.wall_s:.0f} s; {out / 'equal_time.md'} updated", flush=True)
         return 0
     (scene,) = resolve_scenes(args.scene)
-    doc = mask_cost(scene) if args.what == "mask" else zbuffer_cost(scene)
     from rrcache.atomic import write_text
+
+    if args.what == "sweep":
+        doc = sweep(scene, out, [_config(c) for c in (args.config or [""])],
+                    [float(x) for x in args.shares.split(",")], args.frames)
+        _sweep_plot(doc, out / "sweep.png")
+    else:
+        doc = {"mask": mask_cost, "zbuffer": zbuffer_cost, "projection": projection_cost}[args.what](scene, out)
 
     write_text(out / f"{args.what}.json", json.dumps(doc, indent=2) + "\n")
     print(json.dumps(doc, indent=2))
