@@ -219,6 +219,8 @@ def _summary(prof, console: Console) -> None:
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
     _table(prof).print(console)
+    for line in calibration_lines(prof):
+        console.print(line, highlight=False, markup=False, soft_wrap=True)
     # what the measurements imply (the run's own warnings were printed as they came)
     for line in run_warnings(prof, stored=False):
         console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
@@ -228,6 +230,19 @@ def _summary(prof, console: Console) -> None:
                       f"'rrcache instance {prof.path} --level {level} --out DIR' writes a level's shaders again "
                       "(--target webgl2: a page that runs them in a browser)", highlight=False, markup=False,
                       soft_wrap=True)
+
+
+def calibration_lines(prof) -> list[str]:
+    """What validation said of the PSNR predictions: their error on the measured choices, raw and
+    calibrated, and the calibration the profile now predicts with (docs/levels.md)."""
+    cal = prof.calibration or {}
+    raw, calibrated = cal.get("raw") or {}, cal.get("calibrated") or {}
+    if not raw.get("n"):
+        return []
+    return [f"PSNR predicted against measured on {raw['n']} validated choices: |error| mean {raw['mean']:.1f} dB, "
+            f"worst {raw['worst']:.1f} dB (models alone); mean {calibrated['mean']:.1f}, worst "
+            f"{calibrated['worst']:.1f} dB (calibrated by the choices measured before each); the profile now "
+            f"predicts with a {cal.get('shift', 0.0):+.1f} dB calibration (± {cal.get('spread', 0.0):.1f} dB)"]
 
 
 def _estimator_lines(prof) -> list[str]:
@@ -266,6 +281,8 @@ def _estimator_lines(prof) -> list[str]:
 def _level(s) -> str:
     if s.min_psnr is not None:
         return f"≥ {s.min_psnr:g} dB"
+    if s.max_flip is not None:
+        return f"FLIP ≤ {s.max_flip:g}"
     return f"error ≤ {_fmt(s.max_error)}"
 
 
@@ -299,16 +316,48 @@ def _measured_psnr(s) -> str:
     if s.exact or not s.parts:
         return psnr_text(math.inf)
     text = psnr_text(s.measured_psnr)
-    return text + (" (visible)" if s.visible_artifacts else "")
+    if s.measured_psnr_uncertainty:
+        text += f" ± {s.measured_psnr_uncertainty:.1f}"
+    return text
+
+
+def _flip(s) -> str:
+    """The measured mean FLIP ('0' for an exact image), marked where it shows visible artifacts."""
+    if s.exact or (not s.parts and s.measured_error is not None):
+        return "0"
+    if s.measured_flip is None:
+        return "–"
+    return f"{s.measured_flip:.3f}" + (" (visible)" if s.visible_artifacts else "")
+
+
+def level_status(s) -> str:
+    """The table's word on a selection's level: ``met``, ``met, try N`` (the N-th candidate
+    measured stood), ``original`` (nothing measured met it: see the fallback line), ``MISSED``
+    (shipped below its level: only where validation was told not to fall back), or ``–``
+    (not measured).
+
+    >>> from rrcache.selection import Selection
+    >>> level_status(Selection.original(1.0, level_met=True, tries=2, fallback="..."))
+    'original (2 tried)'
+    """
+    if s.level_met is None:
+        return "–"
+    if not s.level_met:
+        return "MISSED"
+    if not s.parts:
+        return f"original ({s.tries} tried)" if s.tries else ("original" if s.fallback else "met")
+    return f"met, try {s.tries}" if s.tries > 1 else "met"
 
 
 def _table(prof) -> TextTable:
-    table = TextTable("selections", [(name, "left" if name in ("level", "node") else "right") for name in (
-        "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.", "error pred.",
-        "error meas.")])
+    table = TextTable("selections (pred. = predicted by the models, meas. = measured by validation)",
+                      [(name, "left" if name in ("level", "node") else "right") for name in (
+                          "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
+                          "FLIP meas.", "level met")])
     for s in prof.selections:
         if s.multi:  # several nodes, each at its own period
-            node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
+            node = " + ".join(f"{p.node}: {p.text or prof.node(p.node).text}" for p in s.parts)
+            period = "/".join(str(p) for p in s.periods)
         elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
             part = s.parts[0]
             slots = " slots" if part.history == "slots" else ""
@@ -320,5 +369,5 @@ def _table(prof) -> TextTable:
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),
-                      _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
+                      _predicted_psnr(s), _measured_psnr(s), _flip(s), level_status(s))
     return table

@@ -170,6 +170,12 @@ class Profile:
     #: of what validation measures (the frame, or the timing window): the covered fractions
     #: differ (:func:`rrcache.model.psnr.coverage_offset_db`)
     psnr_offset_db: float = 0.0
+    #: what validation taught the models (rrcache.model.calibration): ``points`` (each validated
+    #: choice's raw predicted and measured PSNR), the ``shift`` and ``spread`` (dB) of the
+    #: calibration they make, applied to the PSNR predictions of :meth:`psnr_fits`, and the
+    #: predictions' error on them, ``raw`` and ``calibrated`` (as each was predicted when it was
+    #: measured): ``{"n", "mean", "worst"}`` of |predicted − measured| dB. Empty before validation.
+    calibration: dict = field(default_factory=dict)
     #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
     #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
     #: was measured faster at the level
@@ -304,15 +310,24 @@ class Profile:
 
     def psnr_fits(self) -> list:
         """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
-        training runs, shifted by :attr:`psnr_offset_db` to the region validation measures), in
-        the order of :attr:`trained_nodes`."""
+        training runs, shifted by :attr:`psnr_offset_db` to the region validation measures, and
+        by the node's shift of the validation's calibration, :meth:`calibrated`), in the order of
+        :attr:`trained_nodes`."""
         import dataclasses as dc
 
         from rrcache.model.psnr import fit_psnr
 
         fits = [fit_psnr(n.errors, n.psnrs) for n in self.trained_nodes]
         off = float(self.psnr_offset_db or 0.0)
-        return [dc.replace(f, a=f.a + off) if off and f.quality != "no_data" else f for f in fits]
+        cal = self.calibrated()
+        shifts = [off + (cal.shift(n.id) if cal.points else 0.0) for n in self.trained_nodes]
+        return [dc.replace(f, a=f.a + d) if d and f.quality != "no_data" else f for f, d in zip(fits, shifts)]
+
+    def calibrated(self):
+        """The :class:`rrcache.model.calibration.Calibration` validation left in :attr:`calibration`."""
+        from rrcache.model.calibration import Calibration
+
+        return Calibration.from_json(self.calibration)
 
     def select_psnr(self, min_psnr: float) -> Selection:
         """The choice predicted fastest whose predicted PSNR against the original is ≥
@@ -369,9 +384,16 @@ class Profile:
             rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
         ms = float(choice.predicted_ms)
         span = speedup_range(float(self.original_ms), ms, rms, float(self.timing_noise or 0.0))
-        return {"predicted_psnr": value if math.isfinite(value) else None,
-                "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
-                "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
+        out = {"predicted_psnr": value if math.isfinite(value) else None,
+               "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
+               "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
+        cal = self.calibrated()
+        if cal.points and not isinstance(choice.parts[0], AmortizedLoop) and math.isfinite(value):
+            # psnr_fits carries the node's calibration shift: say how much, and widen the ± by its spread
+            out["calibration_db"] = cal.shift(choice.node)
+            if math.isfinite(spread):
+                out["predicted_psnr_uncertainty"] = math.hypot(spread, cal.spread)
+        return out
 
     def _psnr_terms(self, i: int, period, fit) -> tuple[float, float]:
         """(leave-one-out dB, frame spread) of trained node ``i`` at refresh ``period``

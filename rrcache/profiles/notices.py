@@ -48,7 +48,19 @@ def run_warnings(prof, stored: bool = True) -> list[str]:
     for s in prof.selections:
         if s.fallback:
             out.append(f"{s.label}: {s.fallback}")
+        if getattr(s, "level_met", None) is False:
+            out.append(f"{s.label}: MISSED its level: {s.level_note}")
     marked = [s.label for s in prof.selections if s.visible_artifacts]
     if marked:
-        out.append(f"{', '.join(marked)}: below {VISIBLE_DB:.0f} dB PSNR: visible artifacts (a choice, not a default)")
+        out.append(f"{', '.join(marked)}: {visible_words(prof)}: visible artifacts (a choice, not a default)")
     return out
+
+
+def visible_words(prof) -> str:
+    """How the profile judged visible artifacts: measured FLIP where validation measured it, else
+    the predicted PSNR."""
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    if any(s.visible_artifacts and getattr(s, "measured_flip", None) is not None for s in prof.selections):
+        return f"mean FLIP ≥ {VISIBLE_FLIP:g} as measured (below {VISIBLE_DB:.0f} dB PSNR where only predicted)"
+    return f"below {VISIBLE_DB:.0f} dB PSNR (predicted)"
