@@ -115,9 +115,15 @@ def write_page(variant, session, work, out_dir, period: int, runtime: Optional[d
     atomic.write_text(path, json.dumps(manifest, indent=2) + "\n")
     written.append(str(path))
     node = manifest["node"]
+    text = node["text"]
+    try:  # the expression as written (the manifest's is the inlined one)
+        text = work.node(node["id"]).text
+    except (RRCacheError, AttributeError, TypeError):
+        pass
     shader = os.path.basename(str(variant.shader_path or "shader"))
+    where = os.path.basename(str(node["location"])) if node.get("location") else "?"
     title = f"rrcache: {shader}, original and cached"
-    subtitle = (f"caching {node['id']} ({node['type']}, {node['location']}: {node['text']}) with {variant.algorithm}, "
+    subtitle = (f"caching {node['id']} ({node['type']}, {where}: {text}) with {variant.algorithm}, "
                 f"refresh every Δn = {int(period)} frames; session {os.path.basename(str(session.path))}, "
                 f"{data['scene']['frames']} frames at {data['scene']['size'][0]}×{data['scene']['size'][1]}")
     path = out / PAGE_NAME

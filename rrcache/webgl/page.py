@@ -4,7 +4,7 @@ variant side by side in a browser, each with its frame time.
 Everything is inside the file: the passes and the original in GLSL ES 3.00
 (:mod:`rrcache.webgl.glsl_es`), the session's meshes, per-frame uniforms and textures
 (:mod:`rrcache.webgl.scene`), and the runtime (``runtime.js`` beside this module: the cache of
-:mod:`rrcache.runtime.cache` in about 400 lines of JavaScript over WebGL2). Open it from disk; it
+:mod:`rrcache.runtime.cache` in about 480 lines of JavaScript over WebGL2). Open it from disk; it
 fetches nothing. URL parameters: ``?period=N`` (the refresh period to start with),
 ``?size=WxH`` (the render size; keep the session's aspect ratio), ``?autoplay=0`` (start paused;
 ``window.rrcache.step(frame)`` renders one frame).

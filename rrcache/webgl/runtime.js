@@ -423,6 +423,7 @@
     present();
     last = frame;
     api.frames += 1;
+    if (!playing) show();  // stepped by hand (a test, the console): show what it did
     return out;
   };
   api.pixels = function (which) {
