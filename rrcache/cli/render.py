@@ -6,6 +6,7 @@ shader and report per frame.
     rrcache render marble.frag session.json --node n2575 --period 16 --json
     rrcache render marble.rrprofile --level e2            # the profile's e2 choice, as it chose it
     rrcache render marble.rrprofile --node n74 --period 8 # another choice, with the profile's options
+    rrcache render marble.frag session.json --method render-cache --samples 0.05   # the render cache
 
 With ``--node`` the variant caching that node is rendered beside the original (``--node A --period
 50 --node B --period 4``: several nodes, each at its own period, paired in order), frame by frame in
@@ -24,6 +25,10 @@ profile chose, and the refresh block, pattern and depth tolerance to the profile
 adaptive threshold or amortized m and λ), over the profile's validation frames, drawn into the
 profile's timing colour format (``--color-format rgba32f`` for the exact error): what the profile
 measured when it validated the level, again.
+
+``--method render-cache --samples F`` compares the render cache of Walter et al. 2002 (forward
+reprojection, F of the pixels shaded per frame) with the original instead: a baseline at equal
+time, never a choice the profiler makes (:mod:`rrcache.cli.method`).
 
 Frames are drawn into ``--color-format`` (default: rgba8 for a comparison without ``--out``, as
 applications draw; rgba32f otherwise: exact images, and NaN/Inf can only be counted in a float
@@ -61,6 +66,7 @@ from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEP
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
+from rrcache.cli.method import check_method, method_option, render_cache, samples_option
 
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm", "block": "--block",
@@ -109,12 +115,14 @@ _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm
               help="With --node or --level: run the side-by-side comparison this many times (the speed-up is "
                    "the median repeat, with the range).")
 @adaptive_options
+@method_option
+@samples_option
 @quiet_option
 @vert_option
 @click.pass_context
 def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, level, node,
             period, algorithm, block, refresh, filter_, payload, depth_epsilon, color_format, repeats, adaptive,
-            fast_period, spread, quiet, vert):
+            fast_period, spread, method, samples, quiet, vert):
     """Render SESSION through the fragment shader SHADER (or a PROFILE's shader and session) and
     report time and coverage per frame; with --node or --level, compare a cached variant with the
     original."""
@@ -126,13 +134,18 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                                "--level e2)")
     if level is not None:
         refuse_with_level(ctx, _LEVEL_OWNS)
+    check_method(method, samples, {"--node": bool(node), "--level": level is not None})
     loaded = load_session(source.session)
-    cached = bool(node) or level is not None
+    cached = bool(node) or level is not None or method == "render-cache"
     if color_format == "auto":
         # a replay is exact (its images, its NaN/Inf counts need floats); a comparison is a
         # timing: as applications draw (as the profile timed it), unless its images are written
         timing = prof.settings.timing_format if prof is not None else DEFAULT_TIMING_FORMAT
         color_format = timing if cached and not out_dir else ERROR_FORMAT
+    if method == "render-cache":
+        render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_json, color_format, repeats,
+                     err_console, quiet)
+        return
     if level is not None:
         from rrcache.profiles import choice
 
