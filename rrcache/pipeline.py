@@ -35,6 +35,7 @@ from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
 from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
 from rrcache.selection import AdaptiveNode, AmortizedLoop, CachedNode, Selection
+from rrcache.session.changes import per_frame_uniforms
 
 
 @dataclass
@@ -81,7 +82,9 @@ def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, s
     dirs = all_include_dirs(include_dirs, session)
     shader, all_defines = load_for_meshes(shader_path, session, defines, dirs)
     user = load_user_vertex(vertex, session, all_defines, dirs)
-    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user,
+    # what changes between the session's frames: the terms of a sum that read it go last
+    moving = sorted(per_frame_uniforms(session)) if session is not None else ()
+    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll, moving=moving), all_defines, user,
                       tuple(os.path.abspath(d) for d in include_dirs or ()))
 
 

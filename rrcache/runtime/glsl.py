@@ -187,6 +187,57 @@ vec4 rr_previous() {
 }
 """
 
+#: ``plane``: the ``edge`` filter with each texel tested against this surface's own inverse depth
+#: there. Where the bilinear test passes, the hit and the payload are ``bilinear``'s (one fetch).
+#: Where it fails (the band along depth edges), the inverse depth 1/w, an affine function of the
+#: previous frame's screen position over a planar surface, is predicted at each of the four
+#: texels from its value here and its gradient (from the screen-space derivatives of the
+#: reprojected position and depth, taken first, in the caller's control flow); a texel is this
+#: surface when its stored inverse depth is within the tolerance of the prediction, and the
+#: payload is the bilinear mix of those texels alone (weights renormalised; none: a miss).
+#: ``edge`` compares every texel with the depth *here* at twice the tolerance instead, which
+#: takes the board for the piece standing on it and misses a surface seen at a grazing angle.
+_PLANE = """
+vec4 rr_edgeWeights;
+ivec2 rr_edgeBase;
+bool rr_edgeFull;
+
+bool rr_hit() {
+    ivec2 size = textureSize(rr_prevInvDepth, 0);
+    vec2 p = (rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5) * vec2(size) - 0.5;
+    float expected = 1.0 / rr_prevClip.w;
+    vec2 dpx = dFdx(p);
+    vec2 dpy = dFdy(p);
+    vec2 de = vec2(dFdx(expected), dFdy(expected));
+    if (!rr_valid || rr_prevClip.w <= 0.0) return false;
+    rr_uv = (p + 0.5) / vec2(size);
+    if (any(lessThan(rr_uv, vec2(0.0))) || any(greaterThan(rr_uv, vec2(1.0)))) return false;
+    float tolerance = rr_depthEpsilon * expected;
+    rr_edgeFull = abs(texture(rr_prevInvDepth, rr_uv).r - expected) <= tolerance;
+    if (rr_edgeFull) return true;
+    // the gradient g of the inverse depth over previous-frame texels: g . dpx = de.x, g . dpy = de.y
+    float det = dpx.x * dpy.y - dpx.y * dpy.x;
+    vec2 g = abs(det) > 1e-6 * (dot(dpx, dpx) + dot(dpy, dpy))
+        ? vec2(dpy.y * de.x - dpx.y * de.y, dpx.x * de.y - dpy.x * de.x) / det : vec2(0.0);
+    rr_edgeBase = ivec2(floor(p));
+    vec2 f = p - vec2(rr_edgeBase);
+    ivec2 hi = size - 1;
+    ivec2 t0 = clamp(rr_edgeBase, ivec2(0), hi);
+    ivec2 t1 = clamp(rr_edgeBase + ivec2(1, 0), ivec2(0), hi);
+    ivec2 t2 = clamp(rr_edgeBase + ivec2(0, 1), ivec2(0), hi);
+    ivec2 t3 = clamp(rr_edgeBase + ivec2(1, 1), ivec2(0), hi);
+    vec4 d = vec4(texelFetch(rr_prevInvDepth, t0, 0).r, texelFetch(rr_prevInvDepth, t1, 0).r,
+                  texelFetch(rr_prevInvDepth, t2, 0).r, texelFetch(rr_prevInvDepth, t3, 0).r);
+    vec4 e = expected + vec4(dot(g, vec2(t0) - p), dot(g, vec2(t1) - p), dot(g, vec2(t2) - p), dot(g, vec2(t3) - p));
+    vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    rr_edgeWeights = w * vec4(lessThanEqual(abs(d - e), vec4(tolerance)));
+    float total = dot(rr_edgeWeights, vec4(1.0));
+    if (total <= 0.0) return false;
+    rr_edgeWeights /= total;
+    return true;
+}
+""" + _EDGE[_EDGE.index("vec4 rr_previous()"):]
+
 _CURRENT = """
 vec4 rr_current() {
     return texelFetch(rr_curPayload, ivec2(gl_FragCoord.xy), 0);
@@ -222,8 +273,8 @@ def lookup_glsl(filter: str = "bilinear", depth_channel: Optional[int] = None) -
     """
     if filter not in FILTERS:
         raise ValueError(f"cache filter must be one of {FILTERS}, not {filter!r}")
-    if filter == "edge":  # its own hit test (and the common one's declarations before it)
-        return _COMMON.split("\nbool rr_hit()")[0] + "\n" + _EDGE
+    if filter in ("edge", "plane"):  # its own hit test (and the common one's declarations before it)
+        return _COMMON.split("\nbool rr_hit()")[0] + "\n" + (_EDGE if filter == "edge" else _PLANE)
     body = {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM,
             "catmull-rom-y": _CATMULL_ROM_Y}[filter]
     common = _COMMON
