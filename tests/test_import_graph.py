@@ -32,7 +32,7 @@ LAYERS = [
     {"harness"},
     {"compiler"},
     {"pipeline"},
-    {"alternatives", "profiles"},
+    {"alternatives", "profiles", "cluster"},
     {"report"},
     {"profiler"},
     {"bench"},

@@ -79,8 +79,7 @@ def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings) -> tuple
     if (vertex is None) != (prof.vertex is None):
         return "another vertex shader", True
     if vertex is not None:
-        from rrcache.harness.prepare import load_user_vertex
-        from rrcache.pipeline import all_include_dirs
+        from rrcache.pipeline import all_include_dirs, load_user_vertex
 
         user = load_user_vertex(vertex, session, prof.defines, all_include_dirs(entry.include_dirs, session))
         if user.hash != prof.vertex_hash:

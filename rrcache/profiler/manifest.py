@@ -137,7 +137,7 @@ def _paths(value, where: str, base: Path) -> list[str]:
         raise RRCacheError("not a path, a glob or a list of them", where, hint='e.g. "shaders/*.glsl"')
     out: list[str] = []
     for item in items:
-        pattern = item if os.path.isabs(item) else str(base / item)
+        pattern = os.path.normpath(item if os.path.isabs(item) else str(base / item))
         if glob.has_magic(item):
             found = sorted(p for p in glob.glob(pattern, recursive=True) if os.path.isfile(p))
             if not found:
@@ -168,7 +168,7 @@ def _entry(item, where: str, base: Path) -> list[LibraryEntry]:
     dirs = item.get("include_dirs", [])
     if not isinstance(dirs, list) or not all(isinstance(d, str) for d in dirs):
         raise RRCacheError("'include_dirs' is not a list of folders", f"{where}.include_dirs", hint='e.g. ["include"]')
-    dirs = tuple(d if os.path.isabs(d) else str(base / d) for d in dirs)
+    dirs = tuple(os.path.normpath(d if os.path.isabs(d) else str(base / d)) for d in dirs)
     vertex = item.get("vertex")
     if vertex is not None:
         vertex = _paths(vertex, f"{where}.vertex", base)

@@ -181,15 +181,14 @@ def _selection(prof, sel, shots: FrameShots) -> str:
     else:
         what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
                 if sel.node else "keep the original shader (nothing is predicted faster at this level)")
-    if sel.fallback:
-        what += f'<br><span class="warn">measured slowdown, fell back: {_e(sel.fallback)}</span>'
-    if sel.visible_artifacts:
-        what += '<br><span class="warn">below 30 dB PSNR: visible artifacts (a choice, not a default)</span>'
+    what += _level_marks(sel)
     exact = sel.exact or not sel.parts
     predicted_psnr = ("∞ (exact)" if exact else
                       "–" if sel.predicted_psnr is None else
                       f"{sel.predicted_psnr:.1f} ± {sel.predicted_psnr_uncertainty or 0:.1f} dB")
-    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else _f(sel.measured_psnr, 3, " dB"))
+    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else
+                     _f(sel.measured_psnr, 3, " dB") + (f" ± {sel.measured_psnr_uncertainty:.1f}"
+                                                       if sel.measured_psnr_uncertainty else ""))
     speedup = _x(sel.measured_speedup)
     if len(sel.speedups) > 1:
         lo, hi = sel.speedup_range
@@ -201,7 +200,7 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", predicted_speedup, speedup),
             ("PSNR", predicted_psnr, measured_psnr),
-            ("hit rate", "", _f(sel.hit_rate, 3))]
+            ("hit rate", "", _f(sel.hit_rate, 3))] + _measured_rows(sel)
     table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
              + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
              + "</table>")
@@ -225,6 +224,55 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
             f'<div class="shots">{"".join(figures)}</div></div>')
+
+
+def _level_marks(sel) -> str:
+    """What became of the selection's level (docs/levels.md): the choices refused and why, a
+    miss shipped as measured, visible artifacts."""
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    out = ""
+    if sel.fallback:
+        out += f'<br><span class="warn">fell back: {_e(sel.fallback)}</span>'
+    if sel.level_met is False:
+        out += f'<br><span class="warn miss">MISSED its level as measured: {_e(sel.level_note or "")}</span>'
+    if sel.visible_artifacts:
+        why = (f"mean FLIP {sel.measured_flip:.3f} ≥ {VISIBLE_FLIP:g}" if sel.measured_flip is not None
+               else "below 30 dB PSNR (predicted)")
+        out += f'<br><span class="warn">{_e(why)}: visible artifacts (a choice, not a default)</span>'
+    return out
+
+
+def _measured_rows(sel) -> list:
+    """The measured-only rows of a selection's table: FLIP, the temporal error, the level."""
+    exact = sel.exact or not sel.parts
+    flip = "0" if exact and sel.measured_error is not None else (
+        "–" if sel.measured_flip is None else
+        f"{sel.measured_flip:.4f}" + (f" ± {sel.measured_flip_uncertainty:.4f}" if sel.measured_flip_uncertainty else ""))
+    temporal = "∞ (exact)" if exact and sel.measured_error is not None else _f(sel.measured_temporal_psnr, 3, " dB")
+    if sel.level_met is None:
+        level = "–"
+    elif not sel.level_met:
+        level = "missed"
+    elif sel.parts:
+        level = "met" + (f" (candidate {sel.tries})" if sel.tries > 1 else "")
+    else:
+        level = "original" + (f" ({sel.tries} measured, none met it)" if sel.tries else "")
+    return [("mean FLIP", "", flip), ("PSNR of the frame-to-frame changes", "", temporal), ("level", "", level)]
+
+
+def _prediction_errors(prof) -> str:
+    """How far the PSNR predictions were from validation's measurements (``Profile.calibration``)."""
+    cal = getattr(prof, "calibration", None) or {}
+    raw, calibrated = cal.get("raw") or {}, cal.get("calibrated") or {}
+    if not raw.get("n"):
+        return ""
+    return (f'<p class="muted">PSNR predicted against measured on the {raw["n"]} choices validation measured: '
+            f"|predicted − measured| mean {raw['mean']:.1f} dB, worst {raw['worst']:.1f} dB from the models alone; "
+            f"mean {calibrated['mean']:.1f} dB, worst {calibrated['worst']:.1f} dB as predicted with the calibration "
+            f"of the choices measured before each. The profile now predicts with a "
+            f"{float(cal.get('shift') or 0.0):+.1f} dB calibration (± {float(cal.get('spread') or 0.0):.1f} dB; "
+            "docs/levels.md).</p>")
 
 
 def _plots(prof) -> str:
@@ -313,9 +361,11 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         "source line.</p></div></div>",
         f"<h2>Shader source: {_e(name)}</h2>", _source(prof, lines),
         "<h2>Selections</h2>",
-        '<p class="muted">The four error thresholds e1..e4; predicted by the models, measured by rendering '
-        "the session with the chosen variant beside the original.</p>",
+        '<p class="muted">The four levels e1..e4; predicted by the models, measured by rendering '
+        "the session with the chosen variant beside the original. A level ships only what was measured to "
+        "meet it (docs/levels.md).</p>",
         "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        _prediction_errors(prof),
         _estimators(prof),
         "<h2>Model validation</h2>", _plots(prof),
         "<h2>Settings and training</h2>", _settings(prof),
