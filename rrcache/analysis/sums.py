@@ -49,8 +49,9 @@ from typing import Iterable, Mapping, Optional
 
 from rrcache.glsl import ast as A
 from rrcache.glsl.constfold import const_value
+from rrcache.glsl.defuse import declared, definitions, written_roots
 from rrcache.glsl.rewrite import chain_of, clone
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.visitor import NodeVisitor
 
 __all__ = ["SumChain", "Term", "sum_chains", "reorder_sums", "prefix_texts", "name_partial_sums",
            "reassociation_bound", "chain_key"]
@@ -159,11 +160,7 @@ def _accumulation(stmt) -> Optional[tuple[str, str, A.Expr, A.Assign]]:
 
 
 def _declared(node) -> set[str]:
-    out = set()
-    for n in A.walk(node, decl_types=False):
-        if isinstance(n, A.Declarator):
-            out.add(n.name)
-    return out
+    return {d.name for d in declared(node)}
 
 
 _FORBIDDEN = (A.Discard, A.Return, A.Break, A.Continue)
@@ -198,24 +195,38 @@ def _leaf(stmt: A.Compound) -> Optional[dict]:
     return updates
 
 
-def _terms_of(stmt) -> Optional[list]:
-    """The terms a statement holds (flattened), or None when it is not made of terms."""
-    acc = _accumulation(stmt)
-    if acc is not None:
-        return [(stmt, {acc[0]: [acc[1:3]]})]
-    if not isinstance(stmt, A.Compound) or not stmt.stmts:
+class _Terms(NodeVisitor):
+    """The terms a statement holds, flattened (``[(statement, updates)]``), or None when it is
+    not made of terms: a bare accumulation, a self-contained block (:func:`_leaf`), or a block of
+    terms (a nested loop's copies)."""
+
+    def generic_visit(self, stmt):
         return None
-    group = []
-    for s in stmt.stmts:
-        inner = _terms_of(s)
-        if inner is None:
-            group = None
-            break
-        group.extend(inner)
-    if group is not None:
-        return group
-    updates = _leaf(stmt)
-    return [(stmt, updates)] if updates is not None else None
+
+    def visit_ExprStmt(self, stmt):
+        acc = _accumulation(stmt)
+        return None if acc is None else [(stmt, {acc[0]: [acc[1:3]]})]
+
+    def visit_Compound(self, stmt):
+        if not stmt.stmts:
+            return None
+        group = []
+        for s in stmt.stmts:
+            inner = self.visit(s)
+            if inner is None:
+                break
+            group.extend(inner)
+        else:
+            return group
+        updates = _leaf(stmt)
+        return [(stmt, updates)] if updates is not None else None
+
+
+_TERMS = _Terms()
+
+
+def _terms_of(stmt) -> Optional[list]:
+    return _TERMS.visit(stmt)
 
 
 def _label(stmt, source: int) -> str:
@@ -299,21 +310,18 @@ def _reads(expr) -> set[str]:
 
 
 def _dependencies(unit) -> dict[str, set[str]]:
-    """For every variable written in ``main``, what its values are computed from (every write
-    counted: conservative)."""
+    """For every variable written in the program, what its values are computed from (every
+    write counted: conservative; a write through a call reads all its arguments)."""
     deps: dict[str, set[str]] = {}
-    for node in A.walk(unit, decl_types=False):
-        if isinstance(node, A.Declarator) and node.init is not None:
-            deps.setdefault(node.name, set()).update(_reads(node.init))
-        elif isinstance(node, A.Assign):
-            root = node.target
-            while isinstance(root, (A.Field, A.Index)):
-                root = root.obj
-            if isinstance(root, A.Ident):
-                reads = _reads(node.value) | (_reads(node.target) - {root.name})
-                if node.op != "=":
-                    reads.add(root.name)
-                deps.setdefault(root.name, set()).update(reads)
+    for d in declared(unit):
+        if d.init is not None:
+            deps.setdefault(d.name, set()).update(_reads(d.init))
+    for d in definitions(unit):
+        node = d.node
+        reads = _reads(node) - {d.root.name}
+        if not d.whole:
+            reads.add(d.root.name)
+        deps.setdefault(d.root.name, set()).update(reads)
     return deps
 
 

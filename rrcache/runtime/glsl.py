@@ -187,16 +187,19 @@ vec4 rr_previous() {
 }
 """
 
-#: ``plane``: the ``edge`` filter with each texel tested against this surface's own inverse depth
-#: there. Where the bilinear test passes, the hit and the payload are ``bilinear``'s (one fetch).
-#: Where it fails (the band along depth edges), the inverse depth 1/w, an affine function of the
-#: previous frame's screen position over a planar surface, is predicted at each of the four
-#: texels from its value here and its gradient (from the screen-space derivatives of the
-#: reprojected position and depth, taken first, in the caller's control flow); a texel is this
-#: surface when its stored inverse depth is within the tolerance of the prediction, and the
-#: payload is the bilinear mix of those texels alone (weights renormalised; none: a miss).
-#: ``edge`` compares every texel with the depth *here* at twice the tolerance instead, which
-#: takes the board for the piece standing on it and misses a surface seen at a grazing angle.
+#: ``plane``: the hit test of ``edge`` made exact on planes. The inverse depth 1/w is an affine
+#: function of the previous frame's screen position over a planar surface, so its value at each
+#: of the four texels around the reprojected position is predicted from its value here and its
+#: gradient, found from the screen-space derivatives of the reprojected position and depth
+#: (taken first, in the caller's control flow). A texel holds this surface when its stored
+#: inverse depth is within the tolerance of the prediction. All four: the hardware bilinear
+#: payload; some (the band along a depth edge): the bilinear mix of those alone, weights
+#: renormalised; none: a miss. ``bilinear`` misses the band (its mix of foreground and
+#: background depths matches neither) and accepts a texel of another surface at a similar depth
+#: (where a piece stands on the board) into the payload; ``edge`` serves the band but compares
+#: every texel with the depth *here* at twice the tolerance, which takes the board for the piece
+#: and misses a surface seen at a grazing angle. Three more texel fetches than ``bilinear`` per
+#: reprojected pixel.
 _PLANE = """
 vec4 rr_edgeWeights;
 ivec2 rr_edgeBase;
@@ -213,8 +216,6 @@ bool rr_hit() {
     rr_uv = (p + 0.5) / vec2(size);
     if (any(lessThan(rr_uv, vec2(0.0))) || any(greaterThan(rr_uv, vec2(1.0)))) return false;
     float tolerance = rr_depthEpsilon * expected;
-    rr_edgeFull = abs(texture(rr_prevInvDepth, rr_uv).r - expected) <= tolerance;
-    if (rr_edgeFull) return true;
     // the gradient g of the inverse depth over previous-frame texels: g . dpx = de.x, g . dpy = de.y
     float det = dpx.x * dpy.y - dpx.y * dpy.x;
     vec2 g = abs(det) > 1e-6 * (dot(dpx, dpx) + dot(dpy, dpy))
@@ -230,7 +231,10 @@ bool rr_hit() {
                   texelFetch(rr_prevInvDepth, t2, 0).r, texelFetch(rr_prevInvDepth, t3, 0).r);
     vec4 e = expected + vec4(dot(g, vec2(t0) - p), dot(g, vec2(t1) - p), dot(g, vec2(t2) - p), dot(g, vec2(t3) - p));
     vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    rr_edgeWeights = w * vec4(lessThanEqual(abs(d - e), vec4(tolerance)));
+    vec4 ok = vec4(lessThanEqual(abs(d - e), vec4(tolerance)));
+    rr_edgeFull = all(greaterThan(ok, vec4(0.5)));
+    if (rr_edgeFull) return true;
+    rr_edgeWeights = w * ok;
     float total = dot(rr_edgeWeights, vec4(1.0));
     if (total <= 0.0) return false;
     rr_edgeWeights /= total;
