@@ -34,6 +34,7 @@ from rrcache.compiler import Variant, instance, instance_nodes
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
 from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.selection import AdaptiveNode, AmortizedLoop, CachedNode, Selection
 from rrcache.session.changes import per_frame_uniforms
 
@@ -93,14 +94,14 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
     return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
-def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",
+def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``;
     ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule)."""
     return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex, adaptive=adaptive)
 
 
-def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = "bilinear",
+def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
                       payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching every node of ``node_ids`` (two or more; one:
     :func:`variant_for`), each with its own payload and period

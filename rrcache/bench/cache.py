@@ -9,7 +9,7 @@ original in one run (issue 4; Sitthi-amorn 2008a Figs. 8–9).
   nothing moving and no refresh), as a fraction of the original's, and the speed-up that bounds;
   measured like the rows, alternating with the original frame by frame;
 - the node at the compared period with refresh off: what disocclusions alone cost;
-- the reconstruction filters (``bilinear``, ``edge``) at the compared period, timed, and for
+- the hit test and reconstruction filters (``bilinear``, ``edge``, ``plane``) at the compared period, timed, and for
   each the misses sorted by cause (:mod:`rrcache.runtime.misses`: refresh, the depth-edge band,
   disocclusion, off screen), as shares of the covered pixels and of the covered 4×4 blocks (on
   llvmpipe a miss costs its whole block), measured in an untimed run that reads the hit maps.
@@ -33,6 +33,7 @@ from rrcache.gl.formats import DEFAULT_TIMING_FORMAT
 from rrcache.harness.cached import compare
 from rrcache.harness.limit import all_hit_limit, probe_frames
 from rrcache.pipeline import load_for_session, variant_for
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.session import load_session
 
 
@@ -60,7 +61,7 @@ class BenchRow:
     #: the lowest and highest speed-up of the repeats (the row is the median repeat)
     speedup_range: tuple[float, float] = (float("nan"), float("nan"))
     #: the payload's reconstruction filter and hit test (rrcache.runtime.glsl.FILTERS)
-    filter: str = "bilinear"
+    filter: str = DEFAULT_FILTER
 
 
 @dataclass
@@ -170,7 +171,7 @@ class CacheBench:
         lines.append(f"Limit (every pixel hits): {self.limit_ms:.1f} ms against {self.limit_original_ms:.1f} ms, "
                      f"{100 * self.limit_fraction:.0f}% of the original: at most {self.limit_speedup:.2f}×.")
         same = [r.speedup for r in self.periods + self.algorithms + self.blocks + self.filters
-                if (r.algorithm, r.period, r.block, r.filter) == ("three-pass", self.compare_period, 4, "bilinear")]
+                if (r.algorithm, r.period, r.block, r.filter) == ("three-pass", self.compare_period, 4, DEFAULT_FILTER)]
         if self.no_refresh is not None and same:
             r, achieved = self.no_refresh, statistics.median(same)
             lines += ["", f"Where the time between the limit and Δn={self.compare_period} goes (three-pass, k=4): "
@@ -189,7 +190,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         frames: int = 60, start: int = 0, resolution: Optional[tuple[int, int]] = None,
         progress: Optional[Callable[[str, int, int], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
         limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT, vertex: Optional[str] = None,
-        include_dirs=(), filters=(), misses: bool = False, limit_filter: str = "bilinear",
+        include_dirs=(), filters=(), misses: bool = False, limit_filter: str = DEFAULT_FILTER,
         algorithms=("three-pass", "two-pass", "one-pass")) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
@@ -208,22 +209,22 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices),
                        compare_period=compare_period, color_format=color_format)
 
-    plan = [("periods", f"Δn={period}", "three-pass", period, 4, period, "bilinear") for period in periods]
+    plan = [("periods", f"Δn={period}", "three-pass", period, 4, period, DEFAULT_FILTER) for period in periods]
     # only the algorithms the node table allows for this node (one-pass cannot cache a value
     # that needs screen-space derivatives)
-    plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period, "bilinear")
+    plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period, DEFAULT_FILTER)
              for algorithm in algorithms
              if algorithm in getattr(entry, "algorithms", ("three-pass", "two-pass", "one-pass"))]
-    plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period, "bilinear")
+    plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period, DEFAULT_FILTER)
              for block in blocks]
     if periods:
-        plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH, "bilinear"))
+        plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH, DEFAULT_FILTER))
     plan += [("filters", filter_, "three-pass", compare_period, 4, compare_period, filter_) for filter_ in filters]
     variants = {}
     for _group, _label, algorithm, period, _block, _run, filter_ in plan:
         if (algorithm, filter_) not in variants:
             variants[(algorithm, filter_)] = variant_for(work, node_id, algorithm, filter=filter_)
-    miss_filters = list(filters or ("bilinear",)) if misses else []
+    miss_filters = list(filters or (DEFAULT_FILTER,)) if misses else []
     total = len(plan) * repeats + len(miss_filters) + 1
 
     def say(message):  # after each step: the reporter counts finished work
@@ -258,7 +259,7 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
     return bench
 
 
-def miss_breakdown(work, session, node_id: str, frames, period: int, filter_: str = "bilinear",
+def miss_breakdown(work, session, node_id: str, frames, period: int, filter_: str = DEFAULT_FILTER,
                    resolution=None, color_format: str = DEFAULT_TIMING_FORMAT, say=None, algorithm: str = "three-pass",
                    **options) -> MissRow:
     """One untimed run of ``node_id`` at ``period`` with ``filter_`` beside the original, its
@@ -334,7 +335,7 @@ def _layout_variant(work, node_id: str, algorithm: str, layout: str):
     if layout not in PAYLOAD_LAYOUTS:
         raise ValueError(f"payload layout must be one of {PAYLOAD_LAYOUTS}, not {layout!r}")
     dtype, _, packed = layout.partition("-")
-    return instance(work.table, node_id, algorithm, "bilinear", dtype, work.vertex, pack_depth=bool(packed))
+    return instance(work.table, node_id, algorithm, DEFAULT_FILTER, dtype, work.vertex, pack_depth=bool(packed))
 
 
 def breakdown(shader_path: str, session_path: str, node_id: str, algorithms=("three-pass", "two-pass"),

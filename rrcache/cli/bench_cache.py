@@ -7,7 +7,7 @@ results, the read-back; each stage's fixed cost at 8×8 and its cost per covered
 three-pass and two-pass algorithms in each of ``--formats`` (default rgba32f, rgba8: the colour
 target timings used before and the one applications draw into), side by side with the original.
 
-``--filters bilinear,edge`` (the default) times the hit test and reconstruction filters at the
+``--filters bilinear,edge,plane`` (the default) times the hit test and reconstruction filters at the
 compared period, and ``--misses`` (on by default) sorts each one's misses by cause (refresh, the
 depth-edge band, disocclusion, off screen), as shares of the covered pixels and of the 4×4 blocks
 that hold a miss (see :mod:`rrcache.runtime.misses`).
@@ -45,7 +45,7 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
                    "channel: one render target and one fetch fewer).")
 @click.option("--algorithms", default="three-pass,two-pass", show_default=True,
               help="Algorithms of --breakdown, side by side.")
-@click.option("--filters", default="bilinear,edge", show_default=True,
+@click.option("--filters", default="bilinear,edge,plane", show_default=True,
               help="Hit test and reconstruction filters timed at the compared period ('' for none).")
 @click.option("--misses/--no-misses", default=True, show_default=True,
               help="Sort each filter's misses by cause (refresh, depth-edge band, disocclusion, off screen) "

@@ -92,6 +92,12 @@ DEFAULT_BLOCK = 4
 DEFAULT_REFRESH = "random"
 #: the relative depth difference beyond which a reprojected sample is a miss
 DEFAULT_DEPTH_EPSILON = 1e-3
+#: the hit test and payload reconstruction of a cached node when nothing chooses one (one of
+#: rrcache.runtime.glsl.FILTERS). ``plane`` serves the band along depth edges from the texels of
+#: the pixel's own surface, which ``bilinear`` misses: on chess it cut the 4x4 blocks holding a
+#: miss from a fifth to a twentieth at the same error, but on Marble it cost more than it saved
+#: and raised the error (docs/misses.md); a profile measures which to use
+DEFAULT_FILTER = "bilinear"
 
 DrawCallback = Callable[[moderngl.Program, str], None]
 

@@ -42,6 +42,7 @@ original's, bilinear 0.88x: README, "Amortized sampling").
 """
 from __future__ import annotations
 
+import re
 from typing import Optional
 
 from rrcache.runtime.refresh import REFRESH_GLSL
@@ -194,7 +195,7 @@ vec4 rr_previous() {
 #: (taken first, in the caller's control flow). A texel holds this surface when its stored
 #: inverse depth is within the tolerance of the prediction. All four: the hardware bilinear
 #: payload; some (the band along a depth edge): the bilinear mix of those alone, weights
-#: renormalised; none: a miss. ``bilinear`` misses the band (its mix of foreground and
+#: renormalised; none, or less than 1% of the bilinear weight: a miss. ``bilinear`` misses the band (its mix of foreground and
 #: background depths matches neither) and accepts a texel of another surface at a similar depth
 #: (where a piece stands on the board) into the payload; ``edge`` serves the band but compares
 #: every texel with the depth *here* at twice the tolerance, which takes the board for the piece
@@ -236,7 +237,8 @@ bool rr_hit() {
     if (rr_edgeFull) return true;
     rr_edgeWeights = w * ok;
     float total = dot(rr_edgeWeights, vec4(1.0));
-    if (total <= 0.0) return false;
+    // a sample point this surface's texels carry (next to) no weight at is another surface's
+    if (total < 0.01) return false;
     rr_edgeWeights /= total;
     return true;
 }
@@ -274,18 +276,22 @@ def lookup_glsl(filter: str = "bilinear", depth_channel: Optional[int] = None) -
 
     >>> "rr_prevInvDepth" in lookup_glsl(depth_channel=1), "texture(rr_prevPayload, rr_uv).y" in lookup_glsl(depth_channel=1)
     (False, True)
+    >>> "rr_prevInvDepth" in lookup_glsl("plane", depth_channel=3), "texelFetch(rr_prevPayload, t0, 0).w" in lookup_glsl("plane", 3)
+    (False, True)
     """
     if filter not in FILTERS:
         raise ValueError(f"cache filter must be one of {FILTERS}, not {filter!r}")
     if filter in ("edge", "plane"):  # its own hit test (and the common one's declarations before it)
-        return _COMMON.split("\nbool rr_hit()")[0] + "\n" + (_EDGE if filter == "edge" else _PLANE)
-    body = {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM,
-            "catmull-rom-y": _CATMULL_ROM_Y}[filter]
-    common = _COMMON
-    if depth_channel is not None:
-        common = (common.replace("uniform sampler2D rr_prevInvDepth;\n", "")
-                  .replace("texture(rr_prevInvDepth, rr_uv).r", f"texture(rr_prevPayload, rr_uv).{_CHANNELS[depth_channel]}"))
-    return common + body
+        text = _COMMON.split("\nbool rr_hit()")[0] + "\n" + (_EDGE if filter == "edge" else _PLANE)
+    else:
+        text = _COMMON + {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM,
+                          "catmull-rom-y": _CATMULL_ROM_Y}[filter]
+    if depth_channel is not None:  # every read of the inverse depth reads the payload's channel
+        text = text.replace("uniform sampler2D rr_prevInvDepth;\n", "")
+        text = re.sub(r"(texture|texelFetch)\(rr_prevInvDepth, ([^;]*?)\)\.r\b",
+                      lambda m: f"{m.group(1)}(rr_prevPayload, {m.group(2)}).{_CHANNELS[depth_channel]}", text)
+        text = text.replace("textureSize(rr_prevInvDepth, 0)", "textureSize(rr_prevPayload, 0)")
+    return text
 
 
 def current_glsl() -> str:

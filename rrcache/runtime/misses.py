@@ -96,7 +96,7 @@ void main() {
                                      dot(g, vec2(t3) - p));
             vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
             vec4 ok = vec4(lessThanEqual(abs(d - e), vec4(rr_depthEpsilon * expected)));
-            code = dot(w * ok, vec4(1.0)) > 0.0 ? 2.0 : 3.0;
+            code = dot(w * ok, vec4(1.0)) >= 0.01 ? 2.0 : 3.0;
         }
     }
     rr_missCause = vec4(code, 0.0, 0.0, 1.0);
