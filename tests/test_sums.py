@@ -155,3 +155,24 @@ def test_the_static_part_cached_for_ever_stays_exact_while_the_whole_sum_goes_st
                                for r in reference]
     assert max(errors[static.id]) <= _colour_bound("moving_occluders")
     assert max(errors[whole.id][1:]) > 1e-3
+
+
+def test_a_sum_without_weights_is_ordered_by_measured_scores(gl_ctx):
+    """The short training pass (rrcache.profiler.terms): each of the eight lights cached alone
+    beside the original; the static lights then go by their measured error, the moving one last."""
+    from rrcache.profiler.terms import measure_terms
+    from rrcache.session.changes import per_frame_uniforms
+
+    session, work = _load("many_lights_loop")
+    moving = sorted(per_frame_uniforms(session))
+    scores = measure_terms(work, session, frames=range(3), resolution=(48, 48), moving=moving)
+    (key, measured), = scores.items()
+    assert len(measured) == 8 and all(v >= 0 for v in measured.values()) and len(set(measured.values())) > 4
+    reordered = load_for_session(CORPUS / "many_lights_loop.glsl", session, term_scores=scores)
+    chain, = sum_chains(reordered.table.shader.unit, moving, scores)
+    assert chain.key == ("static", "measured")
+    static = [measured[t.label] for t in chain.terms[:7]]
+    assert static == sorted(static) and chain.terms[-1].label == "(i=2)"
+    texts = [n.text for n in _partial_sums(reordered)]
+    assert any("the 4 that measured the least" in t for t in texts)
+    assert any(t.endswith("the static part (without u_light)") for t in texts)

@@ -15,9 +15,10 @@ pass reorders the blocks so that the prefixes are the subsets worth caching, in 
    fold (a factor of the term that evaluates to a number: the Trashcan's Gaussian weights), so
    that a prefix holds the terms that contribute least (the paper's Trashcan: one sample, sixteen,
    twenty-four of twenty-five);
-3. otherwise by a **measured score** when one is given (``scores``: lower first; the profiler's
-   short training pass measures each term's contribution and its change between frames), and
-   last the **source order**.
+3. otherwise by a **measured score** when one is given (``scores``: :func:`chain_key` → term
+   label → score, lower first; :func:`rrcache.profiler.terms.measure_terms` measures each
+   term's contribution and change between frames in a short pass), and last the **source
+   order**.
 
 A *run* is a maximal sequence of consecutive statements of straight-line code (``main``'s body
 and the blocks nested in it, not inside a branch or a loop) each of which is a *term*: a block
@@ -54,7 +55,7 @@ from rrcache.glsl.rewrite import chain_of, clone
 from rrcache.glsl.visitor import NodeVisitor
 
 __all__ = ["SumChain", "Term", "sum_chains", "reorder_sums", "prefix_texts", "name_partial_sums",
-           "reassociation_bound", "chain_key"]
+           "reassociation_bound", "chain_key", "term_values", "chains_to_measure"]
 
 _ADDITIVE, _MULTIPLICATIVE = ("+", "-"), ("*", "/")
 #: the unit roundoff of float32
@@ -90,8 +91,8 @@ class SumChain:
     key: tuple = ()
     reordered: bool = False
     loc: Optional[object] = None
-    #: the measured score of each term in source order (lower first), when given
-    scores: list = field(default_factory=list)
+    #: the measured score of each term by its label (lower first), when given
+    scores: dict = field(default_factory=dict)
 
     @property
     def moving_inputs(self) -> list[str]:
@@ -416,7 +417,7 @@ def _block_runs(body: A.Compound):
         stack.extend(s for k, s in enumerate(block.stmts) if isinstance(s, A.Compound) and k not in inside)
 
 
-def sum_chains(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, list]] = None,
+def sum_chains(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, dict]] = None,
                _with_places: bool = False) -> list:
     """The runs of ``unit`` (the analysed program), each a :class:`SumChain` with its terms in
     program order and the key its order would follow (see the module docstring)."""
@@ -476,9 +477,9 @@ def _key(chain: SumChain, scores) -> None:
     if weights is not None:
         for t, w in zip(chain.terms, weights):
             t.weight = w
-    measured = list(scores.get(chain_key(chain), ())) if scores else []
-    if len(measured) != len(chain.terms):
-        measured = []
+    measured = dict(scores.get(chain_key(chain), {})) if scores else {}
+    if any(t.label not in measured for t in chain.terms) or len({t.label for t in chain.terms}) < len(chain.terms):
+        measured = {}
     key = []
     if any(t.moving for t in chain.terms) and not all(t.moving for t in chain.terms):
         key.append("static")
@@ -498,14 +499,14 @@ def _order(chain: SumChain) -> list[int]:
         if "weight" in chain.key:
             r.append(t.weight)
         elif "measured" in chain.key:
-            r.append(chain.scores[t.source])
+            r.append(chain.scores[t.label])
         r.append(t.source)
         return tuple(r)
 
     return [t.source for t in sorted(chain.terms, key=rank)]
 
 
-def reorder_sums(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, list]] = None) -> list:
+def reorder_sums(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, dict]] = None) -> list:
     """Reorder, in place, every run of ``unit`` by its key (module docstring); returns the runs
     (:class:`SumChain`, terms in their new order)."""
     out = []
@@ -519,7 +520,7 @@ def reorder_sums(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str,
     return list(reversed(out))
 
 
-def prefix_texts(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, list]] = None) -> dict[int, str]:
+def prefix_texts(unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, dict]] = None) -> dict[int, str]:
     """``id(expr) -> text`` for every partial sum of a run of ``unit`` (after
     :func:`reorder_sums`, with the same ``moving`` and ``scores``) that is ordered by something
     other than its source order: ``radiance: 24 of 25 terms, all but (i=2, j=2)``; the last
@@ -576,7 +577,7 @@ def _subset_text(m: int, chain: SumChain) -> str:
     return head
 
 
-def name_partial_sums(table, unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, list]] = None) -> None:
+def name_partial_sums(table, unit, moving: Iterable[str] = (), scores: Optional[Mapping[str, dict]] = None) -> None:
     """Give the node table's entries of the partial sums of reordered runs their
     :func:`prefix_texts` (in place)."""
     texts = prefix_texts(unit, moving, scores)
@@ -586,3 +587,33 @@ def name_partial_sums(table, unit, moving: Iterable[str] = (), scores: Optional[
         text = texts.get(id(entry.node))
         if text is not None:
             entry.text = text
+
+
+def term_values(chain: SumChain, accumulator: str) -> dict:
+    """``label -> expression`` of each term's value added into ``accumulator`` (the term
+    expression, or where it reads a local of the term, that local's last value), for measuring
+    the terms; a term with several updates of it, or none, is left out."""
+    out = {}
+    for t in chain.terms:
+        ups = t.updates.get(accumulator) or []
+        if len(ups) != 1:
+            continue
+        expr = ups[0][1]
+        if isinstance(expr, A.Ident):
+            expr = _local_values(t.stmt).get(expr.name, expr)
+        out[t.label] = expr
+    return out
+
+
+def chains_to_measure(unit, moving: Iterable[str] = ()) -> list:
+    """The runs of ``unit`` whose order a measurement would decide: at least three terms, no
+    foldable weights, and static and moving terms not already telling them all apart (a group
+    of at least two terms of the same kind)."""
+    out = []
+    for chain in sum_chains(unit, moving):
+        if len(chain.terms) < 3 or "weight" in chain.key:
+            continue
+        kinds = [t.moving for t in chain.terms]
+        if max(kinds.count(True), kinds.count(False)) >= 2:
+            out.append(chain)
+    return out

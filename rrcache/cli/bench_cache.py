@@ -43,8 +43,11 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
               help="Payload layouts of --breakdown, side by side: f4, f2 (precision), and "
                    "f4-packed (32-bit with the inverse depth packed into the payload's free "
                    "channel: one render target and one fetch fewer).")
-@click.option("--algorithms", default="three-pass,two-pass", show_default=True,
-              help="Algorithms of --breakdown, side by side.")
+@click.option("--algorithms", default=None,
+              help="Algorithms side by side ('' for none): default all three at the compared period, "
+                   "three-pass,two-pass with --breakdown.")
+@click.option("--blocks", default="1,2,4", show_default=True,
+              help="Refresh block sizes compared at the compared period ('' for none).")
 @click.option("--filters", default="bilinear,edge,plane", show_default=True,
               help="Hit test and reconstruction filters timed at the compared period ('' for none).")
 @click.option("--misses/--no-misses", default=True, show_default=True,
@@ -56,7 +59,7 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 @vert_option
 @include_dirs_option
 def command(shader, session, node, periods, compare_period, frames, repeats, resolution, timing_format, breakdown,
-            formats, payloads, algorithms, filters, misses, as_json, markdown, quiet, vert, include_dirs):
+            formats, payloads, algorithms, blocks, filters, misses, as_json, markdown, quiet, vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import PAYLOAD_LAYOUTS, breakdown as run_breakdown, run
 
@@ -73,9 +76,20 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
     payload_list = [p.strip() for p in payloads.split(",") if p.strip()]
     if not payload_list or any(p not in PAYLOAD_LAYOUTS for p in payload_list):
         raise click.BadParameter(f"{payloads!r}: give some of {', '.join(PAYLOAD_LAYOUTS)}", param_hint="--payloads")
+    if algorithms is None:
+        algorithms = "three-pass,two-pass" if breakdown else "three-pass,two-pass,one-pass"
     algorithm_list = [a.strip() for a in algorithms.split(",") if a.strip()]
-    if not algorithm_list or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
+    if (breakdown and not algorithm_list) or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
         raise click.BadParameter(f"{algorithms!r}: give three-pass, two-pass and/or one-pass", param_hint="--algorithms")
+    try:
+        block_list = [int(b) for b in blocks.split(",") if b.strip()]
+    except ValueError:
+        raise click.BadParameter(f"{blocks!r} is not a comma-separated list of block sizes", param_hint="--blocks")
+    from rrcache.runtime import BLOCK_SIZES
+
+    if any(b not in BLOCK_SIZES for b in block_list):
+        raise click.BadParameter(f"{blocks!r}: give block sizes from {', '.join(map(str, BLOCK_SIZES))}",
+                                 param_hint="--blocks")
     from rrcache.runtime.glsl import FILTERS
 
     filter_list = [f.strip() for f in filters.split(",") if f.strip()]
@@ -90,7 +104,8 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
         else:
             bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution,
                         repeats=repeats, progress=reporter.update, color_format=timing_format, vertex=vert,
-                        include_dirs=include_dirs, filters=tuple(filter_list), misses=misses)
+                        include_dirs=include_dirs, filters=tuple(filter_list), misses=misses,
+                        algorithms=tuple(algorithm_list), blocks=tuple(block_list))
     if as_json:
         click.echo(json.dumps(bench.to_json()))
     else:
