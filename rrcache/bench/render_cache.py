@@ -205,31 +205,44 @@ def _markdown(results: list) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: the error maps' gain: |image − original| × this, per channel
+ERROR_GAIN = 4.0
+
+
 def contact_sheet(results: list, images: dict, path) -> str:
-    """One row per scene: the original, the reprojection cache, the render cache and dynamic
-    resolution at the scene's sheet frame, each titled with its error and PSNR."""
+    """Two rows per scene: the original, the reprojection cache, the render cache and dynamic
+    resolution at the scene's sheet frame, each titled with its error and PSNR; under each
+    method its error map (``|image − original| ×`` :data:`ERROR_GAIN`)."""
     from rrcache.report.agg import agg_pyplot
 
     plt = agg_pyplot()
     methods = ["original", "reprojection cache", "render cache", "dynamic resolution"]
-    fig, axes = plt.subplots(len(results), len(methods), figsize=(3.2 * len(methods), 2.6 * len(results)),
+    fig, axes = plt.subplots(2 * len(results), len(methods), figsize=(3.2 * len(methods), 5.0 * len(results)),
                              dpi=100, squeeze=False)
     try:
         for i, r in enumerate(results):
+            shots = images.get(r.name, {})
+            original = shots.get("original")
             for j, method in enumerate(methods):
-                ax = axes[i][j]
-                image = images.get(r.name, {}).get(method)
-                ax.set_xticks([])
-                ax.set_yticks([])
+                top, bottom = axes[2 * i][j], axes[2 * i + 1][j]
+                for ax in (top, bottom):
+                    ax.set_xticks([])
+                    ax.set_yticks([])
+                image = shots.get(method)
                 if image is None:
-                    ax.set_title(f"{method}: not measured", fontsize=8)
+                    top.set_title(f"{method}: not measured", fontsize=8)
+                    bottom.axis("off")
                     continue
-                ax.imshow(np.clip(np.nan_to_num(image[..., :3]), 0, 1) ** (1 / 1.0), interpolation="nearest")
+                top.imshow(np.clip(np.nan_to_num(image[..., :3]), 0, 1), interpolation="nearest")
                 if method == "original":
-                    ax.set_title(f"{r.name}, frame {r.sheet_frame}: original", fontsize=8)
-                else:
-                    err, db = r.sheet[method]
-                    ax.set_title(f"{method}: error {err:.4f}, {min(db, 100):.1f} dB", fontsize=8)
+                    top.set_title(f"{r.name}, frame {r.sheet_frame}: original", fontsize=8)
+                    bottom.axis("off")
+                    continue
+                err, db = r.sheet[method]
+                top.set_title(f"{method}: error {err:.4f}, {min(db, 100):.1f} dB", fontsize=8)
+                diff = np.abs(np.nan_to_num(image[..., :3]) - np.nan_to_num(original[..., :3])) * ERROR_GAIN
+                bottom.imshow(np.clip(diff, 0, 1), interpolation="nearest")
+                bottom.set_title(f"|{method} − original| × {ERROR_GAIN:g}", fontsize=7)
         fig.tight_layout()
         fig.savefig(path)
     finally:
