@@ -380,3 +380,29 @@ def test_render_method_bad_input_is_one_line_exit_2(tmp_path, capsys, args, mess
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "Traceback" not in err
+
+
+def test_the_equal_time_tool_writes_its_table_sheet_and_stages(gl_ctx, tmp_path):
+    """``python -m rrcache.bench.render_cache equal-time`` on the small scene: the reprojection
+    cache, dynamic resolution and the render cache in one table (shapes only: timings are not
+    asserted), the per-stage table, the contact sheet."""
+    from rrcache.bench import render_cache as bench
+    from rrcache.pipeline import load_for_session
+
+    shader, session = _cli_files(tmp_path)
+    work = load_for_session(shader, load_session(session))
+    (node,) = [n.id for n in work.table.nodes if n.text == "m.albedo * (0.15 + 0.85 * diffuse)"]
+    assert bench.main(["equal-time", "--choice", f"{shader}:{session}={node}:4", "--search-frames", "3",
+                       "--out", str(tmp_path / "out")]) == 0
+    doc = json.loads((tmp_path / "out" / "equal_time.json").read_text())
+    (scene,) = doc["scenes"]
+    assert [r["method"] for r in scene["rows"]] == ["reprojection cache (ours)", "dynamic resolution",
+                                                     "render cache (Walter 2002)"]
+    assert scene["texts"] == ["m.albedo * (0.15 + 0.85 * diffuse)"] and scene["sheet_frame"] == 3
+    assert set(scene["sheet"]) == {"reprojection cache", "dynamic resolution", "render cache"}
+    assert scene["rows"][2]["stages"]["shade"] > 0 and scene["rows"][0]["speedup"] == scene["target_speedup"]
+    md = (tmp_path / "out" / "equal_time.md").read_text()
+    assert "| shader (48×36, 6 frames) | render cache (Walter 2002)" in md and "| shader | " in md
+    assert (tmp_path / "out" / "contact_sheet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(RRCacheError, match="not a choice"):
+        bench.Choice.parse("n66")
