@@ -60,6 +60,7 @@ import numpy as np
 
 from rrcache.bench.scenes import resolve_scenes, scaled_session
 from rrcache.errors import RRCacheError
+from rrcache.gl.program import fullscreen_vertex
 
 #: how ``rrcache bench`` sizes each scene (its FULL settings): chess smaller and shorter
 SCENE_SIZES = {"chess": ((320, 240), 60)}
@@ -121,6 +122,20 @@ def _sizes(scene, out) -> str:
     session = load_session(scene.session)
     return str(scaled_session(scene.session, Path(out) / "sessions" / f"{scene.name}.json", size,
                               min(frames, session.frames)))
+
+
+def _side_by_side(variants: list, repeats: int) -> dict:
+    """Median ms of each ``(name, function)`` in ``variants``, run in turn ``repeats`` times (after
+    one untimed call each)."""
+    for _, fn in variants:
+        fn()
+    times = {name: [] for name, _ in variants}
+    for _ in range(repeats):
+        for name, fn in variants:
+            start = time.perf_counter()
+            fn()
+            times[name].append((time.perf_counter() - start) * 1000.0)
+    return {name: statistics.median(t) for name, t in times.items()}
 
 
 def _load() -> str:
@@ -329,19 +344,16 @@ def zbuffer_cost(scene, out, tiles=(16, 32, 64), repeats: int = 9, frames: int =
             pix, depth, slots = rc.projector.project(rc.cache, screen, rc.size, moving)
             project_ms.append((time.perf_counter() - start) * 1000.0)
         w, h = rc.size
-        variants = [("untiled", dict())] + [(f"tiled {t}×{t}", dict(tiled=True, width=w, tile=t)) for t in tiles]
-        times = {name: [] for name, _ in variants}
         reference = zbuffer(pix, depth, slots, w * h)
-        for _ in range(repeats):
-            for name, kwargs in variants:
-                start = time.perf_counter()
-                got = zbuffer(pix, depth, slots, w * h, **kwargs)
-                times[name].append((time.perf_counter() - start) * 1000.0)
-                if not (np.array_equal(got[0], reference[0]) and np.array_equal(got[1], reference[1])):
-                    raise AssertionError(f"{name} z-buffer differs from the untiled one")
+        variants = [("untiled", {})] + [(f"tiled {t}×{t}", dict(tiled=True, width=w, tile=t)) for t in tiles]
+        for name, kwargs in variants:
+            got = zbuffer(pix, depth, slots, w * h, **kwargs)
+            if not (np.array_equal(got[0], reference[0]) and np.array_equal(got[1], reference[1])):
+                raise AssertionError(f"the {name} z-buffer differs from the untiled one")
+        ms = _side_by_side([(name, lambda kw=kwargs: zbuffer(pix, depth, slots, w * h, **kw))
+                            for name, kwargs in variants], repeats)
     return {"scene": scene.name, "resolution": [w, h], "points": int(len(pix)), "capacity": rc.cache.capacity,
-            "load": _load(), "project_ms": statistics.median(project_ms),
-            "zbuffer_ms": {name: statistics.median(t) for name, t in times.items()}}
+            "load": _load(), "project_ms": statistics.median(project_ms), "zbuffer_ms": ms}
 
 
 _POINTS_VERTEX = """#version 330 core
@@ -461,24 +473,10 @@ def projection_cost(scene, out, repeats: int = 9, frames: int = 8, samples: floa
             found = np.where(got.view(np.uint32) == 0xFFFFFFFF, np.inf, got)
             if not np.allclose(found, expected, rtol=1e-5, equal_nan=True):
                 raise AssertionError("the compute shader's z-buffer differs from numpy's")
-        for _, fn in variants:
-            fn()
-        times = {name: [] for name, _ in variants}
-        for _ in range(repeats):
-            for name, fn in variants:
-                start = time.perf_counter()
-                fn()
-                times[name].append((time.perf_counter() - start) * 1000.0)
-    return {"scene": scene.name, "resolution": [w, h], "points": int(len(points)), "load": _load(),
-            "ms": {name: statistics.median(t) for name, t in times.items()}}
+        ms = _side_by_side(variants, repeats)
+    return {"scene": scene.name, "resolution": [w, h], "points": int(len(points)), "load": _load(), "ms": ms}
 
 
-_FILTER_VERTEX = """#version 330 core
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-"""
 # the projected points: rgb = colour (0 where none), a = depth (0 where none; negative: shaded this
 # frame, exempt from the cull)
 _CULL = """#version 330 core
@@ -584,7 +582,7 @@ def filters_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float =
             return t
 
         def program(fragment):
-            return scope.own(ctx.program(vertex_shader=_FILTER_VERTEX, fragment_shader=fragment))
+            return scope.own(ctx.program(vertex_shader=fullscreen_vertex(0.0), fragment_shader=fragment))
 
         points_tex, kept_tex, image_tex, rows_tex, final_tex, previous_tex = (target() for _ in range(6))
         ages_tex, priority_tex = target(1), target(1)
@@ -624,14 +622,8 @@ def filters_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float =
             raise AssertionError("the GL filters' image differs from numpy's")
         variants = [("numpy (cull, interpolate, prefilter)", numpy_way),
                     ("GL passes (upload, cull, interpolate, prefilter, read the priority)", gl_way)]
-        times = {name: [] for name, _ in variants}
-        for _ in range(repeats):
-            for name, fn in variants:
-                start = time.perf_counter()
-                fn()
-                times[name].append((time.perf_counter() - start) * 1000.0)
-    return {"scene": scene.name, "resolution": [w, h], "load": _load(),
-            "ms": {name: statistics.median(t) for name, t in times.items()}}
+        ms = _side_by_side(variants, repeats)
+    return {"scene": scene.name, "resolution": [w, h], "load": _load(), "ms": ms}
 
 
 def screen_matrix4(screen: np.ndarray) -> np.ndarray:
