@@ -32,7 +32,7 @@ LAYERS = [
     {"harness"},
     {"compiler"},
     {"pipeline"},
-    {"alternatives", "profiles", "cluster"},
+    {"alternatives", "profiles", "cluster", "webgl"},
     {"report"},
     {"profiler"},
     {"bench"},
