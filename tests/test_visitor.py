@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rrcache.analysis.cost import MAX_LOOP_TRIPS, loop_trips
+from rrcache.analysis.cost import EARLY_EXIT, MAX_LOOP_TRIPS, loop_trips
 from rrcache.analysis.estimators import find_estimators, loop_header
 from rrcache.analysis.loops import Constants, body_exits, counted_loop, global_scalars
 from rrcache.analysis.unroll import unroll_loops
@@ -170,6 +170,8 @@ def test_an_early_exit_is_a_property_of_the_body():
 
 def test_the_cost_model_counts_a_loop_past_its_limit_as_the_limit():
     s, loop = _loop("for (int i = 0; i < 100000; i++) { acc += 1.0; if (acc > 3.0) break; }")
+    assert loop_trips(loop, Constants(global_scalars(s.info).get)) == round(MAX_LOOP_TRIPS * EARLY_EXIT)
+    s, loop = _loop("for (int i = 0; i < 100000; i++) { acc += sin(acc); }")
     assert loop_trips(loop, Constants(global_scalars(s.info).get)) == MAX_LOOP_TRIPS
 
 

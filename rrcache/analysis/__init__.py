@@ -15,11 +15,11 @@ from rrcache.analysis.cacheable import (
     REASONS, CacheableNode, ExcludedNode, NodeTable, cacheable_nodes, find_node,
 )
 from rrcache.analysis.compound import expand_compound_assignments
-from rrcache.analysis.cost import CACHE_LOOKUP_COST
+from rrcache.analysis.cost import CACHE_LOOKUP_COST, CHEAP_BELOW
 from rrcache.analysis.inline import inline_calls
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.unroll import unroll_loops
 
-__all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "CACHE_LOOKUP_COST",
+__all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "CACHE_LOOKUP_COST", "CHEAP_BELOW",
            "analyse", "cacheable_nodes", "expand_compound_assignments", "find_node",
            "inline_calls", "unroll_loops"]

@@ -36,7 +36,7 @@ Every expression in a value position of ``main`` is either listed or left out wi
                local variable that has exactly one reaching definition (that definition's
                expression is the node kept).
 ``cheap``      its cost (below) is under ``cheap_below`` (default
-               :data:`rrcache.analysis.cost.CACHE_LOOKUP_COST`): a cache lookup costs more.
+               :data:`rrcache.analysis.cost.CHEAP_BELOW`): too little to repay a lookup.
 
 The *cost* of a node is the work a cache hit saves: the static cost
 (:mod:`rrcache.analysis.cost`) of its expression tree plus that of every definition of a local
@@ -87,7 +87,7 @@ from rrcache.glsl.ast import children, iter_exprs
 from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
 from rrcache.glsl.defuse import out_qualifiers, written_roots
-from rrcache.analysis.cost import CACHE_LOOKUP_COST, loop_trips, op_cost
+from rrcache.analysis.cost import CHEAP_BELOW, loop_trips, op_cost
 from rrcache.analysis.loops import Constants, global_scalars
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text
@@ -224,7 +224,7 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
 
 @deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                    cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False, moving=(),
+                    cheap_below: int = CHEAP_BELOW, analysed: bool = False, moving=(),
                     scores=None) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
 

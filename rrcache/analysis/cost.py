@@ -22,7 +22,8 @@ sign step ...``              ``smoothstep`` 8)
 ``length`` / ``normalize``   dot + ``SQRT`` (+ n multiplies for ``normalize``)
 ``distance``                 n + ``length``
 ``cross``                    9; ``reflect`` dot + 2·n; ``refract`` 2·dot + ``SQRT`` + 4·n
-texture lookups              ``TEXTURE`` = 16 per call (plus the coordinates' cost)
+texture lookups              measured here (below): 60 to 370 per call by kind (plus the
+                             coordinates' cost); ``textureSize`` and the queries 1
 ``dFdx``/``dFdy``/``fwidth`` 2 per component
 other built-ins              2 per component
 constructors, swizzles,      0 (register moves)
@@ -30,10 +31,38 @@ fields, literals, variables
 a call of a user function    ``USER_CALL`` = 32 (only calls the inliner left in place)
 ===========================  ==========================================================
 
-A cache lookup costs about ``CACHE_LOOKUP_COST`` = 42: the reprojection (a divide by w and a
-scale and bias, 8), two bilinear fetches (the previous depth for the hit test and the payload,
-2 × ``TEXTURE``) and the depth comparison (2). Caching a node whose saved work is below that
-cannot pay for itself; :mod:`rrcache.analysis.cacheable` excludes such nodes as ``cheap``.
+Texture fetches are priced by what they cost on llvmpipe, measured against the unit (a chain
+of vec4 ``(x + a) * b``, 8 units a step) by ``python tools/calibrate_costs.py --repeats 15
+--size 256`` (llvmpipe, LP_NUM_THREADS=1, two cores shared with other work, load average 8-16).
+Three runs gave, for the rows below in order, 195/171/189, 120/102/96, 83/73/77, 71/55/58,
+64/55/55, 399/373/345 and 167/177/177; :data:`TEXTURE_COSTS` keeps their means, rounded to 5:
+
+================================================  =====
+fetch                                             units
+================================================  =====
+2D (and 3D, array), implicit LOD, mipmapped       185
+2D, explicit LOD (``textureLod``, ``textureGrad``) 105
+2D without mipmaps                                80
+``textureGather``                                 60
+``texelFetch``                                    60
+cube map, implicit LOD                            370
+cube map, explicit LOD                            175
+================================================  =====
+
+(The same runs put a vec4 ``sin`` at 44.5, 44.5 and 47 units, the model's 32 plus a third;
+the ALU weights are kept.) A loop left rolled that can stop early (a ``break`` of its own, a
+``return`` or ``discard``) runs :data:`EARLY_EXIT` = 0.55 of its trip count: the time of a
+64-step loop whose exit step varies smoothly over the frame, as a ray march's does, was 0.60,
+0.53 and 0.50 of the full loop's (exits hashed per pixel: 0.91, 0.84 and 0.79, as llvmpipe
+runs neighbouring pixels in lockstep).
+
+A cache lookup (the runtime's hit test and bilinear payload fetch, timed the same way in the
+third run) costs :data:`CACHE_LOOKUP_COST` = 100 units here: the reprojection, two fetches of
+textures without mipmaps (the inverse depth has one channel) and the comparison. The node
+table's ``cheap`` threshold, :data:`CHEAP_BELOW` = 42, is the lookup's price before fetches
+were measured, kept so: nodes between it and the measured lookup are listed (on a GPU, where a
+fetch costs a few ALU operations, they can pay) and the profile's timings decide on this
+renderer; the profile's ``min_saving`` (a share of the costliest node) prunes such nodes there.
 
 >>> from rrcache.glsl.frontend import parse_shader
 >>> s = parse_shader("uniform vec3 a;\\nvoid main() { gl_FragColor = vec4(sin(a * 2.0), 1.0); }")
@@ -47,19 +76,31 @@ from rrcache.glsl import ast as A
 
 from rrcache.glsl.ast import walk
 from rrcache.glsl.visitor import NodeVisitor
-from rrcache.analysis.loops import counted_loop
+from rrcache.analysis.loops import counted_loop, exits_early
 
-__all__ = ["ADD", "MUL", "DIV", "SQRT", "TRANSCENDENTAL", "TEXTURE", "USER_CALL",
-           "CACHE_LOOKUP_COST", "MAX_LOOP_TRIPS", "op_cost", "subtree_cost", "loop_trips"]
+__all__ = ["ADD", "MUL", "DIV", "SQRT", "TRANSCENDENTAL", "TEXTURE", "TEXTURE_COSTS", "EARLY_EXIT",
+           "USER_CALL", "CACHE_LOOKUP_COST", "CHEAP_BELOW", "MAX_LOOP_TRIPS", "op_cost", "subtree_cost",
+           "texture_cost", "loop_trips"]
 
 ADD = 1
 MUL = 1
 DIV = 4
 SQRT = 4
 TRANSCENDENTAL = 8
-TEXTURE = 16
+#: a texture fetch's cost by (sampler shape, how the level is chosen), measured (module docstring)
+TEXTURE_COSTS = {
+    ("2d", "implicit"): 185, ("2d", "lod"): 105, ("2d", "flat"): 80, ("2d", "gather"): 60,
+    ("2d", "fetch"): 60, ("cube", "implicit"): 370, ("cube", "lod"): 175,
+}
+#: a 2D fetch with an implicit level of detail, the commonest
+TEXTURE = TEXTURE_COSTS[("2d", "implicit")]
+#: the share of its trip count a loop that can stop early is costed at (module docstring)
+EARLY_EXIT = 0.55
 USER_CALL = 32
-CACHE_LOOKUP_COST = 8 + 2 * TEXTURE + 2
+#: a cache lookup, measured (module docstring)
+CACHE_LOOKUP_COST = 100
+#: the node table's ``cheap`` threshold (module docstring)
+CHEAP_BELOW = 42
 
 _TRANSCENDENTAL = frozenset(
     "sin cos tan asin acos atan sinh cosh tanh asinh acosh atanh exp log exp2 log2 pow".split())
@@ -144,7 +185,7 @@ def _call_cost(e: A.Call) -> int:
     arg_n = _components(e.args[0]) if e.args else 1
     category = getattr(e.target, "category", None)
     if category == "texture" or name.startswith(("texture", "shadow")) or name == "texelFetch":
-        return 1 if name in ("textureSize", "textureQueryLevels", "textureSamples") else TEXTURE
+        return texture_cost(e)
     if name in _TRANSCENDENTAL:
         return TRANSCENDENTAL * n
     if name in _PER_COMPONENT:
@@ -180,6 +221,38 @@ def _call_cost(e: A.Call) -> int:
     return 2 * n
 
 
+_QUERIES = frozenset({"textureSize", "textureQueryLevels", "textureQueryLod", "textureSamples"})
+
+
+def texture_cost(e: A.Call) -> int:
+    """What the texture built-in call ``e`` costs (:data:`TEXTURE_COSTS`): by the shape of its
+    sampler (a cube map or not) and how it picks the level (``texelFetch``, ``textureGather``,
+    an explicit ``Lod``/``Grad``, else implicit: a mipmapped texture is assumed, as sessions
+    give them by default). Size and level queries cost 1.
+
+    >>> from rrcache.glsl.frontend import parse_shader
+    >>> s = parse_shader("uniform samplerCube c; uniform sampler2D t; varying vec3 d;\\n"
+    ...                  "void main() { gl_FragColor = textureCube(c, d) + texture2DLod(t, d.xy, 2.0); }")
+    >>> calls = [n for n in s.unit.walk() if isinstance(n, A.Call) and n.name.startswith("texture")]
+    >>> [(c.name, texture_cost(c)) for c in calls]
+    [('textureCube', 370), ('texture2DLod', 105)]
+    """
+    name = e.name
+    if name in _QUERIES:
+        return 1
+    sampler = getattr(getattr(e.args[0], "type", None), "base", "") if e.args else ""
+    shape = "cube" if "Cube" in (sampler or "") or "Cube" in name else "2d"
+    if name.startswith("texelFetch"):
+        how = "fetch"
+    elif "Gather" in name:
+        how = "gather"
+    elif "Lod" in name or "Grad" in name:
+        how = "lod"
+    else:
+        how = "implicit"
+    return TEXTURE_COSTS.get((shape, how), TEXTURE_COSTS[("2d", how)])
+
+
 def subtree_cost(e: A.Expr) -> int:
     """The cost of evaluating the expression tree ``e`` (variables read count 0; the
     cacheable-node analysis adds the work behind local variables).
@@ -200,18 +273,23 @@ def loop_trips(loop, constants) -> int:
     (:func:`rrcache.analysis.loops.counted_loop`, with ``constants`` folding the header's
     expressions), 1 when it cannot tell (a bound read from a uniform, a ``while`` loop). The
     static cost of what such a loop computes is its body's times this: one iteration of a
-    64-step ray march is not its cost. At most :data:`MAX_LOOP_TRIPS`.
+    64-step ray march is not its cost. A loop that can stop early (a ``break`` of its own, a
+    ``return``, a ``discard``) counts :data:`EARLY_EXIT` of its trips: nor are all 64. At most
+    :data:`MAX_LOOP_TRIPS`.
 
     >>> from rrcache.glsl.frontend import parse_shader
     >>> from rrcache.analysis.loops import Constants, global_scalars
     >>> s = parse_shader("#version 330\\nconst int N = 80;\\nout vec4 c;\\nvoid main() { float t = 0.0;"
     ...                  " for (int i = 0; i < N; i++) { t += 1.0; if (t > 9.0) break; } c = vec4(t); }")
     >>> loop = [n for n in s.unit.walk() if isinstance(n, A.For)][0]
-    >>> loop_trips(loop, Constants(global_scalars(s.info).get))
-    80
+    >>> loop_trips(loop, Constants(global_scalars(s.info).get))   # 80 steps, may break early
+    44
     """
     head, _why = counted_loop(loop, constants)
     if head is None:
         return 1
     trips = head.trips(MAX_LOOP_TRIPS)
-    return MAX_LOOP_TRIPS if trips is None else max(trips, 1)
+    trips = MAX_LOOP_TRIPS if trips is None else max(trips, 1)
+    if exits_early(loop.body):
+        trips = max(1, round(trips * EARLY_EXIT))
+    return trips

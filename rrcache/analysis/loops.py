@@ -35,8 +35,8 @@ import numpy as np
 from rrcache.glsl import ast as A
 from rrcache.glsl.visitor import NodeVisitor
 
-__all__ = ["COMPARE", "Constants", "CountedLoop", "counted_loop", "body_exits", "scalar",
-           "global_scalars"]
+__all__ = ["COMPARE", "Constants", "CountedLoop", "counted_loop", "body_exits", "exits_early",
+           "scalar", "global_scalars"]
 
 #: the comparisons a counted loop's condition may make, evaluated in the index's type
 COMPARE = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
@@ -309,3 +309,39 @@ def body_exits(body: A.Stmt) -> bool:
     (False, True)
     """
     return _Exits().visit(body)
+
+
+class _EarlyExit(NodeVisitor):
+    """Whether a loop body can end the loop before its last iteration."""
+
+    def generic_visit(self, node) -> bool:
+        return False
+
+    def visit_Break(self, s) -> bool:
+        return True
+
+    visit_Return = visit_Discard = visit_Break
+
+    def visit_Compound(self, s: A.Compound) -> bool:
+        return any(self.visit(x) for x in s.stmts)
+
+    def visit_If(self, s: A.If) -> bool:
+        return self.visit(s.then) or (s.else_ is not None and self.visit(s.else_))
+
+    def visit_For(self, s) -> bool:
+        # an inner loop's ``break`` ends only that loop; a ``return`` or ``discard`` ends all
+        return any(n.__class__ in (A.Return, A.Discard) for n in A.walk(s.body, decl_types=False))
+
+    visit_While = visit_DoWhile = visit_Switch = visit_For
+
+
+def exits_early(body: A.Stmt) -> bool:
+    """Whether a loop whose body is ``body`` may stop before its last iteration: a ``break`` of
+    that loop, or a ``return`` or ``discard`` anywhere in it.
+
+    >>> from rrcache.glsl.parser import parse_source
+    >>> loop = parse_source("void main() { for (;;) { for (;;) break; if (x) return; } }").decls[0].body.stmts[0]
+    >>> exits_early(loop.body), exits_early(loop.body.stmts[0].body)
+    (True, True)
+    """
+    return _EarlyExit().visit(body)

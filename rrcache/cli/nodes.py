@@ -67,7 +67,7 @@ SORT_KEYS = {
 
 #: what the cost column counts, for the table's last lines
 COST_UNIT = ("cost: the static estimate of the work one cache hit saves per pixel, in units of one scalar "
-             "add or multiply (a sin costs 8, a texture fetch 16 or more), see rrcache/analysis/cost.py")
+             "add or multiply (a sin costs 8, a texture fetch 60 to 370), see rrcache/analysis/cost.py")
 
 
 def format_table(table, show_all: bool, sort: str = "id") -> str:

@@ -18,6 +18,11 @@ noise, the final colour) never gets measured. Two rules replace it:
    farthest from every node already ordered); across groups it is round-robin, costliest group
    first. So lighting-dependent nodes (the final colour, albedo × diffuse) and the pure noise
    chain (whole noise, partial sums, octaves) are all reached early, and near-duplicates late.
+   Nodes must differ in text as well as in cost: a node whose text is that of one already
+   ordered in its group (the same expression reached through another call site or unrolled
+   iteration) counts as no farther than a copy; and of nodes of equal cost the final colour comes
+   first (``vec4(toneMap(c), 1.0)`` costs what its operand does, and it is the one users ask
+   about).
 
 >>> from types import SimpleNamespace as N
 >>> nodes = [N(id=f"n{c}", cost=c) for c in (100, 98, 60, 30, 5)]
@@ -25,6 +30,11 @@ noise, the final colour) never gets measured. Two rules replace it:
 ['n100', 'n5', 'n60', 'n30', 'n98']
 >>> [n.id for n in diversity_order(nodes, {"n100": "b", "n98": "a", "n60": "a", "n30": "a", "n5": "a"})]
 ['n100', 'n98', 'n5', 'n60', 'n30']
+>>> texts = [N(id="n1", cost=70, text="noise(p)"), N(id="n2", cost=30, text="noise(p)"),
+...          N(id="n3", cost=50, text="p * 2.0"), N(id="n4", cost=90, text="vec4(c)", final=True),
+...          N(id="n5", cost=90, text="c")]
+>>> [n.id for n in diversity_order(texts, {})]   # n1 reads like n2, n5 costs what n4 does: last
+['n4', 'n2', 'n3', 'n5', 'n1']
 """
 from __future__ import annotations
 
@@ -114,13 +124,14 @@ def diversity_order(nodes, signatures: dict) -> list:
     node, then to the table's order."""
     import numpy as np
 
-    ordered = sorted(nodes, key=lambda n: -n.cost)
+    ordered = sorted(nodes, key=lambda n: (-n.cost, not getattr(n, "final", False)))
     if not ordered:
         return []
     cost = np.array([n.cost for n in ordered], dtype=np.float64)
     names = [signatures.get(n.id, "") for n in ordered]
     group_of = {name: i for i, name in enumerate(dict.fromkeys(names))}
     group = np.array([group_of[name] for name in names])
+    texts = [getattr(n, "text", None) for n in ordered]
     head = float(cost.max()) + 1.0
     novelty = cost + head  # nothing taken in any group yet
     taken = np.zeros(len(ordered), dtype=bool)
@@ -133,4 +144,7 @@ def diversity_order(nodes, signatures: dict) -> list:
         same = group == group[pick]
         novelty = np.where(same, np.minimum(np.where(novelty > head, np.inf, novelty), np.abs(cost - cost[pick])),
                            novelty)
+        if texts[pick] is not None:
+            copies = same & np.array([t == texts[pick] for t in texts])
+            novelty = np.where(copies, 0.0, novelty)
     return out
