@@ -15,7 +15,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
+from rrcache import atomic
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
 
 #: name -> (shader, session), relative to the repository root
 PAPER_SCENES = {
@@ -127,8 +129,11 @@ def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: 
                                     'session, say "allow_outside_paths": true in it')
         doc["allow_outside_paths"] = True
     out = Path(out_path)
-    out.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps(doc, indent=2) + "\n"
-    if not out.exists() or out.read_text(encoding="utf-8") != text:
-        out.write_text(text, encoding="utf-8")
+    try:
+        same = read_file(out, limit=len(text.encode("utf-8"))).data == text.encode("utf-8")
+    except Refused:
+        same = False
+    if not same:
+        atomic.write_text(out, text)
     return out

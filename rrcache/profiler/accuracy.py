@@ -126,8 +126,10 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
     """Measure ``nodes`` (default :func:`nodes_that_matter`) of ``profile`` at ``periods`` and
     compare with the models' predictions (see the module docstring)."""
     from rrcache.pipeline import load_for_session, variant_for
-    from rrcache.session import load_session
 
+    from rrcache.profiles.inputs import check_inputs, load_session_of
+
+    check_inputs(profile)  # what profile.json names is the profiled shader, before anything reads it
     table = profile.table
     settings = profile.settings
     periods = [int(p) for p in periods]
@@ -144,7 +146,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
     if unknown:
         raise RRCacheError(f"nodes {unknown} are not trained in this profile", str(profile.path or "profile"),
                            hint="give trained node ids (profile.json lists them)")
-    session = load_session(profile.session)
+    session = load_session_of(profile)
     work = load_for_session(profile.shader, session, profile.defines, profile.include_dirs, vertex=profile.vertex)
     check_same_shader(profile, work)
     plan = Plan.from_json(profile.plan or {})

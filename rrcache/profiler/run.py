@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
@@ -250,27 +251,28 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
     from rrcache.pipeline import variant_for_selection
 
-    out.mkdir(parents=True, exist_ok=True)
     kept = []
-    for sel in prof.selections:
-        folder = out / "optimized" / sel.label
-        if folder.exists():
-            for old in folder.iterdir():
-                if old.is_file():
-                    old.unlink()
-        if not sel.parts:
-            prof.write_variant(sel, folder)
-        else:
-            variant, period = variant_for_selection(work, sel)
-            from rrcache.profiler.adaptive import runtime_kwargs
+    # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
+    # refused, never followed, and the old files of a selection are removed only inside it
+    with OutputFolder(out) as root, root.folder("optimized") as optimized:
+        for sel in prof.selections:
+            with optimized.folder(sel.label) as folder:
+                folder.remove_files()
+                if not sel.parts:
+                    prof.write_variant(sel, folder)
+                else:
+                    variant, period = variant_for_selection(work, sel)
+                    from rrcache.profiler.adaptive import runtime_kwargs
 
-            variant.write(folder, period=period, runtime=dict(prof.settings.cache_options(), **runtime_kwargs(sel)))
-        kept.append(sel.replace(files=str(folder.relative_to(out))))
+                    variant.write(folder, period=period,
+                                  runtime=dict(prof.settings.cache_options(), **runtime_kwargs(sel)))
+            kept.append(sel.replace(files=f"optimized/{sel.label}"))
+        if prof.verdict is not None:  # stopped before training: nothing to plot or report
+            with optimized.folder("original") as folder:
+                prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), folder)
+            plots = False
     prof.selections = kept
     prof.path = out
-    if prof.verdict is not None:  # stopped before training: nothing to plot or report
-        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
-        plots = False
     if plots:
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots

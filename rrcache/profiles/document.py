@@ -32,7 +32,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional
 
-from rrcache.errors import RRCacheError
+from rrcache import atomic
+from rrcache.atomic import OutputFolder
+from rrcache.errors import RRCacheError, printable
 from rrcache.jsonable import finite_json
 from rrcache.model.sets import SetOption
 from rrcache.profiles.amortize import SLOTS_PAYLOADS, EstimatorProfile
@@ -460,23 +462,23 @@ class Profile:
         ``manifest.json`` (recording the period it runs with); for the original shader only a
         ``manifest.json`` saying so. The shader is loaded again and must still have the profiled
         hash."""
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
+        if not isinstance(out_dir, OutputFolder):
+            with OutputFolder(out_dir) as folder:
+                return self.write_variant(choice, folder)
         if not choice.parts:
             note = (self.verdict["answer"] if self.verdict is not None else
                     choice.fallback or "no cached variant is predicted to beat the original at this error")
-            path = out / "manifest.json"
-            path.write_text(json.dumps({"rrcache_selection": 1, "node": None, "shader": self.shader,
-                                        "note": note}, indent=2) + "\n")
-            return [str(path)]
+            return [out_dir.write_text("manifest.json", json.dumps(
+                {"rrcache_selection": 1, "node": None, "shader": self.shader, "note": note}, indent=2) + "\n")]
         from rrcache.pipeline import load_for_session, variant_for_selection
-        from rrcache.session import load_session
+        from rrcache.profiles.inputs import load_session_of
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines, self.include_dirs,
+        # what profile.json names is the profiled shader and session, before anything parses them
+        work = load_for_session(self.shader, load_session_of(self), self.defines, self.include_dirs,
                                 vertex=self.vertex)
         check_same_shader(self, work)
         variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
-        return variant.write(out, period=period, runtime=self.settings.cache_options())
+        return variant.write(out_dir, period=period, runtime=self.settings.cache_options())
 
     # ------------------------------------------------------------------ the document
     def to_json(self) -> dict:
@@ -488,13 +490,9 @@ class Profile:
         out = Path(folder) if folder is not None else self.path
         if out is None:
             raise ValueError("Profile.write needs a folder")
-        out.mkdir(parents=True, exist_ok=True)
         self.path = out
-        target = out / JSON_NAME
-        tmp = out / (JSON_NAME + ".tmp")
-        tmp.write_text(json.dumps(self.to_json(), indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, target)
-        return target
+        atomic.write_text(out / JSON_NAME, json.dumps(self.to_json(), indent=2) + "\n")
+        return out / JSON_NAME
 
     @classmethod
     def from_json(cls, data: Any, file: str = JSON_NAME) -> "Profile":
@@ -779,13 +777,24 @@ def load_profile(path) -> Profile:
 
     >>> p = load_profile("marble-marble.rrprofile")    # doctest: +SKIP
     """
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     path = Path(path)
     file = path / JSON_NAME if path.is_dir() else path
-    if not file.exists():
+    if not file.exists() and not file.is_symlink():
         raise RRCacheError("no profile here", str(file), hint="give the folder 'rrcache profile' wrote (--out)")
+    try:  # by rrcache.files' rule: a regular file inside the profile's folder, within the budget
+        raw = read_file(file, budget.document_bytes, [os.path.realpath(file.parent)]).data
+    except Refused as err:
+        what = f"it resolves to {printable(err.real)}, outside the profile's folder" if err.kind == "outside" else \
+            f"it {err.reason}"
+        raise RRCacheError(f"cannot read the profile: {what}", str(file),
+                           hint="raise the budget with 'rrcache --max-document-bytes N ...'" if err.kind == "size"
+                           else "give the folder 'rrcache profile' wrote (--out)") from None
     try:
-        data = json.loads(file.read_text(encoding="utf-8"), parse_constant=_no_constant)
-    except (OSError, UnicodeDecodeError, ValueError) as err:
+        data = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
+    except (UnicodeDecodeError, ValueError) as err:
         raise RRCacheError(f"cannot read the profile ({err})", str(file), hint="run 'rrcache profile' again") from None
     except RecursionError:  # JSON nested thousands deep: no profile looks like that
         raise RRCacheError("cannot read the profile (its JSON is nested too deeply)", str(file),
