@@ -119,7 +119,7 @@ def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Varia
         return variant_for(work, part.node, algorithm), int(part.period)
     if len(selection.parts) == 1 and isinstance(selection.parts[0], AdaptiveNode):
         # the runtime takes the threshold, fast period and spread from the part
-        # (rrcache.profiler.adaptive.runtime_kwargs)
+        # (rrcache.profiles.choice.adaptive_kwargs)
         part = selection.parts[0]
         return variant_for(work, part.node, algorithm, adaptive=True), int(part.period)
     if selection.multi:  # several nodes, each at its own period (a list, in part order)

@@ -32,7 +32,7 @@ LAYERS = [
     {"harness"},
     {"compiler"},
     {"pipeline"},
-    {"alternatives", "profiles"},
+    {"alternatives", "profiles", "cluster", "webgl"},
     {"report"},
     {"profiler"},
     {"bench"},

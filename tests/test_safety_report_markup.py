@@ -18,7 +18,7 @@ import pytest
 
 from rrcache.profiler import demo_profile
 from rrcache.profiles import load_profile
-from rrcache.report import REPORT_NAME, write_report
+from rrcache.report import write_report
 from rrcache.report.browser import Chromium, find_chromium
 from rrcache.report.html import script_json
 from rrcache.session import load_session

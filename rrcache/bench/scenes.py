@@ -110,8 +110,10 @@ def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: 
     (rewritten only when the content changes, so a profile keyed on it resumes)."""
     source = Path(session_path)
     try:
-        doc = json.loads(source.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as err:
+        doc = json.loads(read_file(source, None).data)
+    except Refused as err:
+        raise RRCacheError(f"cannot read the session: it {err.reason}", str(source), hint="give a session JSON file") from None
+    except ValueError as err:
         raise RRCacheError(f"cannot read the session ({err})", str(source), hint="give a session JSON file") from None
     if not isinstance(doc, dict):
         raise RRCacheError("not a session (no JSON object)", str(source), hint="give a session JSON file")

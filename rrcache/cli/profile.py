@@ -21,16 +21,16 @@ import warnings
 
 import click
 from rich.console import Console
-from rich.table import Table
 
 from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
-from rrcache.harness.timing import UNRELIABLE_NOISE
-from rrcache.model.psnr import VISIBLE_DB, psnr_text
+from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
 from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.notices import ceiling_noise, run_warnings
 from rrcache.profiles.store import STORE_NAME
 from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_KINDS, TrainingSettings, parse_periods
 
@@ -155,8 +155,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         _interrupted(out, err_console)
         sys.exit(130)
     console = Console()
-    if not console.is_terminal:
-        console = Console(width=120)
+    if not console.is_terminal:  # a pipe, a file: whole lines, never wrapped or cut
+        console = Console(soft_wrap=True)
     _summary(prof, console)
 
 
@@ -183,18 +183,12 @@ def _verdict(prof, console: Console) -> None:
     console.print(f"answer: {v['answer']}", highlight=False)
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-    _ceiling_noise(ceiling, console)
+    for line in ceiling_noise(ceiling):
+        console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
     console.print(f"why: {v['reason']}", highlight=False)
     console.print("what would change it:", highlight=False)
     for change in v["changes"]:
         console.print(f"  - {change}", highlight=False)
-
-
-def _ceiling_noise(ceiling, console: Console) -> None:
-    if ceiling is not None and ceiling.noise > UNRELIABLE_NOISE:
-        console.print(f"warning: the original's repeated frames varied by ±{ceiling.noise:.0%} while the ceiling was "
-                      "measured: other work on the machine made it unreliable; profile again on a quieter machine "
-                      "(the profile folder keeps it: use --fresh)", highlight=False)
 
 
 def _summary(prof, console: Console) -> None:
@@ -216,7 +210,7 @@ def _summary(prof, console: Console) -> None:
                   f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
                   "runs were stored and skipped", highlight=False)
     console.print(f"μ = {_fmt(prof.mu)} ({prof.mu_quality}); overhead {_fmt(prof.overhead_ms, '.3f')} ms; "
-                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
+                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {prof.pixels:,.0f} covered pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
     for line in _estimator_lines(prof):
@@ -224,24 +218,31 @@ def _summary(prof, console: Console) -> None:
     ceiling = prof.measured_ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-        _ceiling_noise(ceiling, console)
-    noise = prof.timing_noise
-    if noise is not None and not prof.timing_reliable:
-        console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "
-                      "other work on the machine made the timings unreliable; profile again on a quieter machine",
-                      highlight=False)
-    console.print(_table(prof))
-    for s in prof.selections:
-        if s.fallback:
-            console.print(f"{s.label}: {s.fallback}", highlight=False)
-    if any(s.visible_artifacts for s in prof.selections):
-        marked = ", ".join(s.label for s in prof.selections if s.visible_artifacts)
-        console.print(f"{marked}: below {VISIBLE_DB:.0f} dB PSNR: visible artifacts (a choice, not a default)",
-                      highlight=False)
-    noisy = [s.label for s in prof.selections if s.measured_noise is not None and s.measured_noise > UNRELIABLE_NOISE]
-    if noisy:
-        console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
-                      f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
+    _table(prof).print(console)
+    for line in calibration_lines(prof):
+        console.print(line, highlight=False, markup=False, soft_wrap=True)
+    # what the measurements imply (the run's own warnings were printed as they came)
+    for line in run_warnings(prof, stored=False):
+        console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
+    level = next((s.label for s in prof.selections if s.parts), None)
+    if level is not None:
+        console.print(f"next: {prof.path / 'report.html'} says what each level's files are and how to run them; "
+                      f"'rrcache instance {prof.path} --level {level} --out DIR' writes a level's shaders again "
+                      "(--target webgl2: a page that runs them in a browser)", highlight=False, markup=False,
+                      soft_wrap=True)
+
+
+def calibration_lines(prof) -> list[str]:
+    """What validation said of the PSNR predictions: their error on the measured choices, raw and
+    calibrated, and the calibration the profile now predicts with (docs/levels.md)."""
+    cal = prof.calibration or {}
+    raw, calibrated = cal.get("raw") or {}, cal.get("calibrated") or {}
+    if not raw.get("n"):
+        return []
+    return [f"PSNR predicted against measured on {raw['n']} validated choices: |error| mean {raw['mean']:.1f} dB, "
+            f"worst {raw['worst']:.1f} dB (models alone); mean {calibrated['mean']:.1f}, worst "
+            f"{calibrated['worst']:.1f} dB (calibrated by the choices measured before each); the profile now "
+            f"predicts with a {cal.get('shift', 0.0):+.1f} dB calibration (± {cal.get('spread', 0.0):.1f} dB)"]
 
 
 def _estimator_lines(prof) -> list[str]:
@@ -280,6 +281,8 @@ def _estimator_lines(prof) -> list[str]:
 def _level(s) -> str:
     if s.min_psnr is not None:
         return f"≥ {s.min_psnr:g} dB"
+    if s.max_flip is not None:
+        return f"FLIP ≤ {s.max_flip:g}"
     return f"error ≤ {_fmt(s.max_error)}"
 
 
@@ -313,20 +316,48 @@ def _measured_psnr(s) -> str:
     if s.exact or not s.parts:
         return psnr_text(math.inf)
     text = psnr_text(s.measured_psnr)
-    return text + (" (visible)" if s.visible_artifacts else "")
+    if s.measured_psnr_uncertainty:
+        text += f" ± {s.measured_psnr_uncertainty:.1f}"
+    return text
 
 
-def _table(prof) -> Table:
-    table = Table(title="selections")
-    for name in ("level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
-                 "error pred.", "error meas."):
-        if name == "node":
-            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=36)
-        else:
-            table.add_column(name, justify="right")
+def _flip(s) -> str:
+    """The measured mean FLIP ('0' for an exact image), marked where it shows visible artifacts."""
+    if s.exact or (not s.parts and s.measured_error is not None):
+        return "0"
+    if s.measured_flip is None:
+        return "–"
+    return f"{s.measured_flip:.3f}" + (" (visible)" if s.visible_artifacts else "")
+
+
+def level_status(s) -> str:
+    """The table's word on a selection's level: ``met``, ``met, try N`` (the N-th candidate
+    measured stood), ``original`` (nothing measured met it: see the fallback line), ``MISSED``
+    (shipped below its level: only where validation was told not to fall back), or ``–``
+    (not measured).
+
+    >>> from rrcache.selection import Selection
+    >>> level_status(Selection.original(1.0, level_met=True, tries=2, fallback="..."))
+    'original (2 tried)'
+    """
+    if s.level_met is None:
+        return "–"
+    if not s.level_met:
+        return "MISSED"
+    if not s.parts:
+        return f"original ({s.tries} tried)" if s.tries else ("original" if s.fallback else "met")
+    return f"met, try {s.tries}" if s.tries > 1 else "met"
+
+
+def _table(prof) -> TextTable:
+    table = TextTable("selections (pred. = predicted by the models, meas. = measured by validation)",
+                      [(name, "left" if name in ("level", "node") else "right") for name in (
+                          "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
+                          "FLIP meas.", "level met")])
     for s in prof.selections:
         if s.multi:  # several nodes, each at its own period
-            node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
+            node = " + ".join(f"{p.node}: {p.text or prof.node(p.node).text}" for p in s.parts)
+            period = "/".join(str(p) for p in s.periods)
         elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
             part = s.parts[0]
             slots = " slots" if part.history == "slots" else ""
@@ -338,5 +369,5 @@ def _table(prof) -> Table:
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),
-                      _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
+                      _predicted_psnr(s), _measured_psnr(s), _flip(s), level_status(s))
     return table

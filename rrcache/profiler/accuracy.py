@@ -29,7 +29,7 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.renderer import Renderer
 from rrcache.profiler.plan import Plan
 from rrcache.profiler.train import _Meter, _error_run, _timing_run, timing_frame_indices
-from rrcache.profiles.document import check_same_shader
+from rrcache.profiles.choice import load_work
 
 DEFAULT_PERIODS = (6, 14, 30)
 #: at most this many front nodes are measured (the front's nodes spread over its time range)
@@ -125,9 +125,8 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
              progress: Optional[Callable] = None) -> AccuracyReport:
     """Measure ``nodes`` (default :func:`nodes_that_matter`) of ``profile`` at ``periods`` and
     compare with the models' predictions (see the module docstring)."""
-    from rrcache.pipeline import load_for_session, variant_for
-
-    from rrcache.profiles.inputs import check_inputs, load_session_of
+    from rrcache.pipeline import variant_for
+    from rrcache.profiles.inputs import check_inputs
 
     check_inputs(profile)  # what profile.json names is the profiled shader, before anything reads it
     table = profile.table
@@ -146,9 +145,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
     if unknown:
         raise RRCacheError(f"nodes {unknown} are not trained in this profile", str(profile.path or "profile"),
                            hint="give trained node ids (profile.json lists them)")
-    session = load_session_of(profile)
-    work = load_for_session(profile.shader, session, profile.defines, profile.include_dirs, vertex=profile.vertex)
-    check_same_shader(profile, work)
+    work, session = load_work(profile)
     plan = Plan.from_json(profile.plan or {})
     full = tuple(int(v) for v in session.resolution)
     train_frames = list(range(settings.frames))

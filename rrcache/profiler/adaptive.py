@@ -57,14 +57,6 @@ class AdaptivePoint:
         return AdaptiveNode(self.node, int(self.period), float(self.threshold), int(self.fast_period), text=text)
 
 
-def runtime_kwargs(selection: Selection) -> dict:
-    """The runtime's adaptive arguments of ``selection`` (empty unless its part is adaptive)."""
-    if len(selection.parts) == 1 and isinstance(selection.parts[0], AdaptiveNode):
-        p = selection.parts[0]
-        return {"threshold": float(p.threshold), "fast_period": int(p.fast_period), "spread": float(p.spread)}
-    return {}
-
-
 def sweep(work, session, node: str, period: int, thresholds: Sequence[float], frames, timed_frames=None,
           fast_period: int = DEFAULT_FAST_PERIOD, algorithm: str = "three-pass", filter: str = "bilinear",
           cache_options: Optional[dict] = None, window=None, resolution=None, timing_format: str = "rgba8",

@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import sqlite3
 import time
+import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
@@ -62,6 +63,25 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
+    # the run's warnings are kept in profile.json (the report shows them) and raised again at
+    # the end for the caller
+    raised: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
+                                include_dirs, wait, vertex, adaptive, caught)
+            finally:
+                raised = list(caught)
+    finally:
+        for w in raised:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return prof
+
+
+def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
+             vertex, adaptive, caught: list) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -95,6 +115,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
                                          window=result.plan.timing_window if result.plan is not None else None)
+            prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
@@ -224,19 +245,36 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
     choices = prof.threshold_selections()
     if not settings.validate:
         return choices
-    from rrcache.profiler.validate import validate
+    from rrcache.profiler.validate import Validator
 
-    measured = validate(work, session, settings, store, choices, progress,
-                        window=result.plan.timing_window if result.plan is not None else None,
-                        candidates=prof.front_candidates)
+    validator = Validator(work, session, settings, store, progress,
+                          window=result.plan.timing_window if result.plan is not None else None,
+                          candidates=prof.front_candidates)
+    measured = validator.run(choices)
     if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
                                result.plan.timing_window if result.plan is not None else None)
+    prof.calibration = calibration_record(validator)
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured
+
+
+def calibration_record(validator) -> dict:
+    """``Profile.calibration`` from a finished validation: the calibration's points, shift and
+    spread, and the PSNR predictions' error over every measured choice, raw (the models alone)
+    and calibrated (as predicted when it was measured, by the points before it)."""
+    from rrcache.model.calibration import prediction_errors
+
+    rows = [s for s in validator.measured.values() if s.parts and not s.exact and s.predicted_psnr is not None
+            and s.measured_psnr is not None]
+    record = validator.calibration.to_json()
+    record["raw"] = prediction_errors([(s.predicted_psnr - float(s.calibration_db or 0.0), s.measured_psnr)
+                                       for s in rows])
+    record["calibrated"] = prediction_errors([(s.predicted_psnr, s.measured_psnr) for s in rows])
+    return record
 
 
 def _verdict(ceiling) -> dict:
@@ -249,8 +287,6 @@ def _verdict(ceiling) -> dict:
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    from rrcache.pipeline import variant_for_selection
-
     kept = []
     # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
     # refused, never followed, and the old files of a selection are removed only inside it
@@ -258,14 +294,7 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         for sel in prof.selections:
             with optimized.folder(sel.label) as folder:
                 folder.remove_files()
-                if not sel.parts:
-                    prof.write_variant(sel, folder)
-                else:
-                    variant, period = variant_for_selection(work, sel)
-                    from rrcache.profiler.adaptive import runtime_kwargs
-
-                    variant.write(folder, period=period,
-                                  runtime=dict(prof.settings.cache_options(), **runtime_kwargs(sel)))
+                prof.write_variant(sel, folder, work=work)
             kept.append(sel.replace(files=f"optimized/{sel.label}"))
         if prof.verdict is not None:  # stopped before training: nothing to plot or report
             with optimized.folder("original") as folder:

@@ -27,10 +27,13 @@ from rrcache.atomic import OutputFolder
 from rrcache.budgets import budget
 from rrcache.errors import RRCacheError
 from rrcache.files import Refused, read_file
+from rrcache.jsonable import script_json  # noqa: F401  (the data block; tests import it from here too)
 from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.notices import run_warnings
 from rrcache.report import assets
 from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
 from rrcache.report.images import CAPTIONS, FrameShots, data_uri
+from rrcache.report.next_steps import next_steps_html
 
 REPORT_NAME = "report.html"
 #: the figures of :mod:`rrcache.report.plots` the report shows, with their captions
@@ -43,29 +46,16 @@ def _e(value) -> str:
     return html.escape(str(value), quote=True)
 
 
-#: what the data block's JSON spells as escapes: the HTML parser reads a script's text looking
-#: for ``</script`` and, after ``<!--``, for ``<script`` (the "script data escaped" states), so a
-#: shader comment ``<!--<script>`` left raw made the parser swallow the report's own script
-_SCRIPT_ESCAPES = {ord("<"): "\\u003c", ord(">"): "\\u003e", ord("&"): "\\u0026"}
-
-
-def script_json(data) -> str:
-    """``data`` as JSON safe inside ``<script type="application/json">``: no ``<``, ``>`` or ``&``
-    appears raw (nor any non-ASCII character), so no text from a shader, a file name or a session
-    can end or disable the script element; ``JSON.parse`` reads the escapes back as the same text.
-
-    >>> print(script_json({"text": "<!--<script>a && b</script>"}))
-    {"text":"\\u003c!--\\u003cscript\\u003ea \\u0026\\u0026 b\\u003c/script\\u003e"}
-    """
-    return json.dumps(data, separators=(",", ":"), allow_nan=False).translate(_SCRIPT_ESCAPES)
-
-
 def _f(value, digits: int = 4, suffix: str = "") -> str:
+    """A number in plain units: ``digits`` significant digits, large ones whole with thousands
+    separators (139,730 covered pixels, not 1.39730e+05), only tiny ones in exponent form."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
     value = float(value)
-    if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
+    if value != 0 and abs(value) < 1e-4:
         return f"{value:.{max(1, digits - 1)}e}{suffix}"
+    if abs(value) >= 10 ** digits:
+        return f"{value:,.0f}{suffix}"
     return f"{value:.{digits}g}{suffix}"
 
 
@@ -98,7 +88,7 @@ def _summary(prof, timing: dict) -> str:
         (_f(prof.original_ms, 4, " ms"), "original frame time"),
         (_f(prof.mu, 3), "μ (hit rate limit)"),
         (_f(prof.overhead_ms, 3, " ms"), "cache overhead per frame"),
-        (_f(prof.pixels, 6), "covered pixels per frame"),
+        (f"{round(prof.pixels):,}" if prof.pixels else "–", "covered pixels per frame"),
         ((_x(best.measured_speedup) + f" ({best.label})") if best else "–", "best measured speed-up"),
         (_f(prof.training_wall_s, 3, " s"), "training time"),
         (_f(timing["median_ms"], 2, " ms"), f"re-selection (median of {timing['repeats']})"),
@@ -106,7 +96,22 @@ def _summary(prof, timing: dict) -> str:
     if counts:
         cells.append((f"{counts.get('error_runs_computed', 0)} + {counts.get('timing_runs_computed', 0)}",
                       "error + timing runs computed"))
-    return '<div class="summary">' + "".join(f"<div><b>{_e(v)}</b><span>{_e(k)}</span></div>" for v, k in cells) + "</div>"
+    ceiling = prof.measured_ceiling
+    if ceiling is not None:
+        cells.insert(6, (_x(ceiling.speedup), f"ceiling: every pixel hitting ({ceiling.algorithm})"))
+    return ('<div class="summary">' + "".join(f"<div><b>{_e(v)}</b><span>{_e(k)}</span></div>" for v, k in cells)
+            + "</div>" + _warnings(prof))
+
+
+def _warnings(prof) -> str:
+    """The ceiling in words and every warning of the run (rrcache.profiles.notices), under the tiles."""
+    ceiling = prof.measured_ceiling
+    items = [f"<li>ceiling: {_e(ceiling.summary())}</li>"] if ceiling is not None else []
+    warnings = run_warnings(prof)
+    items += [f'<li class="warn">warning: {_e(w)}</li>' for w in warnings]
+    if not warnings:
+        items.append("<li>no warnings: the timings were steady and every level was met as chosen</li>")
+    return f'<ul class="notices">{"".join(items)}</ul>'
 
 
 def _source(prof, lines: list[str]) -> str:
@@ -149,7 +154,7 @@ def _amortized_what(prof, sel) -> str:
             f"λ = {p.blend:g} ({_e(p.history)} history)" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
 
 
-def _multi_selection(sel) -> str:
+def _multi_selection(prof, sel, shots: FrameShots) -> str:
     """A selection of several nodes: what each caches at which period and its figures (its frames
     are not rendered here: the report's images show one cached node or one amortized estimator)."""
     what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
@@ -165,7 +170,8 @@ def _multi_selection(sel) -> str:
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
-            '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
+            '<p class="muted">several nodes: no frames are shown for this choice</p>'
+            f"{next_steps_html(prof, sel, shots.session.resolution)}</div>")
 
 
 def _level(sel) -> str:
@@ -176,7 +182,7 @@ def _level(sel) -> str:
 
 def _selection(prof, sel, shots: FrameShots) -> str:
     if sel.multi:
-        return _multi_selection(sel)
+        return _multi_selection(prof, sel, shots)
     images = shots.selection_images(sel)  # the original, one cached node or one amortized estimator
     amortized = sel.kind == "amortize"
     if amortized:
@@ -184,15 +190,14 @@ def _selection(prof, sel, shots: FrameShots) -> str:
     else:
         what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
                 if sel.node else "keep the original shader (nothing is predicted faster at this level)")
-    if sel.fallback:
-        what += f'<br><span class="warn">measured slowdown, fell back: {_e(sel.fallback)}</span>'
-    if sel.visible_artifacts:
-        what += '<br><span class="warn">below 30 dB PSNR: visible artifacts (a choice, not a default)</span>'
+    what += _level_marks(sel)
     exact = sel.exact or not sel.parts
     predicted_psnr = ("∞ (exact)" if exact else
                       "–" if sel.predicted_psnr is None else
                       f"{sel.predicted_psnr:.1f} ± {sel.predicted_psnr_uncertainty or 0:.1f} dB")
-    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else _f(sel.measured_psnr, 3, " dB"))
+    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else
+                     _f(sel.measured_psnr, 3, " dB") + (f" ± {sel.measured_psnr_uncertainty:.1f}"
+                                                       if sel.measured_psnr_uncertainty else ""))
     speedup = _x(sel.measured_speedup)
     if len(sel.speedups) > 1:
         lo, hi = sel.speedup_range
@@ -204,7 +209,7 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", predicted_speedup, speedup),
             ("PSNR", predicted_psnr, measured_psnr),
-            ("hit rate", "", _f(sel.hit_rate, 3))]
+            ("hit rate", "", _f(sel.hit_rate, 3))] + _measured_rows(sel)
     table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
              + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
              + "</table>")
@@ -227,7 +232,56 @@ def _selection(prof, sel, shots: FrameShots) -> str:
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(node_attr)}" data-kind="{_e(sel.kind)}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
-            f'<div class="shots">{"".join(figures)}</div></div>')
+            f'<div class="shots">{"".join(figures)}</div>{next_steps_html(prof, sel, shots.session.resolution)}</div>')
+
+
+def _level_marks(sel) -> str:
+    """What became of the selection's level (docs/levels.md): the choices refused and why, a
+    miss shipped as measured, visible artifacts."""
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    out = ""
+    if sel.fallback:
+        out += f'<br><span class="warn">fell back: {_e(sel.fallback)}</span>'
+    if sel.level_met is False:
+        out += f'<br><span class="warn miss">MISSED its level as measured: {_e(sel.level_note or "")}</span>'
+    if sel.visible_artifacts:
+        why = (f"mean FLIP {sel.measured_flip:.3f} ≥ {VISIBLE_FLIP:g}" if sel.measured_flip is not None
+               else "below 30 dB PSNR (predicted)")
+        out += f'<br><span class="warn">{_e(why)}: visible artifacts (a choice, not a default)</span>'
+    return out
+
+
+def _measured_rows(sel) -> list:
+    """The measured-only rows of a selection's table: FLIP, the temporal error, the level."""
+    exact = sel.exact or not sel.parts
+    flip = "0" if exact and sel.measured_error is not None else (
+        "–" if sel.measured_flip is None else
+        f"{sel.measured_flip:.4f}" + (f" ± {sel.measured_flip_uncertainty:.4f}" if sel.measured_flip_uncertainty else ""))
+    temporal = "∞ (exact)" if exact and sel.measured_error is not None else _f(sel.measured_temporal_psnr, 3, " dB")
+    if sel.level_met is None:
+        level = "–"
+    elif not sel.level_met:
+        level = "missed"
+    elif sel.parts:
+        level = "met" + (f" (candidate {sel.tries})" if sel.tries > 1 else "")
+    else:
+        level = "original" + (f" ({sel.tries} measured, none met it)" if sel.tries else "")
+    return [("mean FLIP", "", flip), ("PSNR of the frame-to-frame changes", "", temporal), ("level", "", level)]
+
+
+def _prediction_errors(prof) -> str:
+    """How far the PSNR predictions were from validation's measurements (``Profile.calibration``)."""
+    cal = getattr(prof, "calibration", None) or {}
+    raw, calibrated = cal.get("raw") or {}, cal.get("calibrated") or {}
+    if not raw.get("n"):
+        return ""
+    return (f'<p class="muted">PSNR predicted against measured on the {raw["n"]} choices validation measured: '
+            f"|predicted − measured| mean {raw['mean']:.1f} dB, worst {raw['worst']:.1f} dB from the models alone; "
+            f"mean {calibrated['mean']:.1f} dB, worst {calibrated['worst']:.1f} dB as predicted with the calibration "
+            f"of the choices measured before each. The profile now predicts with a "
+            f"{float(cal.get('shift') or 0.0):+.1f} dB calibration (± {float(cal.get('spread') or 0.0):.1f} dB; "
+            "docs/levels.md).</p>")
 
 
 def _plots(prof) -> str:
@@ -322,9 +376,11 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         "source line.</p></div></div>",
         f"<h2>Shader source: {_e(name)}</h2>", _source(prof, lines),
         "<h2>Selections</h2>",
-        '<p class="muted">The four error thresholds e1..e4; predicted by the models, measured by rendering '
-        "the session with the chosen variant beside the original.</p>",
+        '<p class="muted">The four levels e1..e4; predicted by the models, measured by rendering '
+        "the session with the chosen variant beside the original. A level ships only what was measured to "
+        "meet it (docs/levels.md).</p>",
         "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        _prediction_errors(prof),
         _estimators(prof),
         "<h2>Model validation</h2>", _plots(prof),
         "<h2>Settings and training</h2>", _settings(prof),
