@@ -124,7 +124,7 @@ def write(prof, sel: Selection, out_dir, work=None) -> list[str]:
     if work is None:
         work, _session = load_work(prof)
     variant, period = variant_of(prof, sel, work)
-    return variant.write(out, period=period, runtime=runtime_options(prof, sel))
+    return variant.write(out_dir, period=period, runtime=runtime_options(prof, sel))
 
 
 def describe_options(prof, sel: Selection) -> str:
