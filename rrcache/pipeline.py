@@ -51,6 +51,9 @@ class ShaderWork:
     vertex: object = None
     #: the command line's include folders (absolute; the session's own are in the session)
     include_dirs: tuple = ()
+    #: the cache filter every variant of this work compiles with unless told otherwise (a
+    #: profile's: ``Profile.filter``, chosen by rrcache.profiler.filters)
+    filter: str = DEFAULT_FILTER
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -97,14 +100,16 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
     return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
-def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
+def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: Optional[str] = None,
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``;
-    ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule)."""
-    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex, adaptive=adaptive)
+    ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule; ``filter``: the work's
+    when not given)."""
+    return instance(work.table, node_id, algorithm, filter or work.filter, payload_dtype, work.vertex,
+                    adaptive=adaptive)
 
 
-def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
+def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: Optional[str] = None,
                       payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching every node of ``node_ids`` (two or more; one:
     :func:`variant_for`), each with its own payload and period
@@ -112,7 +117,7 @@ def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass",
     node_ids = list(node_ids)
     if len(node_ids) == 1:
         return variant_for(work, node_ids[0], algorithm, filter, payload_dtype)
-    return instance_nodes(work.table, node_ids, algorithm, filter, payload_dtype, work.vertex)
+    return instance_nodes(work.table, node_ids, algorithm, filter or work.filter, payload_dtype, work.vertex)
 
 
 def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:
