@@ -66,7 +66,7 @@ def load_work(prof, include_dirs=()):
     # what profile.json names is the profiled shader and session, before anything parses them
     session = load_session_of(prof)
     work = load_for_session(prof.shader, session, prof.defines, list(include_dirs) + list(prof.include_dirs),
-                            vertex=prof.vertex)
+                            vertex=prof.vertex, term_scores=prof.term_scores)
     check_same_shader(prof, work)
     work.filter = prof.filter  # the variants compile as the profile trained them
     return work, session
