@@ -24,7 +24,7 @@ manifest when the variant is written (:meth:`rrcache.compiler.Variant.write`, ``
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Mapping, Optional
 
@@ -54,6 +54,9 @@ class ShaderWork:
     #: the cache filter every variant of this work compiles with unless told otherwise (a
     #: profile's: ``Profile.filter``, chosen by rrcache.profiler.filters)
     filter: str = DEFAULT_FILTER
+    #: the measured order of its sums (rrcache.profiler.terms; node ids refer to the program it
+    #: ordered); empty: none measured
+    term_scores: dict = field(default_factory=dict)
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -92,7 +95,8 @@ def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, s
     # what changes between the session's frames: the terms of a sum that read it go last
     moving = sorted(per_frame_uniforms(session)) if session is not None else ()
     table = cacheable_nodes(shader, max_iterations=max_unroll, moving=moving, scores=term_scores or None)
-    return ShaderWork(shader, table, all_defines, user, tuple(os.path.abspath(d) for d in include_dirs or ()))
+    return ShaderWork(shader, table, all_defines, user, tuple(os.path.abspath(d) for d in include_dirs or ()),
+                      term_scores=dict(term_scores or {}))
 
 
 def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:

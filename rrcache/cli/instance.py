@@ -60,7 +60,9 @@ _LEVEL_OWNS = {"node": "--node", "estimator": "--estimator", "samples": "--sampl
               help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default=None,
               help="Cache algorithm (default: the profile's with a PROFILE, else three-pass).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True)
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=None,
+              help=f"The cache's hit test and payload reconstruction (default: the profile's with a PROFILE, else "
+                   f"{DEFAULT_FILTER}).")
 @click.option("--payload", type=click.Choice(AMORTIZE_PAYLOADS), default="f4", show_default=True,
               help="32- or 16-bit floats; u8 (with --estimator and --history slots): 8 bits by the range of "
                    "the estimator's terms.")
@@ -101,6 +103,8 @@ def command(ctx, shader, level, node, estimator, samples, blend, history, period
     else:
         why = "--algorithm"
     check_adaptive(adaptive, node, algorithm)
+    if filter_ is None:
+        filter_ = getattr(prof, "filter", None) or DEFAULT_FILTER
     loaded = load_session(source.session) if source.session else None
     if target == "webgl2" and loaded is None:
         raise click.UsageError("--target webgl2 needs --session SESSION (the scene the page draws)")

@@ -95,6 +95,9 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--filter", "filter_", type=click.Choice(FILTER_CHOICES), default="auto", show_default=True,
               help="The cache's hit test and payload reconstruction: auto measures bilinear against plane on "
                    "the first node and keeps plane where faster at about the same PSNR (docs/misses.md).")
+@click.option("--measure-terms", is_flag=True,
+              help="Before training, order the terms of sums whose weights do not fold by what caching each "
+                   "alone costs in error (docs/sums.md).")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
@@ -128,12 +131,13 @@ def _fmt(value, spec=".3g", none="–"):
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, filter_, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
             wait, max_sets, defines, adaptive, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
+                  measure_terms=measure_terms,
                   validate=not no_validate, validation_frames=validation_frames, levels=levels)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),

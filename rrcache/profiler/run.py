@@ -103,8 +103,16 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
         started = time.time()
         try:
             store.begin_run()
+            if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
+                from rrcache.profiler.terms import scores_for
+
+                scores = scores_for(work, session, store, progress)
+                if scores:
+                    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
+                                            term_scores=scores)
             result = train(work, session, resolved, store, progress)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+            prof.term_scores = dict(work.term_scores)
             prof.sets = _sets(prof, work, session, resolved, store, progress)
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators

@@ -141,6 +141,9 @@ class Profile:
     #: the cache filter trained and validated with (``auto`` settings: measured,
     #: :mod:`rrcache.profiler.filters`; the plan keeps what each candidate measured)
     filter: str = "bilinear"
+    #: the measured order of the shader's sums (``measure_terms``: rrcache.profiler.terms), which
+    #: the node ids refer to: whatever loads the shader for this profile must pass it on
+    term_scores: dict = field(default_factory=dict)
     plan: Optional[dict] = None
     untrained: list[str] = field(default_factory=list)
     budget_stopped: bool = False
