@@ -99,7 +99,9 @@ def run(bench_out, scenes=("chess",), labels=("e3",), frames: Optional[int] = No
     from rrcache.session import load_session
 
     bench_out = Path(bench_out)
-    doc = json.loads((bench_out / "bench.json").read_text(encoding="utf-8"))
+    from rrcache.files import read_bytes
+
+    doc = json.loads(read_bytes(bench_out / "bench.json", None))
     result = SizeResult(str(bench_out), time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()))
     t0 = time.time()
     root = default_root()
