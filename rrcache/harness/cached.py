@@ -31,6 +31,7 @@ from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
+from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
 from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD, DEFAULT_SPREAD
 from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
 
@@ -94,8 +95,10 @@ class CachedRenderer:
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
                  color_format: str = "rgba32f", threshold: Optional[float] = None,
-                 fast_period: int = DEFAULT_FAST_PERIOD, spread: float = DEFAULT_SPREAD):
+                 fast_period: int = DEFAULT_FAST_PERIOD, spread: float = DEFAULT_SPREAD,
+                 clock: str = DEFAULT_CLOCK):
         self.ctx = ctx or get_context()
+        self.clock = make_clock(clock, self.ctx)
         self.color_format = color_format
         self.variant = variant
         self.session = session
@@ -214,13 +217,10 @@ class CachedRenderer:
             self._warm = True
         hit_box = {} if self.hit_maps else None
         with watchdog.frame(f"frame {index} of the cached variant"):
-            ctx.finish()
-            cpu_start = time.process_time()
-            start = time.perf_counter()
+            self.clock.start()
             stats = self._frame(hit_box)
-            ctx.finish()
-            ms = (time.perf_counter() - start) * 1000.0
-            cpu_ms = (time.process_time() - cpu_start) * 1000.0
+            ms = self.clock.stop()
+            cpu_ms = self.clock.cpu_ms
         self._last = index
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0
@@ -267,19 +267,18 @@ class CachedRenderer:
                 marks: list = []
 
                 def mark(stage):
-                    self.ctx.finish()
-                    marks.append((stage, time.perf_counter()))
+                    marks.append((stage, self.clock.mark()))
 
-                self.ctx.finish()
-                start = time.perf_counter()
+                self.clock.start()
+                start = self.clock.started
                 self.drawer.render_shadow_map()
                 stats = self.runtime.frame(self.drawer.draw, mark=mark if stages is not None else None)
-                self.ctx.finish()
-                end = time.perf_counter()
+                ms = self.clock.stop()
+                end = self.clock.end
                 self.runtime.read_color()
                 self.runtime.read_depth()
                 if i >= 2:
-                    times.append((end - start) * 1000.0)
+                    times.append(ms)
                     if stages is not None:
                         last = start
                         for stage, at in marks:
@@ -434,21 +433,22 @@ def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_P
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
             window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f",
             threshold: Optional[float] = None, fast_period: int = DEFAULT_FAST_PERIOD,
-            spread: float = DEFAULT_SPREAD) -> Comparison:
+            spread: float = DEFAULT_SPREAD, clock: str = DEFAULT_CLOCK) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
     is called per frame (for progress bars and writing images). ``window``: both render only
     that rectangle of the frame (errors and times are then the window's). ``color_format``: the
     colour target both draw into (:mod:`rrcache.gl.formats`; ``rgba8`` as an application draws,
     the error then being what it displays). ``threshold``, ``fast_period``, ``spread``: the
-    adaptive refresh of a variant compiled for it (:mod:`rrcache.runtime.adaptive`)."""
+    adaptive refresh of a variant compiled for it (:mod:`rrcache.runtime.adaptive`). ``clock``:
+    the frame clock both are timed with (:mod:`rrcache.harness.timing`)."""
     result = Comparison()
     result.color_format = color_format
-    with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
+    with Renderer(prepared, session, resolution, window=window, color_format=color_format, clock=clock) as original, \
             CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
                            depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window,
                            color_format=color_format, threshold=threshold, fast_period=fast_period,
-                           spread=spread) as cached:
+                           spread=spread, clock=clock) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:

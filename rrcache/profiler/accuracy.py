@@ -159,7 +159,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
             refs.append(renderer.render_frame(i))
             meter.step("reference", f"frame {i}")
     with Renderer(work.prepared, session, full, window=plan.timing_window,
-                  color_format=settings.timing_format) as original:
+                  color_format=settings.timing_format, clock=settings.clock) as original:
         for nid in nodes:
             node = profile.node(nid)
             report.training_r2[nid] = node.error_r2
@@ -172,7 +172,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
                     run, _ = _error_run(cached, nid, p, refs, meter)
                     measured[p] = [run.mean_error]
             with CachedRenderer(variant, session, work.prepared, full, period=periods[0],
-                                window=plan.timing_window, color_format=settings.timing_format, **common) as cached:
+                                window=plan.timing_window, color_format=settings.timing_format, clock=settings.clock, **common) as cached:
                 for p in periods:
                     frames = _timing_run(cached, original, nid, p, timing, meter)
                     counted = sum(f.hits + f.misses for f in frames)

@@ -68,7 +68,7 @@ def runtime_kwargs(selection: Selection) -> dict:
 def sweep(work, session, node: str, period: int, thresholds: Sequence[float], frames, timed_frames=None,
           fast_period: int = DEFAULT_FAST_PERIOD, algorithm: str = "three-pass", filter: str = "bilinear",
           cache_options: Optional[dict] = None, window=None, resolution=None, timing_format: str = "rgba8",
-          repeats: int = 1, on_frame=None) -> list[AdaptivePoint]:
+          repeats: int = 1, on_frame=None, clock: str = "wall") -> list[AdaptivePoint]:
     """Measure node ``node`` with adaptive refresh at each of ``thresholds`` (max age ``period``)
     beside the original: the error over ``frames`` (exact colour), the time over
     ``timed_frames`` (default: the first :data:`TIMED_FRAMES` of ``frames``) ``repeats`` times."""
@@ -84,7 +84,7 @@ def sweep(work, session, node: str, period: int, thresholds: Sequence[float], fr
     for threshold in thresholds:
         exact = compare(variant, session, work.prepared, frames, color_format=ERROR_FORMAT, threshold=float(threshold),
                         **common)
-        runs = [compare(variant, session, work.prepared, timed, color_format=timing_format,
+        runs = [compare(variant, session, work.prepared, timed, color_format=timing_format, clock=clock,
                         threshold=float(threshold), **common) for _ in range(max(1, int(repeats)))]
         ratio = statistics.median(r.ms_per_frame / r.original_ms_per_frame for r in runs)
         points.append(AdaptivePoint(node, int(period), float(threshold), int(fast_period), float(exact.mean_error),
@@ -135,7 +135,7 @@ def extend(prof, work, session, settings, thresholds: Sequence[float], fast_peri
             measured[key] = sweep(work, session, part.node, int(part.period), thresholds, frames,
                                   fast_period=fast_period, algorithm=sel.algorithm or "three-pass",
                                   cache_options=settings.cache_options(), window=window,
-                                  timing_format=settings.timing_format)
+                                  timing_format=settings.timing_format, clock=settings.clock)
         best = best_at_level(sel, measured[key])
         if best is None:
             out.append(sel)

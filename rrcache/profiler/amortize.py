@@ -265,11 +265,11 @@ def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, 
     if not todo or not timing:
         return
     fmt = settings.timing_format
-    with Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt) as original:
+    with Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt, clock=settings.clock) as original:
         for m in todo:
             start = clock()
             with CachedRenderer(_variant(work, est, algorithm, m, history, payload), session, work.prepared, full,
-                                period=DEFAULT_PERIOD, window=plan.timing_window, color_format=fmt,
+                                period=DEFAULT_PERIOD, window=plan.timing_window, color_format=fmt, clock=settings.clock,
                                 **settings.cache_options()) as cached:
                 # (the renderer's first frame draws every phase program once, untimed: a phase's
                 # first draw compiles it, 100-300 ms on a 1 ms shader)

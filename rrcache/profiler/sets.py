@@ -213,7 +213,7 @@ class _Runner:
         with Renderer(work.prepared, session, settings.resolution, window=self.error_window) as renderer:
             self.refs = [renderer.render_frame(i) for i in range(settings.frames)]
         self.original = Renderer(work.prepared, session, self.full, window=self.timing_window,
-                                 color_format=settings.timing_format)
+                                 color_format=settings.timing_format, clock=settings.clock)
 
     def _step(self, detail: str, done: int, total: int) -> None:
         if self.progress is not None:
@@ -245,7 +245,7 @@ class _Runner:
                 self._step(f"{label} error", k + 1, total)
         ratios = []
         with CachedRenderer(variant, self.session, self.work.prepared, self.full, period=periods,
-                            window=self.timing_window, color_format=self.settings.timing_format,
+                            window=self.timing_window, color_format=self.settings.timing_format, clock=self.settings.clock,
                             **self.settings.cache_options()) as cached:
             for k, index in enumerate(self.timing):
                 ref = self.original.render_frame(index)

@@ -248,7 +248,8 @@ def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node
     for algorithm in AUTO_CANDIDATES:
         variant = variant_for(work, node_id, algorithm)
         with CachedRenderer(variant, session, work.prepared, full, period=period, window=window,
-                            color_format=settings.timing_format, **settings.cache_options()) as cached:
+                            color_format=settings.timing_format, clock=settings.clock,
+                            **settings.cache_options()) as cached:
             frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
         fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
     return min(fractions, key=fractions.get), fractions
@@ -311,7 +312,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     ceiling: Optional[Ceiling] = None
     fmt = settings.timing_format
     try:
-        original = Renderer(work.prepared, session, full, color_format=fmt)
+        original = Renderer(work.prepared, session, full, color_format=fmt, clock=settings.clock)
         if need_ref_timing:
             rows = []
             for index in timing:
@@ -328,7 +329,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             plan = Plan.from_json(stored_plan)
         if plan.timing_window is not None:
             original.release()
-            original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt)
+            original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt,
+                                clock=settings.clock)
         timed_original = original
         if order.nodes and len(timing) > 0:
             ceiling = _ceiling(work, session, settings, store, plan, order.nodes[0], timing, meter)
@@ -400,7 +402,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             if todo_timing[nid]:
                 built = clock()
                 with CachedRenderer(variant, session, work.prepared, full, period=todo_timing[nid][0],
-                                    window=plan.timing_window, color_format=fmt, **settings.cache_options()) as cached:
+                                    window=plan.timing_window, color_format=fmt, clock=settings.clock,
+                                    **settings.cache_options()) as cached:
                     compile_s = clock() - built
                     for period in todo_timing[nid]:
                         t0 = clock()
@@ -499,7 +502,8 @@ def _measure_overhead(work, session, settings, store, node_id, timing, meter, al
     variant = variant_for(work, node_id, algorithm)
     times = []
     with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
-                        color_format=settings.timing_format, **settings.cache_options()) as cached:
+                        color_format=settings.timing_format, clock=settings.clock,
+                            **settings.cache_options()) as cached:
         for index in timing:
             cached.reset()
             cached.render_frame(index - 1)

@@ -112,6 +112,7 @@ def validate(work: ShaderWork, session, settings: TrainingSettings, store: Profi
             start = (len(frames) - len(short)) * repeat // max(1, REPEATS - 1)
             stretch = frames[start:start + len(short)]
             runs.append(compare(variant, session, work.prepared, stretch, color_format=settings.timing_format,
+                                clock=settings.clock,
                                 on_frame=lambda *a, r=repeat: step(
                                     detail=f"{choice.label}: {choice.describe()} timing [{r + 1}/{REPEATS}]"),
                                 **common))
