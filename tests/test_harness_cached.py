@@ -18,9 +18,9 @@ from rrcache.analysis import cacheable_nodes
 from rrcache.compiler import instance
 from rrcache.glsl.frontend import load_shader
 from rrcache.harness.cached import CachedRenderer, compare
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer
-from rrcache.harness.vertex import mesh_defines, session_attributes
+from rrcache.compiler.vertex import mesh_defines, session_attributes
 from rrcache.session import load_session
 from masks import dilate, erode  # noqa: E402
 

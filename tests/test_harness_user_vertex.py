@@ -23,7 +23,7 @@ from test_profile import SESSION
 from rrcache.errors import RRCacheError, SessionError, UnsupportedShaderError
 from rrcache.harness.cached import compare
 from rrcache.harness.renderer import render
-from rrcache.harness.user_vertex import user_vertex_from_text
+from rrcache.compiler.user_vertex import user_vertex_from_text
 from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
 

@@ -33,7 +33,7 @@ from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import FrameResult, Renderer, check_frame_index, session_background
 from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
-from rrcache.harness.vertex import vertex_for
+from rrcache.compiler.vertex import vertex_for
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, match_scale
 

@@ -329,16 +329,7 @@ def _table(prof) -> Table:
         else:
             table.add_column(name, justify="right")
     for s in prof.selections:
-        if s.multi:  # several nodes, each at its own period
-            node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
-        elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
-            part = s.parts[0]
-            slots = " slots" if part.history == "slots" else ""
-            node, period = (f"{part.estimator} m={part.samples}/{prof.estimator(part.estimator).samples} "
-                            f"λ={part.blend:g}{slots}: {part.text or ''}"), "–"
-        else:
-            node = "(original)" if s.node is None else f"{s.node}: {s.text}"
-            period = _fmt(s.period, "d")
+        node, period = s.choice.cells(s, prof) if s.parts else ("(original)", "–")
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),

@@ -40,6 +40,7 @@ from rrcache.compiler.passes import build_pass
 from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS, depth_channel_for
+from rrcache.runtime.spec import VariantSpec
 
 __all__ = ["instance", "instance_nodes", "check_algorithm", "Variant", "PassSource"]
 
@@ -68,7 +69,7 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     payload reconstruction filter (``nearest``, ``bilinear``, ``catmull-rom``) and
     ``payload_dtype`` the cache precision (``f4``, or ``f2`` for half floats), recorded for the
     runtime. ``vertex`` is the user's vertex shader (a
-    :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
+    :class:`rrcache.compiler.user_vertex.UserVertex`; None: generated). Raises
     :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
     be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
     ``pack_depth``: keep the inverse depth in the payload's free channel when it has one
@@ -109,7 +110,9 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
-        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel, adaptive=bool(adaptive))
+        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel, adaptive=bool(adaptive),
+        spec=VariantSpec("adaptive" if adaptive else "cache", (node_id,) if isinstance(node_id, (int, str)) else (),
+                         algorithm, filter, payload_dtype, pack_depth))
 
 
 from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)

@@ -35,9 +35,9 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
-from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare, prepare_file
+from rrcache.compiler.prepared import PreparedShader, load_user_vertex, prepare, prepare_file
 from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
-from rrcache.harness.vertex import vertex_for
+from rrcache.compiler.vertex import vertex_for
 
 #: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
 #: and flipped (32), the depth read back (4) and the coverage mask (1); checked before allocating
@@ -97,7 +97,7 @@ class Renderer:
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
     images and masks are then of the window's size.
 
-    >>> from rrcache.harness.prepare import prepare_file
+    >>> from rrcache.compiler.prepared import prepare_file
     >>> from rrcache.session import load_session
     >>> session = load_session("sessions/marble.json")
     >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)

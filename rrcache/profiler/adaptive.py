@@ -24,6 +24,7 @@ from typing import Optional, Sequence
 
 from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD
+from rrcache.kinds import spec_for
 from rrcache.selection import AdaptiveNode, CachedNode, Selection
 
 #: thresholds measured by default (in the cached value's units: a colour or an occlusion in [0, 1])
@@ -58,11 +59,13 @@ class AdaptivePoint:
 
 
 def runtime_kwargs(selection: Selection) -> dict:
-    """The runtime's adaptive arguments of ``selection`` (empty unless its part is adaptive)."""
-    if len(selection.parts) == 1 and isinstance(selection.parts[0], AdaptiveNode):
-        p = selection.parts[0]
-        return {"threshold": float(p.threshold), "fast_period": int(p.fast_period), "spread": float(p.spread)}
-    return {}
+    """The runtime's adaptive arguments of ``selection`` (empty unless its spec has a threshold)."""
+    if not selection.parts:
+        return {}
+    spec = spec_for(selection)
+    if spec.threshold is None:
+        return {}
+    return {"threshold": float(spec.threshold), "fast_period": int(spec.fast_period), "spread": float(spec.spread)}
 
 
 def sweep(work, session, node: str, period: int, thresholds: Sequence[float], frames, timed_frames=None,

@@ -261,10 +261,8 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         if not sel.parts:
             prof.write_variant(sel, folder)
         else:
-            variant, period = variant_for_selection(work, sel)
-            from rrcache.profiler.adaptive import runtime_kwargs
-
-            variant.write(folder, period=period, runtime=dict(prof.settings.cache_options(), **runtime_kwargs(sel)))
+            variant, period = variant_for_selection(work, sel, **prof.settings.cache_options())
+            variant.write(folder, period=period, runtime=variant.spec.manifest_runtime())
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out

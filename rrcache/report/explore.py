@@ -153,7 +153,7 @@ def selections_figure(prof, shots: FrameShots):
     fig, axes = plt.subplots(len(prof.selections), len(names), figsize=(2.4 * len(names), 2.2 * len(prof.selections)),
                              dpi=100, squeeze=False)
     for row, sel in zip(axes, prof.selections):
-        if sel.multi:  # no frames (the shots render one cached node or one amortized estimator)
+        if sel.parts and not sel.choice.has_frames:  # no frames (several nodes at once)
             for ax in row:
                 ax.axis("off")
             row[0].text(-0.08, 0.5, f"{sel.label}: {sel.describe()}", transform=row[0].transAxes, rotation=90,
@@ -179,7 +179,7 @@ def default_choice(prof) -> tuple:
     Amortized selections are not nodes: :func:`selections_figure` and the :class:`Explorer` show
     them; :func:`default_selection` returns the last selection of any kind."""
     for sel in reversed(prof.selections):
-        if sel.parts and sel.kind == "cache":
+        if sel.parts and sel.choice.one_node:
             return sel.node, int(sel.period)
     node = prof.trained_nodes[0]
     return node.id, int(max(node.periods))
@@ -190,7 +190,7 @@ def default_selection(prof):
     several nodes at once, which have no frames), else the original's selection: what
     :func:`describe_choice` and :meth:`FrameShots.selection_images` show first."""
     for sel in reversed(prof.selections):
-        if sel.parts and not sel.multi:
+        if sel.parts and sel.choice.has_frames:
             return sel
     return prof.selections[0] if prof.selections else None
 
@@ -200,20 +200,7 @@ def describe_choice(prof, choice) -> str:
     frames, or an estimator amortized (m of N terms per frame, blend λ, its history)."""
     if not choice.parts:
         return "<b>the original shader</b>: no variant is predicted faster within this error"
-    if choice.kind == "amortize":
-        part = choice.parts[0]
-        est = next((e for e in prof.estimators if e.id == part.estimator), None)
-        of = f" of {est.samples}" if est is not None else ""
-        loop = f" <code>{html.escape(est.text)}</code>" if est is not None and est.text else ""
-        how = ("its N/m subset sums kept apart (slots history)" if part.history == "slots"
-               else "blended with the reprojected estimate (blend history)")
-        return (f"amortize estimator <b>{html.escape(part.estimator)}</b>{loop}: <b>{part.samples}{of}</b> terms "
-                f"per frame, {how}, <b>λ = {part.blend:g}</b>")
-    if choice.multi:
-        return "cache " + " + ".join(f"<b>{html.escape(n)}</b> every Δn = {p}"
-                                     for n, p in zip(choice.nodes, choice.periods))
-    return (f"cache <b>{html.escape(choice.node)}</b> <code>{html.escape(prof.node(choice.node).text)}</code> "
-            f"every <b>Δn = {choice.period}</b> frames")
+    return choice.choice.sentence_html(choice, prof)
 
 
 # ---------------------------------------------------------------------- HTML pieces
@@ -254,11 +241,7 @@ def selections_html(prof) -> str:
             "pred. speed-up", "meas. speed-up", "PSNR", "hit rate"]
     rows = []
     for s in prof.selections:
-        if s.kind == "amortize":  # an amortized estimator: m of N terms per frame, blend λ
-            node_cell, period_cell = s.describe(), "–"
-        else:
-            node_cell = " + ".join(s.nodes) if s.multi else (s.node or "original")
-            period_cell = " + ".join(str(p) for p in s.periods) if s.multi else (s.period or "–")
+        node_cell, period_cell = s.choice.cells(s) if s.parts else ("original", "–")
         cells = [s.label, _f(s.max_error), node_cell, period_cell, _f(s.predicted_error),
                  _f(s.measured_error), _f(s.predicted_ms), _f(s.measured_ms), _f(s.predicted_speedup, 3),
                  _f(s.measured_speedup, 3), _f(s.measured_psnr, 3), _f(s.hit_rate, 3)]
@@ -280,9 +263,6 @@ def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
 
     if isinstance(node, Selection):
         choice = node
-        # adaptive refresh is measured as its node at its max age, as before (no adaptive runtime here)
-        node, period = ((choice.node, choice.period) if choice.kind in ("cache", "adaptive", "original")
-                        else (None, None))
     else:
         choice = (Selection((CachedNode(node, int(period)),)) if node is not None
                   else Selection.original(prof.original_ms))
@@ -298,12 +278,8 @@ def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
 
     settings = prof.settings
     count = min(int(frames or settings.validation_frames or shots.session.frames), int(shots.session.frames))
-    if choice.kind in ("cache", "adaptive"):
-        variant, period = shots.variant(node), int(period)
-    else:  # an amortized estimator (its variant does not use the refresh rule), several nodes
-        variant, period = shots.selection_variant(choice)
-    result = compare(variant, shots.session, shots.work.prepared, range(count), period=period,
-                     **settings.cache_options())
+    variant, _ = shots.selection_variant(choice)  # its spec is the choice's, whole
+    result = compare(variant, shots.session, shots.work.prepared, range(count), variant.spec)
     return {"error": result.mean_error, "psnr": result.psnr, "speedup": result.speedup, "ms": result.ms_per_frame,
             "original_ms": result.original_ms_per_frame, "hit_rate": result.hit_rate, "frames": count,
             "stored": False}
@@ -415,7 +391,7 @@ class Explorer:
             self.measured = measure_choice(self.prof, choice, None, self.shots)
         else:
             self.measured = None
-        shown = choice.parts[0].estimator if choice.kind == "amortize" else (choice.node if choice.parts else None)
+        shown = choice.choice.anchor(choice.parts) if choice.parts else None
         self.source.value = source_html(self.prof, shown, context=8) if shown else source_html(self.prof)
 
     def _show_summary(self, max_error: float, pending: bool = False) -> None:

@@ -118,22 +118,9 @@ def _source(prof, lines: list[str]) -> str:
     return legend + '<div class="src">' + "".join(rows) + "</div>"
 
 
-def _amortized_what(prof, sel) -> str:
-    """What an amortized selection does: the estimator, m of N terms per frame, the history and λ."""
-    p = sel.parts[0]
-    est = next((e for e in getattr(prof, "estimators", ()) if e.id == p.estimator), None)
-    of = f" of its {est.samples}" if est is not None else " of its"
-    how = ("each of its N/m subset sums kept apart and blended with its own reprojected value"
-           if p.history == "slots" else "blended with the reprojected estimate")
-    return (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples}{of} terms per frame, {how} by "
-            f"λ = {p.blend:g} ({_e(p.history)} history)" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
-
-
-def _multi_selection(sel) -> str:
-    """A selection of several nodes: what each caches at which period and its figures (its frames
-    are not rendered here: the report's images show one cached node or one amortized estimator)."""
-    what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
-                                 + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
+def _multi_selection(prof, sel) -> str:
+    """A selection of a kind without frames (several nodes): what it caches and its figures."""
+    what = sel.choice.report_html(sel, prof)
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
@@ -155,15 +142,12 @@ def _level(sel) -> str:
 
 
 def _selection(prof, sel, shots: FrameShots) -> str:
-    if sel.multi:
-        return _multi_selection(sel)
-    images = shots.selection_images(sel)  # the original, one cached node or one amortized estimator
-    amortized = sel.kind == "amortize"
-    if amortized:
-        what = _amortized_what(prof, sel)
-    else:
-        what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
-                if sel.node else "keep the original shader (nothing is predicted faster at this level)")
+    kind = sel.choice  # None: the original shader
+    if kind is not None and not kind.has_frames:
+        return _multi_selection(prof, sel)
+    images = shots.selection_images(sel)  # the original, or the choice at the frame its kind shows
+    what = (kind.report_html(sel, prof) if kind is not None
+            else "keep the original shader (nothing is predicted faster at this level)")
     if sel.fallback:
         what += f'<br><span class="warn">measured slowdown, fell back: {_e(sel.fallback)}</span>'
     if sel.visible_artifacts:
@@ -197,13 +181,13 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             h = round(h0 * w / w0)
             figures.append(f'<figure><img alt="{_e(name)}" data-image="{_e(name)}" width="{w}" height="{h}" '
                            f'src="{images.uri(name)}"><figcaption>{_e(images.caption(name))}</figcaption></figure>')
-    settled = " (its history settled: the cycle of subsets and the blend's memory)" if amortized else ""
+    settled = kind.settled_note if kind is not None else ""
     frame_note = (f"frame {images.frame} at {images.size[0]}×{images.size[1]}"
                   + (f", after {images.frame + 1} frames with the cache{settled}: this frame's error "
                      f"{_f(images.error)}, hit rate {_f(images.hit_rate, 3)}; the table's measurements are over "
                      f"{sel.frames} frames of the session" if images.cached else ""))
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
-    node_attr = "" if amortized else (sel.node or "")
+    node_attr = sel.single_node or ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(node_attr)}" data-kind="{_e(sel.kind)}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import base64
 import io
-import math
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -48,20 +47,7 @@ CAPTIONS = {
 }
 
 
-#: how far the blend's memory λ^k must fall before an amortized frame is shown
-SETTLED = 0.05
-
-
-def settle_frame(frames: int, cycle: int, blend: float) -> int:
-    """The frame shown for an amortized selection: after its ``cycle`` (N/m frames, every subset
-    once) and the frames its blend's memory needs (λ^k ≤ 5 %), plus one; at most the session's
-    last frame (``frames`` - 1).
-
-    >>> settle_frame(150, 4, 0.6), settle_frame(150, 4, 0.0), settle_frame(12, 2, 0.9)
-    (11, 5, 11)
-    """
-    memory = math.ceil(math.log(SETTLED) / math.log(blend)) if 0.0 < blend < 1.0 else 0
-    return min(int(frames) - 1, int(cycle) + memory + 1)
+from rrcache.kinds.amortize import SETTLED, settle_frame  # noqa: F401,E402 (the amortize kind shows its frame)
 
 
 def image_size(resolution, max_width: int = MAX_WIDTH) -> tuple[int, int]:
@@ -210,43 +196,35 @@ class FrameShots:
 
     def variant(self, node: str):
         """The compiled variant caching ``node`` (one per node: the refresh period is the runtime's)."""
-        if node not in self._variants:
-            from rrcache.pipeline import variant_for
+        from rrcache.pipeline import variant_for
 
-            self._variants[node] = variant_for(self.work, node, self.profile.algorithm)
-        return self._variants[node]
+        return variant_for(self.work, node, self.profile.algorithm)
 
     def selection_variant(self, selection):
         """``(variant, period)`` of any selection with parts (its ``algorithm``, else the profile's;
-        :func:`rrcache.pipeline.variant_for_selection`), compiled once per kind of choice."""
-        algorithm = selection.algorithm or self.profile.algorithm
-        key = (selection.key, algorithm)
-        if key not in self._variants:
-            if selection.kind == "cache":
-                self._variants[key] = (self.variant(selection.node), int(selection.period))
-            else:
-                from rrcache.pipeline import variant_for_selection
+        :func:`rrcache.pipeline.variant_for_selection`, compiled once: :func:`rrcache.kinds.compile`)."""
+        from rrcache.pipeline import variant_for_selection
 
-                self._variants[key] = variant_for_selection(self.work, selection.replace(algorithm=algorithm))
-        return self._variants[key]
+        algorithm = selection.algorithm or self.profile.algorithm
+        return variant_for_selection(self.work, selection.replace(algorithm=algorithm),
+                                     **self.profile.settings.cache_options())
 
     def selection_images(self, selection) -> ChoiceImages:
-        """The images of a selection: the original (no part), one cached node (kind ``cache`` or
-        ``adaptive``, as :meth:`images`) or an amortized estimator (kind ``amortize``). Several
-        nodes at once have no images here: RRCacheError."""
+        """The images of a selection: the original (no part), else of its kind of choice at the
+        frame the kind shows (:meth:`rrcache.kinds.base.Kind.shown_frame`). A kind without frames
+        (several nodes at once) has none here: RRCacheError."""
         if not selection.parts:
             return self.images(None, None)
-        if selection.kind == "amortize":
-            key = (selection.key, selection.algorithm or self.profile.algorithm)
-            if key not in self._images:
-                self._images[key] = self._render_amortized(selection)
-            return self._images[key]
-        if selection.multi:
+        kind = selection.choice
+        if not kind.has_frames:
             from rrcache.errors import RRCacheError
 
-            raise RRCacheError(f"no frames for a selection of several nodes ({selection.describe()})", "selection",
+            raise RRCacheError(f"no frames for a selection of {kind.title} ({selection.describe()})", "selection",
                                hint="show one node's frames with FrameShots.images(node, period)")
-        return self.images(selection.node, selection.period)
+        key = (selection.key, selection.algorithm or self.profile.algorithm)
+        if key not in self._images:
+            self._images[key] = self._render_selection(selection)
+        return self._images[key]
 
     def frame_for(self, period: Optional[int]) -> int:
         """The frame shown for a refresh period: Δn + 2 frames into the session (at most its last)."""
@@ -263,46 +241,39 @@ class FrameShots:
 
     def images(self, node: Optional[str], period: Optional[int]) -> ChoiceImages:
         """The images of caching ``node`` every ``period`` frames (node None: the original)."""
-        key = (node, None if node is None else int(period))
-        if key not in self._images:
-            self._images[key] = self._render(*key)
-        return self._images[key]
-
-    def _render(self, node: Optional[str], period: Optional[int]) -> ChoiceImages:
-        frame = self.frame_for(period)
-        ref = self.original(frame)
-        out = ChoiceImages(node, period, frame, self.size)
-        out.arrays["original"] = ref.image[..., :3]
         if node is None:
-            return out
-        return self._cached_run(out, self.variant(node), period, ref)
+            key = (None, None)
+            if key not in self._images:
+                frame = self.frame_for(None)
+                out = ChoiceImages(None, None, frame, self.size)
+                out.arrays["original"] = self.original(frame).image[..., :3]
+                self._images[key] = out
+            return self._images[key]
+        from rrcache.selection import CachedNode, Selection
 
-    def _render_amortized(self, selection) -> ChoiceImages:
-        part = selection.parts[0]
+        return self.selection_images(Selection((CachedNode(node, int(period)),), 0.0, float("nan"), 1.0))
+
+    def _render_selection(self, selection) -> ChoiceImages:
+        kind = selection.choice
         variant, period = self.selection_variant(selection)
-        info = getattr(variant, "amortized", None) or {}
-        frame = settle_frame(self.session.frames, info.get("cycle", 1), part.blend)
-        out = ChoiceImages(None, None, frame, self.size, part=part)
-        n, m = info.get("of"), part.samples
-        out.captions["cached"] = f"amortized: {m} of {n} terms per frame"
-        if part.history == "slots":
-            shown = min(3, variant.components)
-            sums = f"{n // m} subset sums" if n else "subset sums"
-            out.captions["payload"] = f"the {sums} (slots; {shown} channel(s) shown)"
-        else:
-            out.captions["payload"] = "running estimate (blend)"
+        frame = kind.shown_frame(selection, variant, self.session.frames)
+        single = selection.node if len(selection.parts) == 1 and hasattr(selection.parts[0], "node") else None
+        part = None if single is not None else selection.parts[0]
+        out = ChoiceImages(single, selection.period if single is not None else None, frame, self.size, part=part)
+        out.captions.update(kind.payload_captions(selection, variant))
         ref = self.original(frame)
         out.arrays["original"] = ref.image[..., :3]
-        return self._cached_run(out, variant, period, ref)
+        return self._cached_run(out, variant, ref)
 
-    def _cached_run(self, out: ChoiceImages, variant, period, ref) -> ChoiceImages:
-        """Render ``variant`` from frame 0 to ``out.frame`` and fill in ``out``'s cached images."""
+    def _cached_run(self, out: ChoiceImages, variant, ref) -> ChoiceImages:
+        """Render ``variant`` (its spec: the selection's, whole) from frame 0 to ``out.frame`` and
+        fill in ``out``'s cached images."""
         from rrcache.harness.cached import CachedRenderer
         from rrcache.harness.metrics import mean_l2
 
         frame = out.frame
-        with CachedRenderer(variant, self.session, self.work.prepared, self.size, period=period,
-                            hit_maps=True, keep_payload=True, **self.profile.settings.cache_options()) as cached:
+        with CachedRenderer(variant, self.session, self.work.prepared, self.size, variant.spec,
+                            hit_maps=True, keep_payload=True) as cached:
             for index in range(frame + 1):
                 got = cached.render_frame(index)
         mask = ref.mask

@@ -124,9 +124,8 @@ class CacheRuntime:
     (:attr:`rrcache.compiler.variant.Variant.depth_channel`): the payload channel its passes keep
     the inverse depth in (one texture and render target fewer), None for its own texture. ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
     the application's culling state alone (the draw callback may set it per object).
-    ``period`` given as a list or tuple (one Δn per node, with ``payload_components`` one count
-    per node) makes the cache of a multi-node variant, a
-    :class:`rrcache.runtime.multi.MultiCacheRuntime`.
+    A variant of several nodes runs in a :class:`rrcache.runtime.multi.MultiCacheRuntime` (one
+    period and one payload per node); :meth:`from_spec` makes either from a variant's spec.
 
     Example, inside a render loop (``draw`` renders the scene with the given program)::
 
@@ -136,17 +135,20 @@ class CacheRuntime:
             image = rt.read_color()
     """
 
-    #: the class made for several periods (one per node): rrcache.runtime.multi registers
-    #: MultiCacheRuntime here (the package imports it), so this module need not import it
-    multi_class: Optional[type] = None
-
-    def __new__(cls, *args, **kwargs):
-        # several periods (one per node): the cache of a multi-node variant
-        if cls is CacheRuntime and isinstance(kwargs.get("period"), (list, tuple)):
-            if CacheRuntime.multi_class is None:
-                raise ValueError("several periods need rrcache.runtime.multi (import rrcache.runtime)")
-            return super().__new__(CacheRuntime.multi_class)
-        return super().__new__(cls)
+    @classmethod
+    def from_spec(cls, ctx: moderngl.Context, programs: dict, spec, size: tuple[int, int], *,
+                  payload_components, payload_dtype: Optional[str] = None, depth_channel: Optional[int] = None,
+                  payload_decode=None, phase_cycle: int = 1, **target) -> "CacheRuntime":
+        """The runtime of a variant described by ``spec`` (a :class:`rrcache.runtime.spec.VariantSpec`,
+        taken whole: algorithm, periods, refresh, adaptive refresh, blend), with what its
+        compilation fixed (``payload_components``, ``depth_channel``, ``payload_decode``,
+        ``phase_cycle``: a compiled variant's :meth:`~rrcache.compiler.variant.Variant.runtime`
+        passes them) and the application's ``target`` options (``color_format``, ``clear_color``,
+        ``seed``, ``cull_back_faces``). ``payload_dtype`` overrides the spec's (a 16- or 8-bit
+        cache starts in 32 bits until its values are known to fit)."""
+        return cls(ctx, programs, spec.algorithm, size, payload_dtype=payload_dtype or spec.payload,
+                   payload_components=payload_components, depth_channel=depth_channel,
+                   payload_decode=payload_decode, phase_cycle=phase_cycle, **spec.runtime_options(), **target)
 
     def __init__(
         self,
@@ -209,6 +211,8 @@ class CacheRuntime:
         if payload_components not in (1, 2, 3, 4):
             raise ValueError(f"payload_components must be 1 to 4, not {payload_components}")
         self.payload_components = int(payload_components)
+        #: each cached node's payload components (one node here; MultiCacheRuntime sets its own)
+        self.node_components = getattr(self, "node_components", None) or (self.payload_components,)
         if depth_channel is not None and (int(depth_channel) != self.payload_components or payload_dtype != "f4"):
             raise ValueError(f"the inverse depth packs into channel {self.payload_components} of a 32-bit payload "
                              f"(rrcache.runtime.glsl.depth_channel_for), not channel {depth_channel} of {payload_dtype}")
@@ -534,6 +538,10 @@ class CacheRuntime:
         if self.payload_components < 4:
             payload = np.concatenate([payload, np.zeros(payload.shape[:2] + (4 - self.payload_components,), np.float32)], axis=-1)
         return payload
+
+    def read_payloads(self) -> list:
+        """Every cached node's payload (:meth:`read_payload`), in node order: one here."""
+        return [self.read_payload()]
 
     def read_inverse_depth(self, current: bool = False) -> np.ndarray:
         """1/w of the visible surface per pixel (0 where nothing is cached), row 0 = top.

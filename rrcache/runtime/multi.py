@@ -1,7 +1,8 @@
 """`MultiCacheRuntime`: the cache of a variant that caches k ≥ 2 nodes, each at its own rate.
 
-:class:`rrcache.runtime.CacheRuntime` given a sequence of periods (``period=(50, 4)``, one per
-node, in the variant's node order) makes one of these; everything else is as for one node
+:class:`MultiCacheRuntime` takes a sequence of periods (``period=(50, 4)``, one per node, in the
+variant's node order; a compiled variant of several nodes makes it with
+``variant.runtime(ctx, programs, size)``); everything else is as for one node
 (the passes, their depth tests, the clears, the window, the queries: the frame loop is the
 one-node runtime's). What differs:
 
@@ -68,8 +69,7 @@ def target_budget(ctx: moderngl.Context, algorithm: str, k: int) -> None:
 
 
 class MultiCacheRuntime(CacheRuntime):
-    """The cache of several nodes (made by :class:`CacheRuntime` from a sequence of periods;
-    see the module docstring). ``payload_components`` is one count per node; ``period`` reads
+    """The cache of several nodes (see the module docstring). ``payload_components`` is one count per node; ``period`` reads
     as the tuple of periods and may be set to one int (every node) or a sequence."""
 
     def __init__(self, ctx: moderngl.Context, programs, algorithm: str = "three-pass",
@@ -266,4 +266,3 @@ class MultiCacheRuntime(CacheRuntime):
         return self._read(self._invdepths[node][index], 1)[..., 0]
 
 
-CacheRuntime.multi_class = MultiCacheRuntime

@@ -1,0 +1,151 @@
+"""Kind ``adaptive``: one cached node refreshed by how fast its value changes
+(:mod:`rrcache.runtime.adaptive`): an entry whose value changed by at least a threshold when last
+recomputed is recomputed every ``fast_period`` frames, the others every ``period`` (the max age).
+
+Its part is :class:`AdaptiveNode`; it is compiled as the node's variant with ``adaptive=True``
+(:func:`rrcache.compiler.instance`) and measured beside the original at each threshold
+(:mod:`rrcache.profiler.adaptive`), each point kept in the store's ``adaptive_point`` table.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar, Optional
+
+from rrcache.errors import RRCacheError
+from rrcache.kinds.base import Kind, only as _only
+from rrcache.runtime.spec import VariantSpec
+
+
+@dataclass(frozen=True)
+class AdaptiveNode:
+    """Part ``adaptive``: node ``node`` cached with adaptive refresh
+    (:mod:`rrcache.runtime.adaptive`): an entry whose value had changed by at least
+    ``threshold`` when last recomputed is recomputed every ``fast_period`` frames, the others
+    every ``period`` frames (the max age). ``text`` is the node's expression, for people.
+
+    >>> AdaptiveNode("n215", 100, 0.01, 8).describe()
+    'n215 adaptive ≥0.01 Δf=8 Δn=100'
+    """
+
+    KIND: ClassVar[str] = "adaptive"
+
+    node: str
+    period: int
+    threshold: float
+    fast_period: int = 4
+    spread: float = 0.0
+    text: Optional[str] = field(default=None, compare=False)
+
+    def key(self) -> tuple:
+        return (self.KIND, self.node, int(self.period), float(self.threshold), int(self.fast_period),
+                float(self.spread))
+
+    def describe(self) -> str:
+        spread = f" spread {self.spread:g}" if self.spread else ""
+        return f"{self.node} adaptive ≥{self.threshold:g} Δf={self.fast_period} Δn={self.period}{spread}"
+
+    @classmethod
+    def from_json(cls, data: dict, where: str) -> "AdaptiveNode":
+        _only(data, ("kind", "node", "period", "threshold", "fast_period", "spread", "text"), where)
+        node = data.get("node")
+        if not isinstance(node, str) or not node:
+            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
+        for key in ("period", "fast_period"):
+            value = data.get(key, 4 if key == "fast_period" else None)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise RRCacheError("must be a whole number >= 1", f"{where}.{key}")
+        for key in ("threshold", "spread"):
+            value = data.get(key, 0.0 if key == "spread" else None)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise RRCacheError("must be a finite number >= 0", f"{where}.{key}")
+        text = data.get("text")
+        if text is not None and not isinstance(text, str):
+            raise RRCacheError("must be a string or null", f"{where}.text")
+        return cls(node, data["period"], float(data["threshold"]), data.get("fast_period", 4),
+                   float(data.get("spread", 0.0)), text)
+
+
+class AdaptiveKind(Kind):
+    name = "adaptive"
+    part = AdaptiveNode
+    title = "one cached node with adaptive refresh"
+    tables = """
+-- adaptive_point: one node with adaptive refresh at one threshold (max age `period`, fast
+--   period `fast_period`) measured beside the original as validation measures
+--   (rrcache.profiler.adaptive): the error over the validation frames drawn exactly, the time
+--   ratio (variant / original, median frame times) in the timing format; speedups: the timed
+--   repeats' speed-ups as a JSON list.
+CREATE TABLE IF NOT EXISTS adaptive_point (
+    node TEXT NOT NULL,
+    period INTEGER NOT NULL,
+    threshold REAL NOT NULL,
+    fast_period INTEGER NOT NULL,
+    algorithm TEXT NOT NULL,
+    error REAL NOT NULL,
+    psnr REAL NOT NULL,
+    time_ratio REAL NOT NULL,
+    hit_rate REAL NOT NULL,
+    speedups TEXT NOT NULL,
+    wall_s REAL NOT NULL,
+    PRIMARY KEY (node, period, threshold, fast_period, algorithm)
+);
+"""
+
+    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+        (p,) = parts
+        return VariantSpec(self.name, (p.node,), algorithm, periods=(int(p.period),), threshold=float(p.threshold),
+                           fast_period=int(p.fast_period), spread=float(p.spread), **runtime)
+
+    def compile(self, work, spec: VariantSpec):
+        from rrcache.compiler import instance
+
+        return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
+                        pack_depth=spec.pack_depth, adaptive=True)
+
+    def training(self, subject, settings) -> list:
+        """``subject`` = (node, period, thresholds, fast_period, algorithm): each threshold measured
+        beside the original (``compare``)."""
+        node, period, thresholds, fast_period, algorithm = subject
+        base = VariantSpec(self.name, (node,), algorithm, periods=(int(period),), fast_period=int(fast_period),
+                           **settings.cache_options())
+        return [("compare", base.with_runtime(threshold=float(t)), ("adaptive", node, int(period), float(t)))
+                for t in thresholds]
+
+    def collect(self, store, result) -> None:
+        store.add_adaptive_point(result)
+
+    def cells(self, selection, profile=None):
+        p = selection.parts[0]
+        return (f"{p.node}: {p.text}" if p.text else p.node), f"{p.period} (adaptive ≥{p.threshold:g}, Δf={p.fast_period})"
+
+    def sentence(self, selection, profile) -> str:
+        p = selection.parts[0]
+        return (f"cache {p.node} ({profile.node(p.node).text}) every Δn = {int(p.period)} frames at most, every "
+                f"{p.fast_period} where its value changed by ≥ {p.threshold:g} (adaptive refresh)")
+
+    def sentence_html(self, selection, profile) -> str:
+        from rrcache.kinds.single import _cache_sentence
+
+        p = selection.parts[0]
+        return (_cache_sentence(p, profile) + f" at most, every <b>{p.fast_period}</b> where its value changed by "
+                f"<b>≥ {p.threshold:g}</b> (adaptive refresh)")
+
+    def report_html(self, selection, profile) -> str:
+        import html
+
+        p = selection.parts[0]
+        return (f"cache <b>{html.escape(p.node)}</b> every Δn = {p.period} frames at most, every {p.fast_period} where "
+                f"its value changed by ≥ {p.threshold:g} (adaptive refresh): <code>{html.escape(p.text or '')}</code>")
+
+    def plot_label(self, selection) -> tuple:
+        p = selection.parts[0]
+        return p.node, int(p.period)
+
+    def summary(self, selection, profile=None) -> dict:
+        p = selection.parts[0]
+        return {"node": p.node, "period": int(p.period), "kind": self.name, "threshold": float(p.threshold),
+                "fast_period": int(p.fast_period), "spread": float(p.spread)}
+
+
+KIND = AdaptiveKind()

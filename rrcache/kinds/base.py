@@ -1,0 +1,128 @@
+"""What a kind of choice is: the :class:`Kind` protocol every module of :mod:`rrcache.kinds` fills.
+
+A kind owns its **part** (the frozen record a :class:`~rrcache.selection.Selection` holds, with its
+JSON and checks), how a selection of it becomes a :class:`~rrcache.runtime.spec.VariantSpec`
+(:meth:`Kind.spec`) and compiled passes (:meth:`Kind.compile`), the runs its training plans
+(:meth:`Kind.training`), its store tables and how a run result is written there
+(:attr:`Kind.tables`, :meth:`Kind.collect`), and how it is shown (:meth:`Kind.describe`,
+:meth:`Kind.cells`, :meth:`Kind.summary`, :meth:`Kind.shown_frame`). Nothing outside the kind's
+module asks which kind it holds: it asks the registry (:func:`rrcache.kinds.kind_of`) and calls
+these methods.
+"""
+from __future__ import annotations
+
+import html
+from typing import ClassVar, Optional
+
+from rrcache.errors import RRCacheError
+from rrcache.runtime.spec import VariantSpec
+
+
+def only(data: dict, keys: tuple, where: str) -> None:
+    """RRCacheError naming the first key of a part's JSON ``data`` that is not in ``keys``."""
+    unknown = sorted(set(data) - set(keys))
+    if unknown:
+        raise RRCacheError(f"unknown key {unknown[0]!r} (known: {', '.join(keys)})", where)
+
+
+def node_part_key(part) -> tuple:
+    """The identity of a node part without its text (what equality compares)."""
+    return part.key()
+
+
+class Kind:
+    """One kind of choice (see the module docstring). Subclasses set the class attributes and
+    override what differs; an instance is registered in :mod:`rrcache.kinds`."""
+
+    #: the registry's name (``VariantSpec.kind``)
+    name: ClassVar[str] = ""
+    #: the part class it owns (its ``KIND`` is the JSON tag), or None for a kind made of other
+    #: kinds' parts (several nodes: several ``cache`` parts)
+    part: ClassVar[Optional[type]] = None
+    #: what it is, for people ("one cached node")
+    title: ClassVar[str] = ""
+    #: its tables in the profile store (commented DDL; part of the store's one schema)
+    tables: ClassVar[str] = ""
+    #: the images of one frame can be shown for it (the report, the notebooks)
+    has_frames: ClassVar[bool] = True
+    #: the selection caches one node whose algorithms and all-hit limit the bench compares
+    one_node: ClassVar[bool] = False
+    #: the marker of its measured point on the fronts' plot (rrcache.report.sets_plot)
+    marker: ClassVar[str] = "s"
+    #: what the report adds to the note of its frame (how long the cache ran before it)
+    settled_note: ClassVar[str] = ""
+
+    # ---------------------------------------------------------------- what it is
+    def claims(self, parts: tuple) -> bool:
+        """Whether ``parts`` (a selection's, non-empty) are a choice of this kind: by default
+        exactly one part of :attr:`part`."""
+        return self.part is not None and len(parts) == 1 and isinstance(parts[0], self.part)
+
+    def spec(self, parts: tuple, algorithm: str, **runtime) -> VariantSpec:
+        """The variant spec of ``parts`` run with ``algorithm``, with the runtime's fields
+        ``runtime`` (``block``, ``refresh``, ``depth_epsilon``)."""
+        raise NotImplementedError
+
+    def compile(self, work, spec: VariantSpec):
+        """The compiled :class:`~rrcache.compiler.variant.Variant` of ``spec`` over ``work`` (a
+        :class:`~rrcache.pipeline.ShaderWork`); :func:`rrcache.kinds.compile` caches it."""
+        raise NotImplementedError
+
+    # ---------------------------------------------------------------- training and the store
+    def training(self, subject, settings) -> list[tuple[str, VariantSpec, tuple]]:
+        """The runs training ``subject`` plans: ``(measure, spec, key)`` each (``measure``
+        ``error`` or ``timing``, :data:`rrcache.runs.MEASURES`; ``key`` what the store files the
+        result under). Kinds without training return []."""
+        return []
+
+    def collect(self, store, result) -> None:
+        """Write one :class:`~rrcache.runs.RunResult` of this kind's training into ``store``
+        (the collector's one call: :class:`rrcache.profiler.collect.Collector`)."""
+        raise RRCacheError(f"{self.title} keeps no training runs", "store")
+
+    # ---------------------------------------------------------------- showing it
+    def describe(self, parts: tuple) -> str:
+        """One line: ``n12 Δn=16``."""
+        return ", ".join(p.describe() for p in parts)
+
+    def cells(self, selection, profile=None) -> tuple[str, str]:
+        """The (what, period) cells of a table row (the profile summary, the notebooks, the
+        bench); with the ``profile``, what it needs to say more (an estimator's N)."""
+        return self.describe(selection.parts), "–"
+
+    def summary(self, selection, profile=None) -> dict:
+        """The JSON fields ``rrcache select --json`` prints for ``selection`` beside the figures."""
+        return {"kind": self.name, "describe": self.describe(selection.parts)}
+
+    def shown_frame(self, selection, variant, frames: int) -> int:
+        """The frame whose images show ``selection`` (its cache in the steady state), at most the
+        session's last (``frames`` - 1)."""
+        period = max(selection.periods or (0,))
+        return min(int(frames) - 1, int(period) + 2)
+
+    def sentence(self, selection, profile) -> str:
+        """What ``selection`` does, in words (``rrcache select``)."""
+        return self.describe(selection.parts)
+
+    def sentence_html(self, selection, profile) -> str:
+        """One line of HTML saying what ``selection`` does (the notebooks' explorer)."""
+        return html.escape(self.describe(selection.parts))
+
+    def report_html(self, selection, profile) -> str:
+        """The report's line of HTML saying what ``selection`` caches."""
+        return self.sentence_html(selection, profile)
+
+    def plot_label(self, selection) -> tuple:
+        """(what, period) of ``selection`` in the report's chart data."""
+        return self.describe(selection.parts), None
+
+    def anchor(self, parts) -> Optional[str]:
+        """The id of the place in the shader the choice changes (a node, an estimator's loop)."""
+        return getattr(parts[0], "node", None)
+
+    def payload_captions(self, selection, variant) -> dict:
+        """Captions of the images that show something else for this kind (the payload)."""
+        return {}
+
+    def __repr__(self) -> str:
+        return f"<kind {self.name}>"
