@@ -44,7 +44,7 @@ def _what(r) -> tuple[str, str]:
     nodes show each expression and period, in part order."""
     if not r.parts:
         return _code(None), _f(None, "d")
-    what, period = r.choice.cells(r)  # the kind of choice says what its cells show
+    what, period = r.choice.cells(r, texts=True)  # the kind of choice says what its cells show
     return _code(what, limit=110), period
 
 

@@ -115,9 +115,10 @@ CREATE TABLE IF NOT EXISTS adaptive_point (
     def collect(self, store, result) -> None:
         store.add_adaptive_point(result)
 
-    def cells(self, selection, profile=None):
+    def cells(self, selection, profile=None, texts=False):
         p = selection.parts[0]
-        return (f"{p.node}: {p.text}" if p.text else p.node), f"{p.period} (adaptive ≥{p.threshold:g}, Δf={p.fast_period})"
+        what = p.text if texts else (f"{p.node}: {p.text}" if p.text else p.node)
+        return what, f"{p.period} (adaptive ≥{p.threshold:g}, Δf={p.fast_period})"
 
     def sentence(self, selection, profile) -> str:
         p = selection.parts[0]

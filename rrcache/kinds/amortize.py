@@ -139,8 +139,10 @@ CREATE TABLE IF NOT EXISTS amortize_run (
     def collect(self, store, result) -> None:
         store.add_amortize_result(result)
 
-    def cells(self, selection, profile=None):
+    def cells(self, selection, profile=None, texts=False):
         p = selection.parts[0]
+        if texts:
+            return f"{self.describe(selection.parts)}: {p.text}", "–"
         est = profile.estimator(p.estimator) if profile is not None else None
         of = f"/{est.samples}" if est is not None else ""
         slots = " slots" if p.history == "slots" else ""

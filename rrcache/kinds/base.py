@@ -85,9 +85,10 @@ class Kind:
         """One line: ``n12 Δn=16``."""
         return ", ".join(p.describe() for p in parts)
 
-    def cells(self, selection, profile=None) -> tuple[str, str]:
+    def cells(self, selection, profile=None, texts: bool = False) -> tuple[str, str]:
         """The (what, period) cells of a table row (the profile summary, the notebooks, the
-        bench); with the ``profile``, what it needs to say more (an estimator's N)."""
+        bench); with the ``profile``, what it needs to say more (an estimator's N); ``texts``:
+        the expressions rather than the ids (the bench's tables)."""
         return self.describe(selection.parts), "–"
 
     def summary(self, selection, profile=None) -> dict:

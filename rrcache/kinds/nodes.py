@@ -54,8 +54,9 @@ CREATE TABLE IF NOT EXISTS set_run (
     def describe(self, parts) -> str:
         return " + ".join(p.describe() for p in parts)
 
-    def cells(self, selection, profile=None):
-        return " + ".join(p.node for p in selection.parts), " + ".join(str(p.period) for p in selection.parts)
+    def cells(self, selection, profile=None, texts=False):
+        what = " + ".join((p.text or p.node) if texts else p.node for p in selection.parts)
+        return what, " + ".join(str(p.period) for p in selection.parts)
 
     def sentence(self, selection, profile) -> str:
         texts = "; ".join(profile.node(p.node).text for p in selection.parts)

@@ -73,8 +73,10 @@ class CacheKind(Kind):
     def collect(self, store, result) -> None:
         store.add_node_result(result)
 
-    def cells(self, selection, profile=None):
+    def cells(self, selection, profile=None, texts=False):
         p = selection.parts[0]
+        if texts:
+            return p.text, str(p.period)
         return (f"{p.node}: {p.text}" if p.text else p.node), str(p.period)
 
     def summary(self, selection, profile=None) -> dict:
