@@ -122,3 +122,41 @@ def variant_for_selection(work: ShaderWork, selection: Selection, **runtime) -> 
     spec = kinds.spec_for(selection, selection.algorithm or "three-pass", **runtime)
     period = spec.period
     return kinds.compile(work, spec), list(period) if isinstance(period, tuple) else period
+
+
+@dataclass(frozen=True)
+class WorkSource:
+    """How to load a :class:`ShaderWork` and its session, as a plain record (a worker of a
+    distributed executor loads it once): the shader and session paths, the user's ``defines``
+    (pairs), include folders, vertex shader and unroll limit, as :func:`load_for_session` takes
+    them."""
+
+    shader: str
+    session: str
+    defines: tuple = ()
+    include_dirs: tuple = ()
+    vertex: Optional[str] = None
+    max_unroll: int = DEFAULT_MAX_ITERATIONS
+
+    @classmethod
+    def of(cls, work: ShaderWork, session, user_defines=None) -> "WorkSource":
+        """The source of a loaded ``work`` over ``session`` (``user_defines``: the ``-D`` ones)."""
+        return cls(str(work.shader.path), str(session.path), tuple(sorted((user_defines or {}).items())),
+                   tuple(work.include_dirs), getattr(work.vertex, "path", None), int(work.max_unroll))
+
+    def load(self) -> tuple[ShaderWork, object]:
+        """(work, session), loaded and analysed."""
+        from rrcache.session import load_session
+
+        session = load_session(self.session)
+        work = load_for_session(self.shader, session, dict(self.defines), self.include_dirs, self.max_unroll,
+                                vertex=self.vertex)
+        return work, session
+
+
+def load_bench(source: WorkSource):
+    """A :class:`rrcache.harness.execute.Bench` for ``source`` (what a worker makes once, then runs
+    :func:`rrcache.harness.execute.execute` on for every spec it is given)."""
+    from rrcache.harness.execute import Bench
+
+    return Bench(*source.load())

@@ -29,7 +29,7 @@ LAYERS = [
     {"budgets", "deep", "atomic", "stdio", "watchdog"},
     {"glsl", "session", "gl"},
     {"analysis", "runtime"},
-    {"compiler"},
+    {"compiler", "runs"},
     {"kinds"},
     {"selection"},
     {"model", "harness"},

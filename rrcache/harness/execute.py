@@ -2,23 +2,23 @@
 its :class:`~rrcache.runs.RunResult`, and the in-process executor.
 
 :class:`Bench` is what a process keeps to run many specs of one shader over one session: the
-shader work and the session (loaded once per process or worker: :meth:`Bench.load`), the compiled
+shader work and the session (loaded once per process or worker: :func:`rrcache.pipeline.load_bench`), the compiled
 variants (:func:`rrcache.kinds.compile`), the original's reference frames of the error runs
 (rendered once per frame set, window and resolution), the timed original of each timing set-up,
 and the last cached renderer (one renderer serves every period, threshold and blend of a variant:
 :meth:`~rrcache.harness.cached.CachedRenderer.respec`). An executor runs specs on a bench;
 :class:`LocalExecutor` does it in this process, in order. Another executor (a Dask one, say) needs
-only to build a bench per worker with :meth:`Bench.load` and call :func:`execute` there: specs and
-results are plain records.
+only to build a bench per worker with :func:`rrcache.pipeline.load_bench` (from a plain
+:class:`rrcache.pipeline.WorkSource`) and call :func:`execute` there: specs and results are plain
+records.
 
->>> bench = Bench.load(WorkSource("shaders/marble.glsl", "sessions/marble.json"))      # doctest: +SKIP
+>>> bench = load_bench(WorkSource("shaders/marble.glsl", "sessions/marble.json"))      # doctest: +SKIP
 >>> result = execute(RunSpec("error", spec, tuple(range(8)), (640, 480)), bench)      # doctest: +SKIP
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
 from typing import Callable, Iterable, Iterator, Optional
 
 from rrcache import kinds
@@ -31,20 +31,6 @@ from rrcache.runs import PSNR_CAP, FrameRow, RunResult, RunSpec
 FrameCallback = Callable[[RunSpec, int], None]
 
 
-@dataclass(frozen=True)
-class WorkSource:
-    """How to load the shader work and the session of a bench, as a plain record (a worker loads
-    it once): the shader and session paths, the user's defines, include folders, vertex shader
-    and unroll limit, as :func:`rrcache.pipeline.load_for_session` takes them."""
-
-    shader: str
-    session: str
-    defines: tuple = ()
-    include_dirs: tuple = ()
-    vertex: Optional[str] = None
-    max_unroll: Optional[int] = None
-
-
 class Bench:
     """A process's state for running specs over one shader work and session (see the module
     docstring). Close it (or use ``with``) to release its GL objects."""
@@ -55,18 +41,6 @@ class Bench:
         self._references: dict = {}
         self._originals: dict = {}
         self._cached: Optional[tuple] = None
-
-    @classmethod
-    def load(cls, source: WorkSource) -> "Bench":
-        """A bench for ``source``: the session and the shader loaded and analysed once."""
-        from rrcache.pipeline import load_for_session
-        from rrcache.session import load_session
-
-        session = load_session(source.session)
-        extra = {} if source.max_unroll is None else {"max_unroll": int(source.max_unroll)}
-        work = load_for_session(source.shader, session, dict(source.defines), source.include_dirs,
-                                vertex=source.vertex, **extra)
-        return cls(work, session)
 
     # ---------------------------------------------------------------- what the runs share
     def references(self, spec: RunSpec, on_frame: Optional[FrameCallback] = None) -> list:

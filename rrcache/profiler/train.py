@@ -71,19 +71,7 @@ OVERHEAD_SIZE = (8, 8)
 PSNR_CAP = 100.0
 
 
-@dataclass
-class ProgressEvent:
-    """Sent to the ``progress`` callback: ``stage`` (``reference``, ``error``, ``timing``,
-    ``overhead``, ``validate``), frames rendered ``done`` of ``total`` planned (the plan shrinks
-    when the budget stops the training), and a short ``detail`` (node and period)."""
-
-    stage: str
-    done: int
-    total: int
-    detail: str = ""
-
-
-ProgressFn = Callable[[ProgressEvent], None]
+from rrcache.profiler.events import ProgressEvent, ProgressFn  # noqa: F401 (re-exported)
 
 
 class _Meter:
