@@ -130,5 +130,37 @@ class RunResult:
 
     @property
     def steady_error(self) -> float:
+        """The mean error of the steady frames."""
         rows = self.steady
         return float(sum(r.error for r in rows) / len(rows)) if rows else 0.0
+
+    @property
+    def steady_psnr(self) -> float:
+        """The mean PSNR (capped) of the steady frames."""
+        rows = self.steady
+        return float(sum(min(r.psnr, PSNR_CAP) for r in rows) / len(rows)) if rows else PSNR_CAP
+
+    @property
+    def hit_rate(self) -> float:
+        """Hits over hits and misses of the steady frames (NaN where nothing could count them)."""
+        rows = [r for r in self.steady if r.hits is not None and r.misses is not None]
+        if not rows:
+            return math.nan
+        hits, total = sum(r.hits for r in rows), sum(r.hits + r.misses for r in rows)
+        return hits / total if total else 0.0
+
+    @property
+    def ms(self) -> float:
+        """The median frame time of the steady frames."""
+        return _median([r.ms for r in self.steady])
+
+    @property
+    def original_ms(self) -> float:
+        """The median frame time of the original beside the steady frames."""
+        return _median([r.original_ms for r in self.steady])
+
+
+def _median(values) -> float:
+    import statistics
+
+    return float(statistics.median(values)) if values else math.nan

@@ -1,7 +1,7 @@
 """Dump and compare what two versions of rrcache produce: node tables, emitted passes and the
 shipped selections of a resumed profile (the successor of ``tools/compare_node_tables.py``).
 
-    python tools/compare_behaviour.py dump ROOT OUT [--inputs DIR] [--profile DIR] [--quick]
+    python tools/compare_behaviour.py dump ROOT OUT [--inputs DIR] [--profile DIR] [--train] [--quick]
     python tools/compare_behaviour.py compare DUMP_A DUMP_B [--ignore KEY ...]
     python tools/compare_behaviour.py make-profile ROOT OUT [--inputs DIR]
 
@@ -17,6 +17,12 @@ one interpreter) over the shaders of ``--inputs`` (a folder holding ``shaders/``
   set (three-pass and two-pass), the costliest node with adaptive refresh, and every estimator
   amortized (blend, m = N/4; slots at the largest m that fits; slots in 8 bits where the terms'
   range is known).
+
+With ``--train``, two small scenes (the demo scene and the amortization tests' scene) are profiled
+afresh with settings that make what is trained independent of timing (a budget nothing reaches, no
+minimum gain, a fixed algorithm, no validation), and ``OUT/training.json`` gets what the error runs
+measured: every node error run and frame, every estimator error run, the trained sets' errors (the
+sets trained depend on the timing models: only the sets both dumps trained are compared).
 
 With ``--profile DIR`` (a profile folder made by ``make-profile``), a copy of it is resumed with the
 same command line (every run is in its store, so nothing is measured and the result is
@@ -142,6 +148,48 @@ def dump_profile(folder, args, volatile):
         record[f"select --max-error {level}"] = run(["select", folder, "--max-error", level, "--json"])
     return record
 
+TRAIN_ARGS = ["--periods", "2,4", "--frames", "8", "--timing-frames", "3", "--timing-periods", "2,4",
+              "--budget", "100000", "--min-gain", "0", "--algorithm", "three-pass", "--no-validate", "--sets", "2",
+              "--min-saving", "0.5", "--quiet"]
+
+def dump_training(scenes):
+    import sqlite3
+    out = {}
+    for name, shader, session in scenes:
+        with tempfile.TemporaryDirectory() as tmp:
+            code, _, err = run(["profile", shader, session, *TRAIN_ARGS, "--out", tmp])
+            rec = {"code": code, "stderr": err if code else ""}
+            db = Path(tmp) / "profile.sqlite"
+            if db.exists():
+                conn = sqlite3.connect(str(db))
+                q = lambda sql: [list(r) for r in conn.execute(sql)]
+                tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+                rec["error_run"] = q("SELECT node, period, mean_error, psnr, hit_rate, hits, misses, covered, frames "
+                                     "FROM error_run ORDER BY node, period")
+                rec["error_frame"] = q("SELECT node, period, frame, mean_error, psnr, hits, misses, covered, left_out "
+                                       "FROM error_frame ORDER BY node, period, frame")
+                rec["reference_frame"] = q("SELECT frame, covered FROM reference_frame ORDER BY frame")
+                if "amortize_run" in tables:
+                    cols = [c[1] for c in conn.execute("PRAGMA table_info(amortize_run)")]
+                    hist = "history" if "history" in cols else "'blend'"
+                    rec["amortize_error"] = q(f"SELECT estimator, {hist}, samples, blend, mean_error, psnr, hit_rate, "
+                                              "hits, misses FROM amortize_run WHERE kind = 'error' "
+                                              "ORDER BY estimator, 2, samples, blend")
+                if not rec.get("amortize_error"):  # (a store without estimators may lack the table)
+                    rec.pop("amortize_error", None)
+                if "set_run" in tables:
+                    sets = [json.loads(r[0]) for r in conn.execute("SELECT record FROM set_run")]
+                else:
+                    raw = dict(conn.execute("SELECT key, value FROM meta")).get("sets")
+                    sets = json.loads(raw) if raw else []
+                rec["sets"] = {"+".join(f"{n}:{p}" for n, p in zip(d["nodes"], d["periods"])):
+                               [d.get("trained_error"), d.get("trained_psnr"), d.get("trained_hit_rates")]
+                               for d in sets if d.get("trained")}
+                conn.close()
+            out[name] = rec
+            print("trained", name, flush=True)
+    return out
+
 if __name__ == "__main__":
     job = json.loads(sys.argv[1])
     out = Path(job["out"])
@@ -151,6 +199,8 @@ if __name__ == "__main__":
         name = shader.replace("/", "__")
         (out / f"{name}.json").write_text(json.dumps(record, indent=1, sort_keys=True))
         print("dumped", shader, flush=True)
+    if job.get("train"):
+        (out / "training.json").write_text(json.dumps(dump_training(job["train"]), indent=1, sort_keys=True))
     if job.get("profile"):
         record = dump_profile(job["profile"], job["profile_args"], set(job["volatile"]))
         (out / "profile.json").write_text(json.dumps(record, indent=1, sort_keys=True))
@@ -179,12 +229,37 @@ def _run_driver(root: str, inputs: Path, job: dict) -> int:
         os.unlink(driver)
 
 
-def dump(root: str, out: str, inputs: str = ".", profile: str | None = None, quick: bool = False) -> int:
+def _train_scenes(inputs: Path, tmp: str) -> list:
+    """The demo scene, and the amortization tests' scene written from their test module."""
+    scenes = [("demo", DEMO_SHADER, DEMO_SESSION)]
+    values = {}
+    for module, name in (("test_profile_amortize.py", "SHADER"), ("test_profile.py", "SESSION")):
+        source = inputs / "tests" / module
+        if source.exists():
+            import ast
+            for node in ast.parse(source.read_text()).body:
+                if isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Name) and node.targets[0].id == name:
+                    try:
+                        values[name] = ast.literal_eval(node.value)
+                    except ValueError:
+                        pass
+    if len(values) == 2:
+        shader, session = Path(tmp) / "soft.frag", Path(tmp) / "orbit.json"
+        shader.write_text(values["SHADER"])
+        session.write_text(json.dumps({**values["SESSION"], "resolution": [64, 64]}))
+        scenes.append(("amortize", str(shader), str(session)))
+    return scenes
+
+
+def dump(root: str, out: str, inputs: str = ".", profile: str | None = None, quick: bool = False,
+         train: bool = False, no_shaders: bool = False) -> int:
     inputs_path = Path(inputs).resolve()
-    job = {"out": os.path.abspath(out), "shaders": _shaders(inputs_path), "quick": quick, "volatile": sorted(VOLATILE)}
-    tmp = None
+    job = {"out": os.path.abspath(out), "shaders": [] if no_shaders else _shaders(inputs_path), "quick": quick,
+           "volatile": sorted(VOLATILE)}
+    tmp = tempfile.mkdtemp(prefix="rrcache-compare-")
+    if train:
+        job["train"] = _train_scenes(inputs_path, tmp)
     if profile:
-        tmp = tempfile.mkdtemp(prefix="rrcache-compare-")
         folder = Path(tmp) / "demo.rrprofile"
         shutil.copytree(profile, folder)
         job["profile"] = str(folder)
@@ -192,8 +267,7 @@ def dump(root: str, out: str, inputs: str = ".", profile: str | None = None, qui
     try:
         return _run_driver(root, inputs_path, job)
     finally:
-        if tmp:
-            shutil.rmtree(tmp, ignore_errors=True)
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def make_profile(root: str, out: str, inputs: str = ".") -> int:
@@ -240,6 +314,11 @@ def compare(a: str, b: str, ignore=()) -> int:
             diffs += 1
             continue
         x, y = _drop(json.loads(pa.read_text()), set(ignore)), _drop(json.loads(pb.read_text()), set(ignore))
+        if name == "training.json":  # the sets trained depend on timing: compare those both trained
+            for scene in set(x) & set(y):
+                a, b = x[scene].get("sets", {}), y[scene].get("sets", {})
+                common = set(a) & set(b)
+                x[scene]["sets"], y[scene]["sets"] = {k: a[k] for k in common}, {k: b[k] for k in common}
         if x == y:
             count = len(x.get("variants", ())) if isinstance(x, dict) else 0
             print(f"same {name}" + (f" ({count} variants)" if count else ""))
@@ -263,6 +342,8 @@ def main(argv: list[str]) -> int:
     d.add_argument("--inputs", default=".")
     d.add_argument("--profile", default=None)
     d.add_argument("--quick", action="store_true", help="one algorithm per node")
+    d.add_argument("--train", action="store_true", help="profile two small scenes afresh and dump their error runs")
+    d.add_argument("--no-shaders", action="store_true", help="leave out the node tables and passes")
     c = sub.add_parser("compare")
     c.add_argument("a")
     c.add_argument("b")
@@ -274,7 +355,7 @@ def main(argv: list[str]) -> int:
     m.add_argument("--inputs", default=".")
     args = parser.parse_args(argv)
     if args.what == "dump":
-        return dump(args.root, args.out, args.inputs, args.profile, args.quick)
+        return dump(args.root, args.out, args.inputs, args.profile, args.quick, args.train, args.no_shaders)
     if args.what == "compare":
         return compare(args.a, args.b, args.ignore)
     return make_profile(args.root, args.out, args.inputs)

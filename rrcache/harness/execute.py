@@ -164,17 +164,19 @@ def _compare(spec: RunSpec, bench: Bench, step, start: float) -> RunResult:
 class LocalExecutor:
     """Runs specs in this process, in order, on one :class:`Bench` (``on_frame`` for progress).
 
-    The executor interface (what another executor provides too): :meth:`run` takes the specs and
-    yields one :class:`~rrcache.runs.RunResult` per spec (here in order, as each finishes); a
-    ``KeyboardInterrupt`` stops it between frames (the results already yielded stand)."""
+    The executor interface (what another executor provides too): :meth:`run` takes the specs (and
+    an ``on_frame`` for this call's progress, else the executor's) and yields one
+    :class:`~rrcache.runs.RunResult` per spec (here in order, as each finishes; a caller that
+    stops iterating stops the runs not begun); a ``KeyboardInterrupt`` stops it between frames
+    (the results already yielded stand); :meth:`close` releases what it holds."""
 
     def __init__(self, bench: Bench, on_frame: Optional[FrameCallback] = None):
         self.bench = bench
         self.on_frame = on_frame
 
-    def run(self, specs: Iterable[RunSpec]) -> Iterator[RunResult]:
+    def run(self, specs: Iterable[RunSpec], on_frame: Optional[FrameCallback] = None) -> Iterator[RunResult]:
         for spec in specs:
-            yield execute(spec, self.bench, self.on_frame)
+            yield execute(spec, self.bench, on_frame or self.on_frame)
 
     def close(self) -> None:
         self.bench.close()

@@ -173,10 +173,14 @@ class CompileCache:
 
     @staticmethod
     def key(work, spec: VariantSpec) -> tuple:
-        """(shader hash, unroll limit, compiled spec); a work without a hash is its own key."""
+        """(shader hash, its file and its vertex shader's, unroll limit, compiled spec): the hash
+        covers what is compiled, the paths what the variant names (its manifest, its messages);
+        a work without a hash is its own key."""
         shader = getattr(work, "hash", None)
-        source = (shader, getattr(work, "max_unroll", None)) if shader else ("object", id(work))
-        return source + (spec.compiled(),)
+        if not shader:
+            return ("object", id(work), spec.compiled())
+        paths = (str(getattr(work.shader, "path", None)), str(getattr(getattr(work, "vertex", None), "path", None)))
+        return (shader, *paths, getattr(work, "max_unroll", None), spec.compiled())
 
     def get(self, work, spec: VariantSpec):
         key = self.key(work, spec)

@@ -103,10 +103,10 @@ CREATE TABLE IF NOT EXISTS adaptive_point (
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
                         pack_depth=spec.pack_depth, adaptive=True)
 
-    def training(self, subject, settings) -> list:
-        """``subject`` = (node, period, thresholds, fast_period, algorithm): each threshold measured
-        beside the original (``compare``)."""
-        node, period, thresholds, fast_period, algorithm = subject
+    def training(self, subject, settings, algorithm) -> list:
+        """``subject`` = (node, period, thresholds, fast_period): each threshold measured beside the
+        original (``compare``)."""
+        node, period, thresholds, fast_period = subject
         base = VariantSpec(self.name, (node,), algorithm, periods=(int(period),), fast_period=int(fast_period),
                            **settings.cache_options())
         return [("compare", base.with_runtime(threshold=float(t)), ("adaptive", node, int(period), float(t)))

@@ -124,12 +124,12 @@ CREATE TABLE IF NOT EXISTS amortize_run (
                                   phase=spec.phase, history=spec.history, filter=spec.filter,
                                   payload_dtype=spec.payload, vertex=work.vertex)
 
-    def training(self, subject, settings) -> list:
+    def training(self, subject, settings, algorithm) -> list:
         """``subject`` = (estimator id, history, payload, [(m, [λ, ...]), ...], timed m list): the
         error runs at each (m, λ) and the timing runs at each timed m."""
         estimator, history, payload, errors, timed = subject
         key = history if payload == "f4" else f"{history}/{payload}"
-        base = VariantSpec(self.name, (), settings.algorithm, payload=payload, estimator=estimator, history=history,
+        base = VariantSpec(self.name, (), algorithm, payload=payload, estimator=estimator, history=history,
                            **settings.cache_options())
         out = [("error", _with(base, m, lam), ("amortize", estimator, key, int(m), float(lam)))
                for m, blends in errors for lam in blends]

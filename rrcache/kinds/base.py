@@ -69,10 +69,11 @@ class Kind:
         raise NotImplementedError
 
     # ---------------------------------------------------------------- training and the store
-    def training(self, subject, settings) -> list[tuple[str, VariantSpec, tuple]]:
-        """The runs training ``subject`` plans: ``(measure, spec, key)`` each (``measure``
-        ``error`` or ``timing``, :data:`rrcache.runs.MEASURES`; ``key`` what the store files the
-        result under). Kinds without training return []."""
+    def training(self, subject, settings, algorithm: str) -> list[tuple[str, VariantSpec, tuple]]:
+        """The runs training ``subject`` with ``settings`` (a
+        :class:`~rrcache.profiles.settings.TrainingSettings`) and ``algorithm`` plans:
+        ``(measure, spec, key)`` each (``measure`` of :data:`rrcache.runs.MEASURES`; ``key``
+        what the collector files the result under). Kinds without training return []."""
         return []
 
     def collect(self, store, result) -> None:

@@ -43,10 +43,10 @@ CREATE TABLE IF NOT EXISTS set_run (
 
         return instance_nodes(work.table, list(spec.nodes), spec.algorithm, spec.filter, spec.payload, work.vertex)
 
-    def training(self, subject, settings) -> list:
+    def training(self, subject, settings, algorithm) -> list:
         """``subject``: (node ids, periods) of one set: an error run and a timing run."""
         nodes, periods = subject
-        spec = VariantSpec(self.name, tuple(nodes), settings.algorithm, periods=tuple(periods),
+        spec = VariantSpec(self.name, tuple(nodes), algorithm, periods=tuple(periods),
                            **settings.cache_options())
         key = ("set", tuple(nodes), tuple(int(p) for p in periods))
         return [("error", spec, key), ("timing", spec, key)]

@@ -64,9 +64,9 @@ class CacheKind(Kind):
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
                         pack_depth=spec.pack_depth)
 
-    def training(self, subject, settings) -> list:
+    def training(self, subject, settings, algorithm) -> list:
         """A node (``subject``, its id) at each training period (error) and timing period (timing)."""
-        base = VariantSpec(self.name, (subject,), settings.algorithm, **settings.cache_options())
+        base = VariantSpec(self.name, (subject,), algorithm, **settings.cache_options())
         return ([("error", base.with_runtime(periods=(p,)), ("node", subject, p)) for p in settings.periods]
                 + [("timing", base.with_runtime(periods=(p,)), ("node", subject, p)) for p in settings.timing_periods])
 

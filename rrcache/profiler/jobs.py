@@ -101,10 +101,12 @@ class RunPlan:
     """Groups of runs executed in order within a budget (see the module docstring).
 
     ``done(spec)``: the store holds this run's result (resume); ``spent()``: seconds the budget has
-    spent; ``budget``: seconds (None: no limit)."""
+    spent; ``budget``: seconds (None: no limit); ``completed()``: groups complete, earlier
+    invocations included (the progress's estimate of the seconds per group)."""
 
     def __init__(self, groups: list, done: Callable[[RunSpec], bool] = lambda spec: False,
-                 budget: Optional[float] = None, spent: Callable[[], float] = lambda: 0.0):
+                 budget: Optional[float] = None, spent: Callable[[], float] = lambda: 0.0,
+                 completed: Optional[Callable[[], int]] = None):
         self.groups = []
         self.skipped: list[Group] = []
         self.resumed = 0
@@ -115,6 +117,8 @@ class RunPlan:
                 self.groups.append(Group(group.name, todo, group.started or len(todo) < len(group.runs)))
         self.budget = budget
         self.spent = spent
+        #: groups complete so far, earlier invocations included (default: this execution's)
+        self.completed = completed
 
     @property
     def total(self) -> int:
@@ -133,17 +137,18 @@ class RunPlan:
                 if meter is not None:
                     meter.shrink(sum(r.cost for r in group.runs))
                 continue
-            for result in executor.run(group.runs):
+            for result in executor.run(group.runs, on_frame=meter.on_frame() if meter is not None else None):
                 collect(result)
                 out.append(result)
             finished += 1
             if after_group is not None:
                 after_group(group)
             if meter is not None:
-                self._expect(meter, finished, self.groups[k + 1:])
+                self._expect(meter, self.completed() if self.completed is not None else finished,
+                             self.groups[k + 1:])
         return out
 
-    def _expect(self, meter: Meter, finished: int, rest: list, tail: int = 0) -> None:
+    def _expect(self, meter: Meter, finished: int, rest: list) -> None:
         """After each group, plan only the groups the budget is expected to reach (at the mean
         seconds per group so far), so the progress's total and ETA are those of the run that will
         happen."""

@@ -23,7 +23,9 @@ import time
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache import kinds
 from rrcache.errors import RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -80,21 +82,29 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     try:
         store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
         started = time.time()
+        # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+        # the original's reference frames rendered once
+        compiled = sum(kinds.compile_counts().values())
+        executor = LocalExecutor(Bench(work, session))
         try:
             store.begin_run()
-            result = train(work, session, resolved, store, progress)
+            result = train(work, session, resolved, store, progress, executor=executor)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
-            prof.sets = _sets(prof, work, session, resolved, store, progress)
+            prof.sets = _sets(prof, work, session, resolved, store, progress, executor)
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress)
+            prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=executor)
+            executor.close()  # validation renders side by side with its own renderers
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
-                                         window=result.plan.timing_window if result.plan is not None else None)
+                                         window=result.plan.timing_window if result.plan is not None else None,
+                                         store=store, executor=executor)
             _write_outputs(prof, out, work, plots)
+            # how many variants this invocation compiled (each at most once: the compile cache)
+            prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
             prof.write(out)
@@ -104,6 +114,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         except BaseException:
             _end_quietly(store, "failed")
             raise
+        finally:
+            executor.close()
         store.close()
     finally:
         lock.release()
@@ -181,12 +193,12 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     return prof
 
 
-def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+def _sets(prof: Profile, work, session, settings, store, progress, executor=None) -> list:
     """The sets of several cached nodes predicted to improve the front, the few picked trained
     (:mod:`rrcache.profiler.sets`)."""
     from rrcache.profiler.sets import train_sets
 
-    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets, executor=executor)
 
 
 def _psnr_offset(store, settings, result: TrainingResult) -> float:

@@ -1,8 +1,15 @@
 """The profile store: a versioned SQLite file of every training measurement.
 
-In the manner of coverage.py's data file: the schema is one commented string (:data:`SCHEMA`), a
-``meta`` table names what the file belongs to, and nothing in a file is trusted before it is
-checked. A store is keyed by (shader hash, session hash, settings hash, rrcache version); opening
+In the manner of coverage.py's data file: the schema is one commented string (:data:`SCHEMA`: the
+store's own tables and each kind of choice's, :attr:`rrcache.kinds.base.Kind.tables`, put together
+here), a ``meta`` table names what the file belongs to, and nothing in a file is trusted before it
+is checked. Opening a store to write upgrades an older schema in place, in one transaction
+(schema 1: a validation's node and period in two columns; schema 2: the set stage's record in
+``meta('sets')`` and an amortization table made when first written, perhaps without its history
+column); reading one (:func:`read_store`) changes nothing.
+
+Only the collector of a profile's runs writes the measurements (:mod:`rrcache.profiler.collect`:
+``add_node_result``, ``add_amortize_result``, ``add_set_run``, ``add_adaptive_point`` …). A store is keyed by (shader hash, session hash, settings hash, rrcache version); opening
 it with another key is refused with the differences named (use another ``--out``, or ``--fresh``,
 which moves the old file aside as ``profile.sqlite.bak``). A damaged file (``PRAGMA
 integrity_check``) or a foreign SQLite file (no ``meta`` table, or another schema) is refused too.
@@ -24,21 +31,23 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Optional
 
+from rrcache import kinds
 from rrcache.errors import RRCacheError
 from rrcache.selection import Selection, parts_from_json, parts_to_json
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
+#: the schema versions :func:`read_store` reads as they are
+READABLE = ("2", "3")
 #: the store's file name in a profile folder
 STORE_NAME = "profile.sqlite"
 
-SCHEMA = """\
+BASE_SCHEMA = """\
 -- rrcache profile store; the schema version is in meta('schema_version').
 --
 -- meta: what the file belongs to. Keys: schema_version, rrcache_version, shader_hash,
 --   session_hash, settings_json, settings_hash, created, updated (unix seconds); and, once the
 --   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profiler.plan),
 --   kept so that a resumed run renders exactly what the first one did.
---   sets: JSON of the sets of cached nodes the set stage trained (rrcache.profiler.sets).
 CREATE TABLE meta (
     key TEXT PRIMARY KEY,
     value TEXT NOT NULL
@@ -160,6 +169,19 @@ CREATE TABLE validation (
     frames INTEGER NOT NULL
 );
 """
+
+
+def _kinds_schema() -> str:
+    """The tables each kind of choice keeps (rrcache.kinds), in the registry's order."""
+    return "".join(k.tables for k in kinds.all_kinds() if k.tables)
+
+
+#: the whole schema: the store's own tables and the kinds' (amortized runs, sets, adaptive points)
+SCHEMA = BASE_SCHEMA + _kinds_schema()
+
+#: the columns of an amortize_run row (rrcache.kinds.amortize), in the order add_amortize_rows takes
+AMORTIZE_COLUMNS = ("estimator", "history", "kind", "samples", "blend", "frame", "mean_error", "psnr", "hit_rate",
+                    "hits", "misses", "ms", "original_ms", "wall_s")
 
 _VALIDATION_COLUMNS = ("label", "max_error", "parts", "algorithm", "predicted_error", "predicted_ms",
                        "predicted_speedup", "measured_error", "measured_psnr", "measured_ms", "measured_original_ms",
@@ -371,7 +393,7 @@ class ProfileStore:
         try:
             conn.execute("PRAGMA journal_mode=WAL")
             conn.execute("BEGIN")
-            for statement in _statements(SCHEMA):
+            for statement in _statements(BASE_SCHEMA + _kinds_schema()):
                 conn.execute(statement)
             now = repr(time.time())
             meta = {"schema_version": str(SCHEMA_VERSION), "rrcache_version": key.rrcache_version,
@@ -399,9 +421,8 @@ class ProfileStore:
         except sqlite3.DatabaseError as err:
             raise _refuse(path, f"an SQLite file that is not a profile store ({err})", _FRESH_HINT) from None
         version = meta.get("schema_version")
-        if version in _MIGRATIONS and "validation" in tables:
-            _MIGRATIONS[version](self.conn)
-            version = str(SCHEMA_VERSION)
+        while version in _MIGRATIONS and "validation" in tables:
+            version = _upgrade(self.path, self.conn, version)
         if version != str(SCHEMA_VERSION):
             raise _refuse(path, f"profile store schema {version!r}, this rrcache reads schema {SCHEMA_VERSION}"
                           if version else "an SQLite file that is not a profile store (no schema version)", _FRESH_HINT)
@@ -412,6 +433,14 @@ class ProfileStore:
         if differences:
             raise _refuse(path, "the profile store was made for other inputs: " + "; ".join(differences), _FRESH_HINT)
         self.conn.execute("PRAGMA journal_mode=WAL")
+        self._kind_tables()
+
+    def _kind_tables(self) -> None:
+        """The tables of a kind registered since the store was made (a plug-in), created empty."""
+        have = {r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        wanted = [st for st in _statements(_kinds_schema()) if _table_name(st) not in have]
+        if wanted:
+            self._write([(st, ()) for st in wanted])
 
     # ------------------------------------------------------------------ transactions
     def _write(self, statements: Iterable[tuple[str, tuple]]) -> sqlite3.Cursor:
@@ -441,6 +470,12 @@ class ProfileStore:
                           "free disk space or make the folder writable; what was stored before is kept, "
                           "and running the same command again resumes") from None
         return last
+
+    def write(self, statements: Iterable[tuple[str, tuple]]) -> None:
+        """Run ``statements`` (SQL, arguments) in one transaction: how a kind of choice's
+        collector writes its own table (:meth:`rrcache.kinds.base.Kind.collect`); a failed write
+        is refused as every write is."""
+        self._write(list(statements))
 
     def begin_run(self) -> int:
         """Log the start of a ``profile`` invocation; its id tags what it computes."""
@@ -621,6 +656,120 @@ class ProfileStore:
                                  algorithm=algorithm).with_measurement(*figures[3:]))
         return out
 
+    # ------------------------------------------------------------------ the kinds' runs
+    def add_node_result(self, result) -> None:
+        """A node's error or timing run (a :class:`rrcache.runs.RunResult` keyed ``("node", id,
+        period)``): the run and its frames, in one transaction."""
+        _, node, period = result.spec.key
+        rows = result.frames
+        if result.spec.measure == "error":
+            frames = [ErrorFrame(r.frame, float(r.error), float(r.psnr), _count(r.hits), _count(r.misses),
+                                 int(r.covered), int(r.left_out)) for r in rows]
+            steady = frames[1:] or frames
+            hits, misses = sum(f.hits for f in steady), sum(f.misses for f in steady)
+            run = ErrorRun(node, int(period), float(sum(f.mean_error for f in steady) / max(1, len(steady))),
+                           float(sum(f.psnr for f in steady) / max(1, len(steady))),
+                           hits / (hits + misses) if hits + misses else 0.0, hits, misses,
+                           sum(f.covered for f in steady), len(frames), float(result.wall_s))
+            self.add_error_run(run, frames)
+        else:
+            self.add_timing_run(node, int(period), [TimingFrame(r.frame, _count(r.hits), _count(r.misses), float(r.ms),
+                                                                float(r.original_ms)) for r in rows],
+                                float(result.wall_s))
+
+    def has_node_run(self, measure: str, node: str, period: int) -> bool:
+        return (self.has_error_run if measure == "error" else self.has_timing_run)(node, period)
+
+    def add_amortize_rows(self, rows: list[tuple]) -> None:
+        """Rows of ``amortize_run`` (in :data:`AMORTIZE_COLUMNS` order), in one transaction."""
+        self._write([(f"INSERT OR REPLACE INTO amortize_run ({', '.join(AMORTIZE_COLUMNS)}) VALUES "
+                      f"({', '.join('?' * len(AMORTIZE_COLUMNS))})", tuple(r)) for r in rows])
+
+    def add_amortize_result(self, result) -> None:
+        """An estimator's error run (one row: the means over the frames after the first) or timing
+        run (a row per timed frame), keyed ``("amortize", estimator, history, m, λ)``."""
+        _, estimator, history, m, lam = result.spec.key
+        rows = result.frames
+        if result.spec.measure == "error":
+            steady = rows[1:]
+            errs = [r.error for r in steady] or [0.0]
+            psnrs = [r.psnr for r in steady] or [100.0]
+            hits, misses = sum(r.hits or 0 for r in steady), sum(r.misses or 0 for r in steady)
+            rate = hits / (hits + misses) if hits + misses else 0.0
+            self.add_amortize_rows([(estimator, history, "error", int(m), float(lam), -1, float(sum(errs) / len(errs)),
+                                     float(sum(psnrs) / len(psnrs)), rate, hits, misses, 0.0, 0.0,
+                                     float(result.wall_s))])
+        else:
+            wall = float(result.wall_s) / max(1, len(rows))
+            self.add_amortize_rows([(estimator, history, "timing", int(m), 0.0, int(r.frame), 0.0, 0.0, 0.0,
+                                     int(r.hits or 0), int(r.misses or 0), float(r.ms), float(r.original_ms), wall)
+                                    for r in rows])
+
+    def amortize_rows(self, estimator: str, kind: str, history: str = "blend") -> list[dict]:
+        """The stored ``amortize_run`` rows of ``estimator`` of ``kind`` (``error`` or ``timing``)
+        and ``history`` (``blend``, ``slots``, ``slots/u8``; a schema-2 table without the history
+        column has blend rows only)."""
+        if not self._has_table("amortize_run"):
+            return []
+        try:
+            if "history" not in _columns(self.conn, "amortize_run"):
+                if history != "blend":
+                    return []
+                cur = self.conn.execute("SELECT *, 'blend' AS history FROM amortize_run WHERE estimator = ? AND "
+                                        "kind = ? ORDER BY samples, blend, frame", (estimator, kind))
+            else:
+                cur = self.conn.execute("SELECT * FROM amortize_run WHERE estimator = ? AND kind = ? AND history = ? "
+                                        "ORDER BY samples, blend, frame", (estimator, kind, history))
+            names = [d[0] for d in cur.description]
+            return [dict(zip(names, r)) for r in cur.fetchall()]
+        except sqlite3.DatabaseError as err:
+            raise _refuse(self.path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+
+    def amortize_spent_s(self) -> float:
+        """Seconds the stored amortization runs took (they count against the training budget)."""
+        if not self._has_table("amortize_run"):
+            return 0.0
+        return float(self.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM amortize_run").fetchone()[0])
+
+    def add_set_run(self, record: dict) -> None:
+        """The set stage's record of one set (``nodes``, ``periods``, the prediction and what its
+        runs measured: :meth:`rrcache.model.sets.SetOption.to_json`), replacing an earlier one."""
+        self._write([("INSERT OR REPLACE INTO set_run(nodes, periods, record) VALUES (?, ?, ?)",
+                      (json.dumps(list(record["nodes"])), json.dumps([int(p) for p in record["periods"]]),
+                       json.dumps(record)))])
+
+    def set_runs(self) -> list[dict]:
+        """The set stage's records (a schema-2 store's from ``meta('sets')``)."""
+        if not self._has_table("set_run"):
+            return _set_records(self.meta().get("sets"))
+        out = []
+        for (raw,) in self.conn.execute("SELECT record FROM set_run ORDER BY rowid"):
+            out.extend(_set_records(f"[{raw}]"))
+        return out
+
+    def add_adaptive_point(self, point, algorithm: str, wall_s: float) -> None:
+        """One measured adaptive threshold (:class:`rrcache.profiler.adaptive.AdaptivePoint`)."""
+        self._write([("INSERT OR REPLACE INTO adaptive_point VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                      (point.node, int(point.period), float(point.threshold), int(point.fast_period), algorithm,
+                       float(point.error), float(point.psnr), float(point.time_ratio), float(point.hit_rate),
+                       json.dumps([float(v) for v in point.speedups]), float(wall_s)))])
+
+    def adaptive_points(self, node: Optional[str] = None) -> list[dict]:
+        """The stored adaptive points (of ``node``), by node, period and threshold."""
+        if not self._has_table("adaptive_point"):
+            return []
+        cur = self.conn.execute("SELECT * FROM adaptive_point" + (" WHERE node = ?" if node else "")
+                                + " ORDER BY node, period, threshold", (node,) if node else ())
+        names = [d[0] for d in cur.description]
+        rows = [dict(zip(names, r)) for r in cur.fetchall()]
+        for r in rows:
+            r["speedups"] = tuple(json.loads(r["speedups"]))
+        return rows
+
+    def _has_table(self, name: str) -> bool:
+        return self.conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?",
+                                 (name,)).fetchone() is not None
+
     def spent_s(self) -> float:
         """Training seconds stored so far (error and timing runs): what the budget has spent."""
         a = self.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM error_run").fetchone()[0]
@@ -659,6 +808,11 @@ class ProfileStore:
         self.close()
 
 
+def _count(value) -> int:
+    """A hit or miss count as stored (an algorithm that cannot count them: 0)."""
+    return int(value) if value is not None else 0
+
+
 def _migrate_1(conn: sqlite3.Connection) -> None:
     """Schema 1 → 2 in one transaction: the validation rows' ``node``/``period`` columns become
     ``parts`` (the algorithm was not recorded: NULL)."""
@@ -668,14 +822,14 @@ def _migrate_1(conn: sqlite3.Connection) -> None:
                            "measured_error, measured_psnr, measured_ms, measured_original_ms, measured_speedup, "
                            "hit_rate, frames FROM validation").fetchall()
         conn.execute("DROP TABLE validation")
-        table = SCHEMA[SCHEMA.index("CREATE TABLE validation"):]
+        table = BASE_SCHEMA[BASE_SCHEMA.index("CREATE TABLE validation"):]
         conn.execute(table[:table.index(";")])
         for label, max_error, node, period, *figures in old:
             parts = [] if node is None else [{"kind": "cache", "node": node, "period": int(period)}]
             conn.execute(f"INSERT INTO validation({', '.join(_VALIDATION_COLUMNS)}) VALUES "
                          f"({', '.join('?' * len(_VALIDATION_COLUMNS))})",
                          (label, max_error, json.dumps(parts), None, *figures))
-        conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
+        conn.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
         conn.execute("COMMIT")
     except BaseException:
         if conn.in_transaction:
@@ -683,9 +837,69 @@ def _migrate_1(conn: sqlite3.Connection) -> None:
         raise
 
 
-#: older schema version -> the function that upgrades a store in place (schema 1 kept a
-#: validation's node and period in two columns; schema 2 keeps its parts)
-_MIGRATIONS = {"1": _migrate_1}
+def _migrate_2(conn: sqlite3.Connection) -> None:
+    """Schema 2 → 3 in one transaction: the kinds' tables made (``amortize_run`` from before the
+    slots history rebuilt with its ``history`` column, its rows ``blend``), and the set stage's
+    record moved from ``meta('sets')`` into ``set_run``."""
+    conn.execute("BEGIN IMMEDIATE")
+    try:
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        if "amortize_run" in tables and "history" not in _columns(conn, "amortize_run"):
+            conn.execute("ALTER TABLE amortize_run RENAME TO amortize_run_old")
+            tables.discard("amortize_run")
+        for statement in _statements(_kinds_schema()):
+            conn.execute(statement)
+        if "amortize_run_old" in {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}:
+            old = [c for c in AMORTIZE_COLUMNS if c != "history"]
+            conn.execute(f"INSERT INTO amortize_run ({', '.join(old)}, history) "
+                         f"SELECT {', '.join(old)}, 'blend' FROM amortize_run_old")
+            conn.execute("DROP TABLE amortize_run_old")
+        row = conn.execute("SELECT value FROM meta WHERE key = 'sets'").fetchone()
+        for record in _set_records(row[0] if row else None):
+            conn.execute("INSERT OR REPLACE INTO set_run(nodes, periods, record) VALUES (?, ?, ?)",
+                         (json.dumps(record["nodes"]), json.dumps(record["periods"]), json.dumps(record)))
+        conn.execute("DELETE FROM meta WHERE key = 'sets'")
+        conn.execute("UPDATE meta SET value = '3' WHERE key = 'schema_version'")
+        conn.execute("COMMIT")
+    except BaseException:
+        if conn.in_transaction:
+            conn.execute("ROLLBACK")
+        raise
+
+
+def _set_records(raw) -> list[dict]:
+    """The set stage's records of a ``meta('sets')`` value (schema 2; what is not one is dropped)."""
+    try:
+        data = json.loads(raw) if raw else []
+    except ValueError:
+        return []
+    return [d for d in data if isinstance(d, dict) and "nodes" in d and "periods" in d] if isinstance(data, list) else []
+
+
+def _columns(conn: sqlite3.Connection, table: str) -> list[str]:
+    return [r[1] for r in conn.execute(f"PRAGMA table_info({table})").fetchall()]
+
+
+def _table_name(statement: str) -> str:
+    words = statement.replace("(", " ").split()
+    return words[words.index("TABLE") + (4 if words[words.index("TABLE") + 1] == "IF" else 1)]
+
+
+#: older schema version -> the function that upgrades a store in place to the next version
+#: (schema 1 kept a validation's node and period in two columns; schema 2 kept the sets in meta
+#: and made the amortization table when first written)
+_MIGRATIONS = {"1": _migrate_1, "2": _migrate_2}
+
+
+def _upgrade(path: Path, conn: sqlite3.Connection, version: str) -> str:
+    """Run the upgrade from ``version``; its version after. A store that cannot be written (a
+    full disk) is refused with what to do; the file is left as it was."""
+    try:
+        _MIGRATIONS[version](conn)
+    except sqlite3.Error as err:
+        raise _refuse(path, f"cannot upgrade the profile store from schema {version}: {err}",
+                      "free some disk space or make the folder writable, then run the profile again") from None
+    return str(int(version) + 1)
 
 
 def _statements(script: str) -> list[str]:
@@ -705,10 +919,9 @@ def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     try:
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
         version = dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") if "meta" in tables else None
-        if version in _MIGRATIONS and "validation" in tables:
-            _MIGRATIONS[version](conn)
-            version = str(SCHEMA_VERSION)
-        if version != str(SCHEMA_VERSION):
+        if version == "1" and "validation" in tables:
+            version = _upgrade(path, conn, version)
+        if version not in READABLE:
             raise _refuse(path, "an SQLite file that is not a profile store", _FRESH_HINT)
     except sqlite3.DatabaseError as err:
         conn.close()
