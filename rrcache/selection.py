@@ -69,6 +69,10 @@ class Selection:
       ``predicted_speedup_range``, ``measured_noise``, ``exact``, ``visible_artifacts``,
       ``fallback``: the PSNR level, the predictions' uncertainty and what validation found
       (see the field comments).
+    - ``measured_psnr_uncertainty``, ``measured_error_uncertainty``, ``measured_flip`` (±
+      ``measured_flip_uncertainty``), ``measured_temporal_psnr``, ``max_flip``, ``level_met``,
+      ``level_note``, ``tries``, ``calibration_db``: whether the level was met as measured, how
+      many candidates it took, and the perceptual and temporal measures (docs/levels.md).
     """
 
     parts: tuple = field(default=(), metadata={"parts": True})
@@ -98,10 +102,31 @@ class Selection:
     measured_noise: Optional[float] = _at_least(None)
     #: the image is the original's (nothing cached, or every pixel recomputed): PSNR ∞
     exact: bool = False
-    #: below 30 dB (measured, else predicted): a choice with visible artifacts
+    #: a choice with visible artifacts: measured mean FLIP at or above the threshold
+    #: (rrcache.model.levels.VISIBLE_FLIP), else predicted PSNR below 30 dB
     visible_artifacts: bool = False
-    #: why this selection stands instead of the models' first choice (a measured slowdown)
+    #: why this selection stands instead of the models' first choice: every choice measured before
+    #: it at this level and why each was refused (docs/levels.md)
     fallback: Optional[str] = None
+    #: the ± (95%) of the measured PSNR (dB) and error: how much the session's mean would move with
+    #: other frames like these (rrcache.model.levels.batch_uncertainty)
+    measured_psnr_uncertainty: Optional[float] = _at_least(None)
+    measured_error_uncertainty: Optional[float] = _at_least(None)
+    #: the mean FLIP over the validated frames it was computed on, and its ± (rrcache.harness.perceptual)
+    measured_flip: Optional[float] = _at_least(None)
+    measured_flip_uncertainty: Optional[float] = _at_least(None)
+    #: the PSNR (dB) of the frame-to-frame changes against the original's: smears and lags
+    measured_temporal_psnr: Optional[float] = None
+    #: the FLIP level it was selected at (None: a PSNR or error level)
+    max_flip: Optional[float] = _at_least(None)
+    #: whether its measurement meets its level (None: not measured), and why not
+    level_met: Optional[bool] = None
+    level_note: Optional[str] = None
+    #: the candidates measured for its level until one stood (0: nothing measured, the original)
+    tries: int = _at_least(0)
+    #: the dB the per-profile calibration added to the models' ``predicted_psnr`` when it was
+    #: chosen (rrcache.model.calibration; None: none applied)
+    calibration_db: Optional[float] = None
 
     @classmethod
     def original(cls, original_ms: float, **kw) -> "Selection":

@@ -146,6 +146,7 @@ def test_json_shape(quick_run):
         if scene["equal_time"]:
             methods = [r["method"] for r in scene["equal_time"]]
             assert methods[0] == "reprojection cache (ours)" and "dynamic resolution" in methods
+            assert paper.RENDER_CACHE in methods or any("render cache" in n for n in scene["notes"])
             for row in scene["equal_time"]:
                 assert row["speedup"] > 0 and row["mean_error"] >= 0 and 0 < row["psnr"] <= 100
         else:

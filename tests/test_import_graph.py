@@ -34,7 +34,7 @@ LAYERS = [
     {"selection"},
     {"model", "harness"},
     {"pipeline"},
-    {"alternatives", "profiles"},
+    {"alternatives", "profiles", "cluster"},
     {"report"},
     {"profiler"},
     {"bench"},

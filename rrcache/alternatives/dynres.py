@@ -155,16 +155,18 @@ class DynresRenderer:
         self.release()
 
 
-def measure_scale(prepared, session, size, frames, original: Optional[Renderer] = None):
+def measure_scale(prepared, session, size, frames, original: Optional[Renderer] = None,
+                  on_frame: Optional[Callable] = None):
     """A function ``scale -> Comparison`` measuring dynamic resolution at ``scale`` over
-    ``frames`` side by side with the original (``original`` reused when given)."""
+    ``frames`` side by side with the original (``original`` reused when given;
+    ``on_frame(row, frame, original's frame)`` after each frame)."""
 
     def run(scale: float):
         own = original is None
         ref = Renderer(prepared, session, size) if own else original
         try:
             with DynresRenderer(prepared, session, size, scale) as dyn:
-                return compare_renderers(ref, dyn, frames)
+                return compare_renderers(ref, dyn, frames, on_frame=on_frame)
         finally:
             if own:
                 ref.release()

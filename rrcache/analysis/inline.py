@@ -60,7 +60,8 @@ from rrcache.glsl.rewrite import (
     NameAllocator, assign, check_reserved_names, clone, declare, declare_typed, rewrite_scoped,
     with_chain,
 )
-from rrcache.glsl.writes import out_qualifiers, param_qualifier
+from rrcache.glsl.defuse import definitions, out_qualifiers, param_qualifier
+from rrcache.glsl.visitor import NodeVisitor
 
 __all__ = ["inline_calls", "inline_unit"]
 
@@ -125,77 +126,108 @@ class _Template:
         return body
 
 
-def _returns_in_loops(s: A.Node, inside: bool = False) -> bool:
-    if isinstance(s, A.Return):
-        return inside
-    if isinstance(s, A.Expr):
-        return False
-    loopish = isinstance(s, (A.For, A.While, A.DoWhile, A.Switch))
-    return any(_returns_in_loops(c, inside or loopish) for c in _stmt_children(s))
-
-
 def _stmt_children(s: A.Node):
     if isinstance(s, A.Compound):
         return s.stmts
     return [sub for _, sub in A.branches(s)]
 
 
-def _has_return(s: A.Node) -> bool:
-    if isinstance(s, A.Return):
-        return True
-    return any(_has_return(c) for c in _stmt_children(s))
+class _Returns(NodeVisitor):
+    """Whether a statement holds a ``return`` (``in_loops``: one inside a loop or ``switch``)."""
+
+    def __init__(self, in_loops: bool):
+        self.in_loops = in_loops
+
+    def visit_Return(self, s, inside: bool = False) -> bool:
+        return inside or not self.in_loops
+
+    def generic_visit(self, s, inside: bool = False) -> bool:
+        return any(self.visit(c, inside) for c in _stmt_children(s))
+
+    def visit_For(self, s, inside: bool = False) -> bool:
+        return self.generic_visit(s, True)
+
+    visit_While = visit_DoWhile = visit_Switch = visit_For
 
 
-def _has_continue(s: A.Node) -> bool:
-    """A ``continue`` that belongs to the loop whose body is ``s``."""
-    if isinstance(s, A.Continue):
+class _Continues(NodeVisitor):
+    """Whether a loop body holds a ``continue`` of that loop."""
+
+    def visit_Continue(self, s) -> bool:
         return True
-    if isinstance(s, (A.For, A.While, A.DoWhile)):
+
+    def visit_For(self, s) -> bool:
         return False
-    return any(_has_continue(c) for c in _stmt_children(s))
+
+    visit_While = visit_DoWhile = visit_For
+
+    def generic_visit(self, s) -> bool:
+        return any(self.visit(c) for c in _stmt_children(s))
 
 
-def _convert_returns(stmts: list, is_void: bool, needs_flag: bool) -> list:
-    out: list = []
-    for i, s in enumerate(stmts):
-        if not _has_return(s):
-            out.append(s)
-            continue
-        if isinstance(s, A.Return):
-            if s.expr is not None and not is_void:
-                out.append(assign(_RET, s.expr, s.loc))
-            if needs_flag:
-                out.append(assign(_LIVE, A.BoolLit(False, loc=s.loc), s.loc))
-            return out          # the rest of this block is dead code
-        out.append(_convert_stmt(s, is_void, needs_flag))
-        rest = stmts[i + 1:]
-        if rest:
-            out.append(A.If(A.Ident(_LIVE, loc=s.loc), A.Compound(
-                _convert_returns(rest, is_void, needs_flag), loc=s.loc), loc=s.loc))
+_returns_in_loops = _Returns(in_loops=True).visit
+_has_return = _Returns(in_loops=False).visit
+_has_continue = _Continues().visit
+
+
+class _ConvertReturns(NodeVisitor):
+    """A body's ``return``s as assignments to the result (and, with ``needs_flag``, the live flag
+    cleared and what follows guarded by it): visiting a statement returns its conversion."""
+
+    def __init__(self, is_void: bool, needs_flag: bool):
+        self.is_void, self.needs_flag = is_void, needs_flag
+
+    def block(self, stmts: list) -> list:
+        out: list = []
+        for i, s in enumerate(stmts):
+            if not _has_return(s):
+                out.append(s)
+                continue
+            if isinstance(s, A.Return):
+                if s.expr is not None and not self.is_void:
+                    out.append(assign(_RET, s.expr, s.loc))
+                if self.needs_flag:
+                    out.append(assign(_LIVE, A.BoolLit(False, loc=s.loc), s.loc))
+                return out          # the rest of this block is dead code
+            out.append(self.visit(s))
+            rest = stmts[i + 1:]
+            if rest:
+                out.append(A.If(A.Ident(_LIVE, loc=s.loc), A.Compound(
+                    self.block(rest), loc=s.loc), loc=s.loc))
+            return out
         return out
-    return out
 
+    def visit_Compound(self, s: A.Compound) -> A.Compound:
+        return A.Compound(self.block(s.stmts), loc=s.loc)
 
-def _convert_stmt(s, is_void, needs_flag):
-    if isinstance(s, A.Compound):
-        return A.Compound(_convert_returns(s.stmts, is_void, needs_flag), loc=s.loc)
-    if isinstance(s, A.If):
+    def visit_If(self, s: A.If) -> A.If:
         def branch(b):
             if b is None:
                 return None
             stmts = b.stmts if isinstance(b, A.Compound) else [b]
-            return A.Compound(_convert_returns(stmts, is_void, needs_flag), loc=b.loc)
+            return A.Compound(self.block(stmts), loc=b.loc)
         return A.If(s.cond, branch(s.then), branch(s.else_), loc=s.loc)
-    if isinstance(s, A.Return):
-        return A.Compound(_convert_returns([s], is_void, needs_flag), loc=s.loc)
-    raise AssertionError("returns inside loops are not inlined")
+
+    def visit_Return(self, s: A.Return) -> A.Compound:
+        return A.Compound(self.block([s]), loc=s.loc)
+
+    def generic_visit(self, s):
+        raise AssertionError("returns inside loops are not inlined")
+
+
+def _convert_returns(stmts: list, is_void: bool, needs_flag: bool) -> list:
+    return _ConvertReturns(is_void, needs_flag).block(stmts)
 
 
 def _wrap(stmts: list, loc) -> A.Stmt:
     return stmts[0] if len(stmts) == 1 else A.Compound(stmts, loc=loc)
 
 
-class _Inliner:
+class _Inliner(NodeVisitor):
+    """Visiting a statement returns the statements that replace it; visiting an expression
+    that holds a call to inline (through :meth:`expr`) appends to ``pre`` what must run before
+    it and returns what stands in its place."""
+
     def __init__(self, unit: A.TranslationUnit):
         self.unit = clone(unit)
         self.names = NameAllocator(unit)
@@ -234,13 +266,10 @@ class _Inliner:
     def _global_names_read(self, d: A.FunctionDecl) -> set[str]:
         """The global names the body of ``d`` uses: globals (by their semantic symbols) and the
         functions it calls (built-in or not)."""
-        names = set()
-        for n in walk(d.body, decl_types=False):
-            if isinstance(n, A.Ident):
-                if n.symbol is not None and id(getattr(n.symbol, "decl", None)) in self.global_copy:
-                    names.add(n.name)
-            elif isinstance(n, A.Call) and n.kind in ("builtin", "function"):
-                names.add(n.name)
+        names = {n.name for n in walk(d.body, decl_types=False) if n.__class__ is A.Ident
+                 and n.symbol is not None and id(getattr(n.symbol, "decl", None)) in self.global_copy}
+        names.update(n.name for n in walk(d.body, decl_types=False) if n.__class__ is A.Call
+                     and n.kind in ("builtin", "function"))
         return names
 
     def _unshadow_globals(self) -> None:
@@ -284,13 +313,12 @@ class _Inliner:
         for i, d in enumerate(decls):
             if not isinstance(d, A.FunctionDecl) or d.body is None:
                 continue
-            last = -1
-            for n in walk(d.body):
-                if isinstance(n, A.Ident) and n.symbol is not None \
-                        and id(getattr(n.symbol, "decl", None)) in self.global_copy:
-                    last = max(last, pos.get(id(self.global_copy[id(n.symbol.decl)]), -1))
-                elif isinstance(n, (A.TypeSpecifier, A.Call)) and n.name in struct_pos:
-                    last = max(last, struct_pos[n.name])
+            last = max([pos.get(id(self.global_copy[id(n.symbol.decl)]), -1)
+                        for n in walk(d.body) if n.__class__ is A.Ident and n.symbol is not None
+                        and id(getattr(n.symbol, "decl", None)) in self.global_copy]
+                       + [struct_pos[n.name] for n in walk(d.body)
+                          if n.__class__ in (A.TypeSpecifier, A.Call) and n.name in struct_pos],
+                       default=-1)
             if last > i:
                 after.setdefault(id(decls[last]), []).append(d)
                 moved[id(d)] = d
@@ -333,28 +361,19 @@ class _Inliner:
             self.templates[id(d)] = _Template(d, body, not last_only, self.call_sites.get(id(d), 0))
 
     def _body_effectful(self, d: A.FunctionDecl) -> bool:
+        """Whether calling ``d`` has an effect beyond its result: it has an ``out``/``inout``
+        parameter, writes a variable that is not its own, or calls something effectful."""
         if any(param_qualifier(p) != "in" for p in d.params):
             return True
-        local = {p.name for p in d.params if p.name}
         for n in walk(d.body, decl_types=False):
-            if isinstance(n, A.Declarator):
-                local.add(n.name)
-            elif isinstance(n, A.Call):
+            if n.__class__ is A.Call:
                 t = self._target(n)
                 if t is not None and self.effectful.get(id(t), True):
                     return True
                 if n.kind == "builtin" and getattr(n.target, "side_effects", False):
                     return True
-            elif isinstance(n, (A.Assign, A.Unary)):
-                tgt = n.target if isinstance(n, A.Assign) else (
-                    n.operand if n.op in ("++", "--") else None)
-                while isinstance(tgt, (A.Field, A.Index)):
-                    tgt = tgt.obj
-                if isinstance(tgt, A.Ident):
-                    sym = tgt.symbol
-                    if sym is None or sym.kind not in ("local", "param"):
-                        return True
-        return False
+        return any(w.root.symbol is None or w.root.symbol.kind not in ("local", "param")
+                   for w in definitions(d.body))
 
     def _prune(self) -> None:
         """Drop functions (and prototypes) no longer called from main or a kept function."""
@@ -430,49 +449,61 @@ class _Inliner:
         return out
 
     def stmt(self, s) -> list:
-        if isinstance(s, A.Compound):
-            return [A.Compound(self.block(s.stmts), loc=s.loc)]
-        if isinstance(s, A.DeclStmt):
-            return self.decl_stmt(s)
-        if isinstance(s, A.ExprStmt):
-            if not self.has_call(s.expr):
-                return [s]
-            pre: list = []
-            e = self.expr(s.expr, pre, value_used=False)
-            return pre + ([A.ExprStmt(e, loc=s.loc)] if e is not None else [])
-        if isinstance(s, A.If):
-            pre = []
-            cond = self.expr(s.cond, pre)
-            then = _wrap(self.stmt(s.then), s.then.loc)
-            else_ = _wrap(self.stmt(s.else_), s.else_.loc) if s.else_ is not None else None
-            return pre + [A.If(cond, then, else_, loc=s.loc)]
-        if isinstance(s, A.Switch):
-            pre = []
-            e = self.expr(s.expr, pre)
-            return pre + [A.Switch(e, A.Compound(self.block(s.body.stmts), loc=s.body.loc),
-                                   loc=s.loc)]
-        if isinstance(s, A.Return):
-            pre = []
-            e = self.expr(s.expr, pre) if s.expr is not None else None
-            return pre + [A.Return(e, loc=s.loc)]
-        if isinstance(s, A.For):
-            return self.for_stmt(s)
-        if isinstance(s, A.While):
-            body = _wrap(self.stmt(s.body), s.body.loc)
-            if isinstance(s.cond, A.Expr) and self.has_call(s.cond):
-                pre: list = []
-                cond = self.expr(s.cond, pre)
-                body = A.Compound(pre + [self._exit_unless(cond), body], loc=s.loc)
-                return [A.While(A.BoolLit(True, loc=s.loc), body, loc=s.loc)]
-            return [A.While(s.cond, body, loc=s.loc)]
-        if isinstance(s, A.DoWhile):
-            body = _wrap(self.stmt(s.body), s.body.loc)
-            if self.has_call(s.cond) and not _has_continue(s.body):
-                pre = []
-                cond = self.expr(s.cond, pre)
-                return [A.DoWhile(A.Compound([body] + pre, loc=s.loc), cond, loc=s.loc)]
-            return [A.DoWhile(body, s.cond, loc=s.loc)]
+        return self.visit(s)
+
+    def generic_visit(self, s, *args):
         return [s]
+
+    def visit_Compound(self, s: A.Compound) -> list:
+        return [A.Compound(self.block(s.stmts), loc=s.loc)]
+
+    def visit_DeclStmt(self, s: A.DeclStmt) -> list:
+        return self.decl_stmt(s)
+
+    def visit_ExprStmt(self, s: A.ExprStmt) -> list:
+        if not self.has_call(s.expr):
+            return [s]
+        pre: list = []
+        e = self.expr(s.expr, pre, value_used=False)
+        return pre + ([A.ExprStmt(e, loc=s.loc)] if e is not None else [])
+
+    def visit_If(self, s: A.If) -> list:
+        pre: list = []
+        cond = self.expr(s.cond, pre)
+        then = _wrap(self.stmt(s.then), s.then.loc)
+        else_ = _wrap(self.stmt(s.else_), s.else_.loc) if s.else_ is not None else None
+        return pre + [A.If(cond, then, else_, loc=s.loc)]
+
+    def visit_Switch(self, s: A.Switch) -> list:
+        pre: list = []
+        e = self.expr(s.expr, pre)
+        return pre + [A.Switch(e, A.Compound(self.block(s.body.stmts), loc=s.body.loc),
+                               loc=s.loc)]
+
+    def visit_Return(self, s: A.Return) -> list:
+        pre: list = []
+        e = self.expr(s.expr, pre) if s.expr is not None else None
+        return pre + [A.Return(e, loc=s.loc)]
+
+    def visit_For(self, s: A.For) -> list:
+        return self.for_stmt(s)
+
+    def visit_While(self, s: A.While) -> list:
+        body = _wrap(self.stmt(s.body), s.body.loc)
+        if isinstance(s.cond, A.Expr) and self.has_call(s.cond):
+            pre: list = []
+            cond = self.expr(s.cond, pre)
+            body = A.Compound(pre + [self._exit_unless(cond), body], loc=s.loc)
+            return [A.While(A.BoolLit(True, loc=s.loc), body, loc=s.loc)]
+        return [A.While(s.cond, body, loc=s.loc)]
+
+    def visit_DoWhile(self, s: A.DoWhile) -> list:
+        body = _wrap(self.stmt(s.body), s.body.loc)
+        if self.has_call(s.cond) and not _has_continue(s.body):
+            pre: list = []
+            cond = self.expr(s.cond, pre)
+            return [A.DoWhile(A.Compound([body] + pre, loc=s.loc), cond, loc=s.loc)]
+        return [A.DoWhile(body, s.cond, loc=s.loc)]
 
     def _exit_unless(self, cond: A.Expr) -> A.If:
         return A.If(A.Unary("!", cond, loc=cond.loc), A.Break(loc=cond.loc), loc=cond.loc)
@@ -532,74 +563,88 @@ class _Inliner:
     def expr(self, e, pre: list, value_used: bool = True):
         if e is None or not self.has_call(e):
             return e
-        if isinstance(e, A.Call):
-            t = self._target(e)
-            if t is not None and self.inlinable.get(id(t), False):
-                return self.inline(e, t, pre)
-            e.args = self.operands(e.args, pre, _lvalue_positions(e))
+        return self.visit(e, pre, value_used)
+
+    def visit_Call(self, e: A.Call, pre: list, value_used: bool = True):
+        t = self._target(e)
+        if t is not None and self.inlinable.get(id(t), False):
+            return self.inline(e, t, pre)
+        e.args = self.operands(e.args, pre, _lvalue_positions(e))
+        return e
+
+    def visit_Binary(self, e: A.Binary, pre: list, value_used: bool = True):
+        if e.op not in ("&&", "||"):
+            return self.visit_Expr(e, pre, value_used)
+        left = self.expr(e.left, pre)
+        if not self.has_call(e.right):
+            e.left = left
             return e
-        if isinstance(e, A.Binary) and e.op in ("&&", "||"):
-            left = self.expr(e.left, pre)
-            if not self.has_call(e.right):
-                e.left = left
-                return e
-            name = self.names.fresh("cond")
-            pre.append(declare(name, A.FullType([], A.TypeSpecifier("bool")), left, loc=e.loc))
-            inner: list = []
-            right = self.expr(e.right, inner)
-            inner.append(assign(name, right, e.loc))
-            test = A.Ident(name, loc=e.loc)
-            if e.op == "||":
-                test = A.Unary("!", test, loc=e.loc)
-            pre.append(A.If(test, A.Compound(inner, loc=e.loc), loc=e.loc))
-            return A.Ident(name, loc=e.loc, type=e.type)
-        if isinstance(e, A.Ternary):
-            cond = self.expr(e.cond, pre)
-            if not (self.has_call(e.then) or self.has_call(e.else_)):
-                e.cond = cond
-                return e
-            if e.type is not None and e.type.is_void:   # ``c ? f() : g();`` as a statement
-                arms = []
-                for branch in (e.then, e.else_):
-                    inner: list = []
-                    v = self.expr(branch, inner, value_used=False)
-                    if v is not None:
-                        inner.append(A.ExprStmt(v, loc=branch.loc))
-                    arms.append(A.Compound(inner, loc=e.loc))
-                pre.append(A.If(cond, arms[0], arms[1], loc=e.loc))
-                return None
-            name = self.names.fresh("sel")
-            pre.append(declare_typed(name, e.type, None, e.loc))
-            branches = []
+        name = self.names.fresh("cond")
+        pre.append(declare(name, A.FullType([], A.TypeSpecifier("bool")), left, loc=e.loc))
+        inner: list = []
+        right = self.expr(e.right, inner)
+        inner.append(assign(name, right, e.loc))
+        test = A.Ident(name, loc=e.loc)
+        if e.op == "||":
+            test = A.Unary("!", test, loc=e.loc)
+        pre.append(A.If(test, A.Compound(inner, loc=e.loc), loc=e.loc))
+        return A.Ident(name, loc=e.loc, type=e.type)
+
+    def visit_Ternary(self, e: A.Ternary, pre: list, value_used: bool = True):
+        cond = self.expr(e.cond, pre)
+        if not (self.has_call(e.then) or self.has_call(e.else_)):
+            e.cond = cond
+            return e
+        if e.type is not None and e.type.is_void:   # ``c ? f() : g();`` as a statement
+            arms = []
             for branch in (e.then, e.else_):
                 inner: list = []
-                v = self.expr(branch, inner)
-                inner.append(assign(name, v, e.loc))
-                branches.append(A.Compound(inner, loc=e.loc))
-            pre.append(A.If(cond, branches[0], branches[1], loc=e.loc))
-            return A.Ident(name, loc=e.loc, type=e.type)
-        if isinstance(e, A.Sequence):
-            for x in e.exprs[:-1]:
-                v = self.expr(x, pre, value_used=False)
+                v = self.expr(branch, inner, value_used=False)
                 if v is not None:
-                    pre.append(A.ExprStmt(v, loc=x.loc))
-            return self.expr(e.exprs[-1], pre, value_used)
-        if isinstance(e, A.Assign):
-            e.target = self.lvalue(e.target, pre)
-            e.value = self.expr(e.value, pre)
-            return e
-        if isinstance(e, A.Unary) and e.op in ("++", "--"):
-            e.operand = self.lvalue(e.operand, pre)
-            return e
-        names = [n for n in ("left", "right", "operand", "obj", "index") if hasattr(e, n)]
-        if names:
-            values = self.operands([getattr(e, n) for n in names], pre, set())
-            for n, v in zip(names, values):
-                setattr(e, n, v)
-            return e
-        if isinstance(e, A.InitList):
-            e.items = self.operands(e.items, pre, set())
-            return e
+                    inner.append(A.ExprStmt(v, loc=branch.loc))
+                arms.append(A.Compound(inner, loc=e.loc))
+            pre.append(A.If(cond, arms[0], arms[1], loc=e.loc))
+            return None
+        name = self.names.fresh("sel")
+        pre.append(declare_typed(name, e.type, None, e.loc))
+        branches = []
+        for branch in (e.then, e.else_):
+            inner = []
+            v = self.expr(branch, inner)
+            inner.append(assign(name, v, e.loc))
+            branches.append(A.Compound(inner, loc=e.loc))
+        pre.append(A.If(cond, branches[0], branches[1], loc=e.loc))
+        return A.Ident(name, loc=e.loc, type=e.type)
+
+    def visit_Sequence(self, e: A.Sequence, pre: list, value_used: bool = True):
+        for x in e.exprs[:-1]:
+            v = self.expr(x, pre, value_used=False)
+            if v is not None:
+                pre.append(A.ExprStmt(v, loc=x.loc))
+        return self.expr(e.exprs[-1], pre, value_used)
+
+    def visit_Assign(self, e: A.Assign, pre: list, value_used: bool = True):
+        e.target = self.lvalue(e.target, pre)
+        e.value = self.expr(e.value, pre)
+        return e
+
+    def visit_Unary(self, e: A.Unary, pre: list, value_used: bool = True):
+        if e.op not in ("++", "--"):
+            return self.visit_Expr(e, pre, value_used)
+        e.operand = self.lvalue(e.operand, pre)
+        return e
+
+    def visit_InitList(self, e: A.InitList, pre: list, value_used: bool = True):
+        e.items = self.operands(e.items, pre, set())
+        return e
+
+    def visit_Expr(self, e, pre: list, value_used: bool = True):
+        """An operation on its operands (fields, indices, arithmetic): they are lowered left to
+        right."""
+        names = A.child_fields(e.__class__, decl_types=False)
+        values = self.operands([getattr(e, n) for n in names], pre, set())
+        for n, v in zip(names, values):
+            setattr(e, n, v)
         return e
 
     def operands(self, items: list, pre: list, lvalues: set) -> list:
@@ -628,12 +673,11 @@ class _Inliner:
 
     def lvalue(self, e: A.Expr, pre: list) -> A.Expr:
         """An l-value whose index expressions are evaluated once, now."""
-        if isinstance(e, A.Field):
+        if isinstance(e, (A.Field, A.Index)):
             e.obj = self.lvalue(e.obj, pre)
-        elif isinstance(e, A.Index):
-            e.obj = self.lvalue(e.obj, pre)
-            idx = self.expr(e.index, pre)
-            e.index = idx if is_literal(idx) else self.hoist(idx, pre)
+            if isinstance(e, A.Index):
+                idx = self.expr(e.index, pre)
+                e.index = idx if is_literal(idx) else self.hoist(idx, pre)
         return e
 
     # ------------------------------------------------------------------ the call site

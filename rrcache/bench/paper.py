@@ -19,9 +19,10 @@ Per scene (:func:`run_scene`):
 4. On the **medium selection** (e3, the threshold of the paper's Fig. 10; the nearest cached
    selection when e3 caches nothing): the three cache algorithms side by side and the cache's
    speed-up limit (every pixel hitting), through :func:`rrcache.bench.cache.run`.
-5. **Equal time** (§5.4): dynamic resolution and simplification tuned to the medium
-   selection's measured speed-up (:mod:`rrcache.alternatives`), then measured over the bench
-   frames beside the original; error and PSNR of all three. The simplification's candidates
+5. **Equal time** (§5.4): dynamic resolution, the render cache of Walter et al. 2002 (its
+   sample share) and simplification tuned to the medium selection's measured speed-up
+   (:mod:`rrcache.alternatives`), then measured over the bench frames beside the original; error
+   and PSNR of all of them. The simplification's candidates
    are the ``candidates`` costliest nodes whose cost is at most what the target allows to save
    (static cost taken as proportional to time, keeping at least half of ``cost / target``);
    a medium selection no faster than the original gets no equal-time comparison.
@@ -129,6 +130,8 @@ class MethodRow:
     original_ms: float
     matched: Optional[bool] = None
     steps: list = field(default_factory=list)
+    #: the median ms of each stage of a frame (the render cache's row)
+    stages: Optional[dict] = None
 
 
 @dataclass
@@ -310,9 +313,13 @@ def _equal_time(work, session, frames, medium: Selection,
     search = list(frames)[:max(1, settings.search_frames)]
 
     try:
-        rows.append(_dynres_row(work, session, frames, search, target, settings, progress))
+        rows.append(dynres_row(work, session, frames, search, target, settings, progress))
     except RRCacheError as err:
         result.notes.append(f"dynamic resolution failed: {err}")
+    try:
+        rows.append(render_cache_row(work, session, frames, search, target, settings, progress))
+    except RRCacheError as err:
+        result.notes.append(f"render cache failed: {err}")
     try:
         row = _simplification_row(work, session, frames, search, target, settings, result, progress)
     except RRCacheError as err:
@@ -323,7 +330,9 @@ def _equal_time(work, session, frames, medium: Selection,
     return rows
 
 
-def _dynres_row(work, session, frames, search, target, settings, progress) -> MethodRow:
+def dynres_row(work, session, frames, search, target, settings, progress, on_frame=None) -> MethodRow:
+    """Dynamic resolution tuned to the ``target`` speed-up over the ``search`` frames, then measured
+    over ``frames`` beside the original (``on_frame(row, frame, original)`` per frame)."""
     from rrcache.alternatives import dynres
 
     def dyn_step(scale, speedup):
@@ -331,12 +340,42 @@ def _dynres_row(work, session, frames, search, target, settings, progress) -> Me
 
     found = dynres.tune_scale(work.prepared, session, None, search, target, lo=settings.min_scale,
                               rel_tol=settings.tolerance, max_steps=settings.max_steps, progress=dyn_step)
-    final = dynres.measure_scale(work.prepared, session, None, frames)(found.value)
+    final = dynres.measure_scale(work.prepared, session, None, frames, on_frame=on_frame)(found.value)
     low = dynres.low_size(tuple(session.resolution), found.value)
     return MethodRow("dynamic resolution", f"scale {found.value:.3f} ({low[0]}×{low[1]}, bilinear)",
                      final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
                      final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                      [list(s) for s in found.steps])
+
+
+#: the equal-time row of the render cache (Walter, Drettakis, Greenberg 2002)
+RENDER_CACHE = "render cache (Walter 2002)"
+
+
+def render_cache_row(work, session, frames, search, target, settings, progress, on_frame=None,
+                     render_cache=None) -> MethodRow:
+    """The render cache with its sample share tuned to the ``target`` speed-up over the ``search``
+    frames (:func:`rrcache.alternatives.render_cache.tune.tune_samples`), then measured over
+    ``frames`` beside the original; ``render_cache``: its other settings (the defaults when None).
+    The row's ``stages`` are the median ms of each stage of its frames."""
+    from rrcache.alternatives.render_cache import RenderCacheSettings
+    from rrcache.alternatives.render_cache.tune import compare, tune_samples
+
+    base = render_cache or RenderCacheSettings()
+
+    def step(share, speedup):
+        _say(progress, f"render cache {share:.2%} of the pixels: {speedup:.2f}× (target {target:.2f}×)")
+
+    found = tune_samples(work.prepared, session, search, target, base, rel_tol=settings.tolerance,
+                         max_steps=settings.max_steps, progress=step)
+    final = compare(work.prepared, session, frames, replace(base, samples=found.value), on_frame=on_frame)
+    row = MethodRow(RENDER_CACHE, f"{found.value:.2%} of the pixels per frame ({final.budget} pixels, "
+                                  f"{base.block}×{base.block} blocks, {base.points_per_pixel:g} points per pixel)",
+                    final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
+                    final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
+                    [list(s) for s in found.steps])
+    row.stages = dict(final.stages)
+    return row
 
 
 def _simplification_row(work, session, frames, search, target, settings, result, progress) -> Optional[MethodRow]:

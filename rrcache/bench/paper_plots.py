@@ -36,7 +36,8 @@ def write_scene_plot(scene, out) -> str:
             if _x(r.speedup) is not None:
                 ax.scatter([_x(r.speedup)], [r.mean_error], marker=markers.get(r.method, "x"), facecolors="none",
                            edgecolors="tab:gray", zorder=2, label=f"{r.method} ({scene.medium} node)")
-        colours = {"dynamic resolution": "tab:orange", "simplification (Pellacini 2005)": "tab:green"}
+        colours = {"dynamic resolution": "tab:orange", "simplification (Pellacini 2005)": "tab:green",
+                   "render cache (Walter 2002)": "tab:purple"}
         for r in scene.equal_time[1:]:
             if _x(r.speedup) is not None:
                 ax.scatter([_x(r.speedup)], [r.mean_error], marker="*", s=120, color=colours.get(r.method, "tab:red"),

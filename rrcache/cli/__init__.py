@@ -29,6 +29,7 @@ _COMMANDS = {
     "bench-repeats": "bench_repeats",
     "bench": "bench",
     "profile": "profile",
+    "profile-library": "profile_library",
     "select": "select",
     "accuracy": "accuracy",
     "render": "render",

@@ -238,14 +238,39 @@ def _summary(prof, console: Console) -> None:
     for s in prof.selections:
         if s.fallback:
             console.print(f"{s.label}: {s.fallback}", highlight=False)
+        if s.level_met is False:
+            console.print(f"{s.label}: MISSED its level: {s.level_note}", highlight=False)
+    for line in calibration_lines(prof):
+        console.print(line, highlight=False)
     if any(s.visible_artifacts for s in prof.selections):
         marked = ", ".join(s.label for s in prof.selections if s.visible_artifacts)
-        console.print(f"{marked}: below {VISIBLE_DB:.0f} dB PSNR: visible artifacts (a choice, not a default)",
+        console.print(f"{marked}: {_visible_words(prof)}: visible artifacts (a choice, not a default)",
                       highlight=False)
     noisy = [s.label for s in prof.selections if s.measured_noise is not None and s.measured_noise > UNRELIABLE_NOISE]
     if noisy:
         console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
                       f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
+
+
+def _visible_words(prof) -> str:
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    if any(s.visible_artifacts and s.measured_flip is not None for s in prof.selections):
+        return f"mean FLIP ≥ {VISIBLE_FLIP:g} as measured (below {VISIBLE_DB:.0f} dB PSNR where only predicted)"
+    return f"below {VISIBLE_DB:.0f} dB PSNR (predicted)"
+
+
+def calibration_lines(prof) -> list[str]:
+    """What validation said of the PSNR predictions: their error on the measured choices, raw and
+    calibrated, and the calibration the profile now predicts with (docs/levels.md)."""
+    cal = prof.calibration or {}
+    raw, calibrated = cal.get("raw") or {}, cal.get("calibrated") or {}
+    if not raw.get("n"):
+        return []
+    return [f"PSNR predicted against measured on {raw['n']} validated choices: |error| mean {raw['mean']:.1f} dB, "
+            f"worst {raw['worst']:.1f} dB (models alone); mean {calibrated['mean']:.1f}, worst "
+            f"{calibrated['worst']:.1f} dB (calibrated by the choices measured before each); the profile now "
+            f"predicts with a {cal.get('shift', 0.0):+.1f} dB calibration (± {cal.get('spread', 0.0):.1f} dB)"]
 
 
 def _estimator_lines(prof) -> list[str]:
@@ -284,6 +309,8 @@ def _estimator_lines(prof) -> list[str]:
 def _level(s) -> str:
     if s.min_psnr is not None:
         return f"≥ {s.min_psnr:g} dB"
+    if s.max_flip is not None:
+        return f"FLIP ≤ {s.max_flip:g}"
     return f"error ≤ {_fmt(s.max_error)}"
 
 
@@ -317,13 +344,43 @@ def _measured_psnr(s) -> str:
     if s.exact or not s.parts:
         return psnr_text(math.inf)
     text = psnr_text(s.measured_psnr)
-    return text + (" (visible)" if s.visible_artifacts else "")
+    if s.measured_psnr_uncertainty:
+        text += f" ± {s.measured_psnr_uncertainty:.1f}"
+    return text
+
+
+def _flip(s) -> str:
+    """The measured mean FLIP ('0' for an exact image), marked where it shows visible artifacts."""
+    if s.exact or (not s.parts and s.measured_error is not None):
+        return "0"
+    if s.measured_flip is None:
+        return "–"
+    return f"{s.measured_flip:.3f}" + (" (visible)" if s.visible_artifacts else "")
+
+
+def level_status(s) -> str:
+    """The table's word on a selection's level: ``met``, ``met, try N`` (the N-th candidate
+    measured stood), ``original`` (nothing measured met it: see the fallback line), ``MISSED``
+    (shipped below its level: only where validation was told not to fall back), or ``–``
+    (not measured).
+
+    >>> from rrcache.selection import Selection
+    >>> level_status(Selection.original(1.0, level_met=True, tries=2, fallback="..."))
+    'original (2 tried)'
+    """
+    if s.level_met is None:
+        return "–"
+    if not s.level_met:
+        return "MISSED"
+    if not s.parts:
+        return f"original ({s.tries} tried)" if s.tries else ("original" if s.fallback else "met")
+    return f"met, try {s.tries}" if s.tries > 1 else "met"
 
 
 def _table(prof) -> Table:
-    table = Table(title="selections")
+    table = Table(title="selections (pred. = predicted by the models, meas. = measured by validation)")
     for name in ("level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
-                 "error pred.", "error meas."):
+                 "FLIP meas.", "level met"):
         if name == "node":
             table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=36)
         else:
@@ -333,5 +390,5 @@ def _table(prof) -> Table:
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),
-                      _predicted_psnr(s), _measured_psnr(s), _fmt(s.predicted_error), _fmt(s.measured_error))
+                      _predicted_psnr(s), _measured_psnr(s), _flip(s), level_status(s))
     return table

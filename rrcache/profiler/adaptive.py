@@ -27,7 +27,6 @@ from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.runs import RunSpec
 from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD
 from rrcache.runtime.spec import VariantSpec
-from rrcache.kinds import spec_for
 from rrcache.selection import AdaptiveNode, CachedNode, Selection
 
 #: thresholds measured by default (in the cached value's units: a colour or an occlusion in [0, 1])
@@ -59,16 +58,6 @@ class AdaptivePoint:
 
     def part(self, text: Optional[str] = None) -> AdaptiveNode:
         return AdaptiveNode(self.node, int(self.period), float(self.threshold), int(self.fast_period), text=text)
-
-
-def runtime_kwargs(selection: Selection) -> dict:
-    """The runtime's adaptive arguments of ``selection`` (empty unless its spec has a threshold)."""
-    if not selection.parts:
-        return {}
-    spec = spec_for(selection)
-    if spec.threshold is None:
-        return {}
-    return {"threshold": float(spec.threshold), "fast_period": int(spec.fast_period), "spread": float(spec.spread)}
 
 
 def sweep(executor, spec: VariantSpec, thresholds: Sequence[float], frames, timed_frames=None, resolution=None,

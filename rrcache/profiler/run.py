@@ -235,19 +235,36 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
     choices = prof.threshold_selections()
     if not settings.validate:
         return choices
-    from rrcache.profiler.validate import validate
+    from rrcache.profiler.validate import Validator
 
-    measured = validate(work, session, settings, store, choices, progress,
-                        window=result.plan.timing_window if result.plan is not None else None,
-                        candidates=prof.front_candidates)
+    validator = Validator(work, session, settings, store, progress,
+                          window=result.plan.timing_window if result.plan is not None else None,
+                          candidates=prof.front_candidates)
+    measured = validator.run(choices)
     if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
                                result.plan.timing_window if result.plan is not None else None)
+    prof.calibration = calibration_record(validator)
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured
+
+
+def calibration_record(validator) -> dict:
+    """``Profile.calibration`` from a finished validation: the calibration's points, shift and
+    spread, and the PSNR predictions' error over every measured choice, raw (the models alone)
+    and calibrated (as predicted when it was measured, by the points before it)."""
+    from rrcache.model.calibration import prediction_errors
+
+    rows = [s for s in validator.measured.values() if s.parts and not s.exact and s.predicted_psnr is not None
+            and s.measured_psnr is not None]
+    record = validator.calibration.to_json()
+    record["raw"] = prediction_errors([(s.predicted_psnr - float(s.calibration_db or 0.0), s.measured_psnr)
+                                       for s in rows])
+    record["calibrated"] = prediction_errors([(s.predicted_psnr, s.measured_psnr) for s in rows])
+    return record
 
 
 def _verdict(ceiling) -> dict:
@@ -260,8 +277,6 @@ def _verdict(ceiling) -> dict:
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    from rrcache.pipeline import variant_for_selection
-
     out.mkdir(parents=True, exist_ok=True)
     kept = []
     for sel in prof.selections:
@@ -270,11 +285,7 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
             for old in folder.iterdir():
                 if old.is_file():
                     old.unlink()
-        if not sel.parts:
-            prof.write_variant(sel, folder)
-        else:
-            variant, period = variant_for_selection(work, sel, **prof.settings.cache_options())
-            variant.write(folder, period=period, runtime=variant.spec.manifest_runtime())
+        prof.write_variant(sel, folder, work=work)
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out

@@ -1,46 +1,59 @@
-"""Validation: the four selections rendered beside the original, predicted against measured, and
-never a measured slowdown shipped.
+"""Validation: each level's selection rendered beside the original, and a level that means what it
+says (docs/levels.md).
 
-After training, :func:`validate` takes the labelled selections of the profile
+After training, :class:`Validator` (``validate``) takes the labelled selections of the profile
 (:meth:`rrcache.profiles.Profile.threshold_selections`: by default predicted PSNR ≥ 45, 40, 35,
 30 dB) and measures each with :func:`rrcache.harness.cached.compare`, side by side with the
 original at the session's full resolution, alternating frame by frame (main paper §4.4, Fig. 6).
 Shaders timed in a window (:mod:`rrcache.profiler.plan`) are validated in the same window.
 
-**Error and repeats.** A selection's error, PSNR and hit rate are measured over
-``validation_frames`` consecutive frames drawn exactly (``rgba32f``, as the error runs the
-models were trained on: an 8-bit target would add its own rounding to the error); its speed-up
-:data:`REPEATS` times in the settings' timing format (:mod:`rrcache.gl.formats`, ``rgba8`` by
-default, as applications draw), each over :data:`SHORT_FRAMES` consecutive frames, the stretches
-spread over the validation frames (the refresh schedule makes the hit/miss mix steady from a
-stretch's second frame on). The measured speed-up is the median of the repeats, ``speedups``
-keeps each, ``measured_noise`` the noisiest run's frame-to-frame noise of the original
-(:func:`rrcache.harness.timing.frame_noise`).
+**What is measured.** Over ``validation_frames`` consecutive frames drawn exactly (``rgba32f``,
+as the error runs the models were trained on): the error, the PSNR with its uncertainty
+(:func:`rrcache.model.levels.batch_uncertainty` over the per-frame PSNRs), the hit rate, the
+mean FLIP on :data:`~rrcache.harness.perceptual.FLIP_FRAMES` frames spread over them and the
+temporal error (the PSNR of the frame-to-frame changes, :mod:`rrcache.harness.perceptual`). The
+speed-up :data:`REPEATS` times in the settings' timing format (``rgba8`` by default, as
+applications draw), each over :data:`SHORT_FRAMES` consecutive frames, the stretches spread over
+the validation frames; the measured speed-up is their median, ``speedups`` keeps each,
+``measured_noise`` the noisiest run's frame-to-frame noise of the original.
 
-**Never a measured slowdown.** A selection is *slower than the original beyond the noise* when
-every repeat measured it slower (the highest repeat < 1.0). Then the next candidate on the
-predicted Pareto front at the same level (:meth:`~rrcache.profiles.Profile.front_candidates`,
-fastest first) is measured instead, up to :data:`MAX_FALLBACKS` of them, and failing those the
-original shader stands; the selection that stands says why in ``fallback`` (the rejected
-choices and what they measured). A median below 1.0 with some repeat at or above it is within
-the noise and is kept, with its range shown.
+**A level that means what it says.** A measured selection stands at its level only when it
+passes both rules of :mod:`rrcache.model.levels`: its measured quality misses the level by no
+more than the measurement's uncertainty, and its measured speed-up clears the gain worth having
+(``--min-gain``) with every repeat at least 1.0. Otherwise the next candidate is measured: the
+fastest of the level's candidates (``candidates(choice)``: the predicted Pareto front at the
+level, fastest first) that the *calibrated* models (:mod:`rrcache.model.calibration`, refitted
+with every measured point) predict to meet the level with the calibration's margin, up to
+:data:`MAX_TRIES` measured candidates per level. A choice measured already (for another level,
+or by an earlier run of the same store) is not rendered again. When none stands, the original
+shader stands for that level, its ``fallback`` listing every choice measured and why each was
+refused (docs/levels.md says why the original and not the best measured choice). The models'
+choices of the later levels are checked against the calibration before they are measured, so a
+level whose first choice the calibrated model already predicts to miss goes straight to one it
+does not.
+
+With ``fallback=False`` each choice is measured as chosen and only marked: ``level_met`` False
+and ``level_note`` saying why.
 
 A selection of the original shader is not rendered: its image is exact (PSNR ∞) and its speed-up 1.
-A choice already measured in the store (a resumed run) is not rendered again.
 
 >>> rows = validate(work, session, settings, store, prof.threshold_selections(), candidates=prof.front_candidates)  # doctest: +SKIP
->>> [(r.label, r.node, r.period, r.fallback) for r in rows]                                                       # doctest: +SKIP
-[('e1', 'n104', 50, None), ('e2', None, None, 'n102 Δn=34 measured 0.94× (0.92–0.96) ...'), ...]
+>>> [(r.label, r.describe(), r.tries, r.fallback) for r in rows]                                                  # doctest: +SKIP
+[('e1', 'the original shader', 3, 'n104 Δn=50: measured 40.7 ± 0.3 dB, below the level 45 dB; ...'), ...]
 """
 from __future__ import annotations
 
+import json
+import math
 import statistics
 from typing import Callable, Optional
 
 from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.harness.cached import compare
+from rrcache.harness.perceptual import FrameQuality, flip_frame_indices
 from rrcache.harness.timing import frame_noise
-from rrcache.model.psnr import VISIBLE_DB
+from rrcache.model.calibration import Calibration
+from rrcache.model.levels import VISIBLE_FLIP, batch_uncertainty, quality_miss, speed_miss
 from rrcache.pipeline import ShaderWork, variant_for_selection
 from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn
 from rrcache.profiles.settings import TrainingSettings
@@ -50,8 +63,15 @@ from rrcache.selection import Selection
 #: side-by-side measurements of each selection, and the frames of each after the first
 REPEATS = 3
 SHORT_FRAMES = 24
-#: at most this many further candidates of the front are measured for a level before the original
-MAX_FALLBACKS = 2
+#: at most this many candidates are measured for one level (the models' first choice included)
+MAX_TRIES = 3
+#: kept for callers of the earlier rule: further candidates after the first
+MAX_FALLBACKS = MAX_TRIES - 1
+#: the store's meta key of the figures its validation table has no column for
+EXTRA_META = "validation_figures"
+#: the measured figures kept in EXTRA_META, per selection
+_EXTRA_FIELDS = ("speedups", "measured_noise", "measured_psnr_uncertainty", "measured_error_uncertainty",
+                 "measured_flip", "measured_flip_uncertainty", "measured_temporal_psnr", "exact")
 
 
 def slower_beyond_noise(speedups) -> bool:
@@ -63,107 +83,268 @@ def slower_beyond_noise(speedups) -> bool:
     return bool(speedups) and max(speedups) < 1.0
 
 
-def _range_text(sel: Selection) -> str:
-    lo, hi = sel.speedup_range or (sel.measured_speedup, sel.measured_speedup)
-    return f"{sel.measured_speedup:.2f}× ({lo:.2f}–{hi:.2f} over {len(sel.speedups) or 1} repeats)"
+def calibration_group(sel: Selection) -> Optional[str]:
+    """What a selection's calibration point is grouped by: its node (one cached node), its
+    estimator (``est:e1``) or its nodes joined by ``+`` (a set); None for the original.
+
+    >>> from rrcache.selection import CachedNode
+    >>> calibration_group(Selection((CachedNode("n3", 8),), 0.01, 1.0, 2.0))
+    'n3'
+    """
+    if not sel.parts:
+        return None
+    if sel.kind == "amortize":
+        return f"est:{sel.parts[0].estimator}"
+    if sel.multi:
+        return "+".join(sel.nodes)
+    return sel.node
+
+
+def _key_text(sel: Selection) -> str:
+    return json.dumps(sel.key)
+
+
+class Validator:
+    """One profile's validation (see the module docstring): ``run(choices)`` returns the
+    selections that stand; :attr:`calibration` is the calibration after every measured point,
+    :attr:`measured` every measurement by what it caches."""
+
+    def __init__(self, work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore,
+                 progress: Optional[ProgressFn] = None, window=None,
+                 candidates: Optional[Callable[[Selection], list[Selection]]] = None, fallback: bool = True,
+                 calibration: Optional[Calibration] = None):
+        self.work, self.session, self.settings, self.store = work, session, settings, store
+        self.progress, self.window, self.candidates, self.fallback = progress, window, candidates, fallback
+        self.calibration = calibration or Calibration()
+        self.frames = list(range(settings.validation_frames))
+        self.short = self.frames[:max(2, min(SHORT_FRAMES, len(self.frames)))]
+        self.per = len(self.frames) + REPEATS * len(self.short)
+        self.measured: dict[tuple, Selection] = {}
+        self._stored = {row.key: row for row in store.validations() if row.parts}
+        self._extras = self._read_extras()
+        self.state = {"done": 0, "total": 0}
+
+    # ------------------------------------------------------------------ measuring
+    def _read_extras(self) -> dict:
+        raw = self.store.meta().get(EXTRA_META)
+        try:
+            data = json.loads(raw) if raw else {}
+        except ValueError:
+            data = {}
+        return data if isinstance(data, dict) else {}
+
+    def _keep_extras(self, sel: Selection) -> None:
+        self._extras[_key_text(sel)] = {k: (list(v) if isinstance(v, tuple) else v)
+                                        for k in _EXTRA_FIELDS for v in [getattr(sel, k)]}
+        self.store.set_meta(EXTRA_META, json.dumps(self._extras, allow_nan=False, default=_no_nan))
+
+    def _from_store(self, choice: Selection) -> Selection:
+        m = self._stored[choice.key]
+        extra = self._extras.get(_key_text(choice), {})
+        exact = bool(extra.get("exact", m.exact or m.measured_error == 0.0))
+        sel = choice.with_measurement(m.measured_error, None if exact else m.measured_psnr, m.measured_ms,
+                                      m.measured_original_ms, m.measured_speedup, m.hit_rate, m.frames,
+                                      tuple(extra.get("speedups") or (m.measured_speedup,)))
+        values = {k: extra.get(k) for k in _EXTRA_FIELDS if k not in ("speedups", "exact")}
+        return self._flagged(sel.replace(exact=exact, **values))
+
+    @staticmethod
+    def _flagged(sel: Selection) -> Selection:
+        """``visible_artifacts`` from what was measured: FLIP at or above
+        :data:`~rrcache.model.levels.VISIBLE_FLIP` (docs/levels.md)."""
+        flip = sel.measured_flip
+        return sel.replace(visible_artifacts=bool(flip is not None and flip >= VISIBLE_FLIP and not sel.exact))
+
+    def _step(self, detail: str) -> None:
+        self.state["done"] += 2
+        if self.progress is not None:
+            self.progress(ProgressEvent("validate", self.state["done"], max(self.state["total"], self.state["done"]),
+                                        detail))
+
+    def measure(self, choice: Selection) -> Selection:
+        """``choice`` with its measured figures (rendered, or from an earlier measurement)."""
+        if choice.key in self.measured:
+            m = self.measured[choice.key]
+            return choice.with_measurement(m.measured_error, m.measured_psnr, m.measured_ms, m.measured_original_ms,
+                                           m.measured_speedup, m.hit_rate, m.frames, m.speedups).replace(
+                **{k: getattr(m, k) for k in _EXTRA_FIELDS if k != "speedups"},
+                visible_artifacts=m.visible_artifacts)
+        if choice.key in self._stored:
+            sel = self._from_store(choice)
+            self.measured[choice.key] = sel
+            return sel
+        self.state["total"] += 2 * self.per
+        variant, period = variant_for_selection(self.work, choice)
+        common = dict(period=period, window=self.window, **self.settings.cache_options())
+        quality = FrameQuality(flip_frame_indices(self.frames))
+        what = f"{choice.label}: {choice.describe()}"
+
+        def on_exact(row, got, ref):
+            quality.add(row.index, got.image, ref.image)
+            self._step(f"{what} error")
+
+        # the error over every validation frame, drawn exactly (rgba32f) as the error runs are
+        exact_run = compare(variant, self.session, self.work.prepared, self.frames, color_format=ERROR_FORMAT,
+                            on_frame=on_exact, **common)
+        # the speed-up in the timing format, REPEATS times over stretches spread over the frames
+        runs = []
+        for repeat in range(REPEATS):
+            start = (len(self.frames) - len(self.short)) * repeat // max(1, REPEATS - 1)
+            stretch = self.frames[start:start + len(self.short)]
+            runs.append(compare(variant, self.session, self.work.prepared, stretch,
+                                color_format=self.settings.timing_format, clock=self.settings.clock,
+                                on_frame=lambda *a, r=repeat: self._step(f"{what} timing [{r + 1}/{REPEATS}]"),
+                                **common))
+        speedups = tuple(r.speedup for r in runs)
+        exact = exact_run.mean_error == 0.0
+        steady = exact_run.frames[1:] or exact_run.frames
+        psnr = None if exact else min(exact_run.psnr, PSNR_CAP)  # exact: PSNR ∞, kept as null
+        sel = choice.with_measurement(exact_run.mean_error, psnr,
+                                      statistics.median(r.ms_per_frame for r in runs),
+                                      statistics.median(r.original_ms_per_frame for r in runs),
+                                      float(statistics.median(speedups)), exact_run.hit_rate,
+                                      len(exact_run.frames), speedups)
+        temporal = quality.temporal_psnr
+        sel = sel.replace(
+            measured_noise=max(frame_noise([f.original_ms for f in r.frames[1:]]) for r in runs), exact=exact,
+            measured_psnr_uncertainty=None if exact else batch_uncertainty([min(f.psnr, PSNR_CAP) for f in steady]),
+            measured_error_uncertainty=batch_uncertainty([f.mean_error for f in steady]),
+            measured_flip=quality.flip,
+            measured_flip_uncertainty=batch_uncertainty(quality.flips) if quality.flips else None,
+            measured_temporal_psnr=None if temporal is None or not math.isfinite(temporal) else min(temporal, PSNR_CAP))
+        sel = self._flagged(sel)
+        self.measured[choice.key] = sel
+        self._keep_extras(sel)
+        return sel
+
+    # ------------------------------------------------------------------ the levels
+    def _learn(self, sel: Selection) -> None:
+        """Add ``sel``'s measured point to the calibration (raw prediction against measurement)."""
+        if sel.parts and not sel.exact and sel.predicted_psnr is not None and sel.measured_psnr is not None:
+            raw = sel.predicted_psnr - float(sel.calibration_db or 0.0)
+            self.calibration = self.calibration.add(calibration_group(sel), raw, sel.measured_psnr,
+                                                    key=sel.describe())
+
+    def _calibrated(self, sel: Selection) -> Selection:
+        """``sel`` with its predicted PSNR as the current calibration predicts it (the shift it
+        applied in ``calibration_db``)."""
+        if not sel.parts or sel.predicted_psnr is None or sel.exact:
+            return sel
+        raw = sel.predicted_psnr - float(sel.calibration_db or 0.0)
+        value, spread = self.calibration.predict(calibration_group(sel), raw)
+        if not self.calibration.points:
+            return sel
+        base = float(sel.predicted_psnr_uncertainty or 0.0)
+        return sel.replace(predicted_psnr=value, calibration_db=value - raw,
+                           predicted_psnr_uncertainty=math.sqrt(base * base + spread * spread))
+
+    def _admissible(self, sel: Selection) -> bool:
+        """Whether the calibrated models predict ``sel`` to meet its PSNR level with the
+        calibration's margin (always, before any point, or for a level of another kind)."""
+        if sel.min_psnr is None or not self.calibration.points or not sel.parts or sel.exact:
+            return True
+        if sel.predicted_psnr is None:
+            return False
+        return sel.predicted_psnr - self.calibration.spread >= sel.min_psnr
+
+    def miss(self, sel: Selection) -> Optional[str]:
+        """Why the measured ``sel`` may not stand at its level, or None."""
+        if not sel.parts:
+            return None
+        quality = quality_miss(sel.measured_psnr, float(sel.measured_psnr_uncertainty or 0.0), sel.min_psnr,
+                               sel.measured_error, float(sel.measured_error_uncertainty or 0.0), sel.max_error,
+                               sel.measured_flip, float(sel.measured_flip_uncertainty or 0.0), sel.max_flip,
+                               exact=sel.exact)
+        if quality is not None:
+            return quality
+        return speed_miss(sel.speedups or (sel.measured_speedup,), self.settings.min_gain)
+
+    def _pool(self, choice: Selection) -> list[Selection]:
+        pool = [choice]
+        if self.fallback and self.candidates is not None:
+            pool += [c for c in self.candidates(choice) if c.key != choice.key and c.parts]
+        return pool
+
+    def level(self, choice: Selection) -> Selection:
+        """The selection that stands at ``choice``'s level (see the module docstring)."""
+        if not choice.parts:
+            return _original(choice).replace(level_met=True, tries=0)
+        if not self.fallback:
+            sel = self.measure(self._calibrated(choice))
+            self._learn(sel)
+            why = self.miss(sel)
+            return sel.replace(tries=1, level_met=why is None, level_note=why)
+        pool = [choice] + sorted(self._pool(choice)[1:], key=lambda c: c.predicted_ms)
+        refused: list[tuple[Selection, str]] = []
+        rendered = 0
+        while True:
+            done = {s.key for s, _ in refused}
+            nxt = next((c for c in (self._calibrated(c) for c in pool if c.key not in done) if self._admissible(c)),
+                       None)
+            if nxt is None:
+                break
+            fresh = nxt.key not in self.measured and nxt.key not in self._stored
+            if fresh and rendered >= MAX_TRIES:
+                break
+            rendered += int(fresh)
+            sel = self.measure(nxt)
+            self._learn(sel)
+            why = self.miss(sel)
+            if why is None:
+                sel = sel.replace(tries=len(refused) + 1, level_met=True)
+                if refused:
+                    sel = sel.replace(fallback=f"{_refusals(refused)}; so {sel.describe()} stands "
+                                               f"(candidate {len(refused) + 1})")
+                return sel
+            refused.append((sel, why))
+            # every measurement is kept in the store (the refused ones under their own label)
+            self.store.add_validation(sel.replace(label=f"{choice.label}~{len(refused)}"))
+        original = _original(choice).replace(level_met=True, tries=len(refused))
+        if refused:
+            return original.replace(fallback=f"{_refusals(refused)}; so the original shader stands")
+        shift = self.calibration.shift(calibration_group(choice))
+        return original.replace(
+            fallback=f"{choice.describe()} and every other candidate are predicted below the level once calibrated "
+                     f"by the choices measured before ({shift:+.1f} dB); so the original shader stands")
+
+    def run(self, choices: list[Selection]) -> list[Selection]:
+        """Measure each labelled choice (see the module docstring); store every measurement and
+        return the selections that stand, in order."""
+        self.state["total"] = 2 * self.per * len({c.key for c in choices if c.parts} - set(self._stored))
+        out = []
+        for choice in choices:
+            sel = self.level(choice)
+            self.store.add_validation(sel)
+            out.append(sel)
+        return out
+
+
+def _no_nan(value):
+    raise TypeError(f"not JSON: {value!r}")
+
+
+def _refusals(refused) -> str:
+    return "; ".join(f"{s.describe()}: {why}" for s, why in refused)
 
 
 def validate(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore, choices: list[Selection],
              progress: Optional[ProgressFn] = None, window=None,
              candidates: Optional[Callable[[Selection], list[Selection]]] = None,
-             fallback: bool = True) -> list[Selection]:
+             fallback: bool = True, calibration: Optional[Calibration] = None) -> list[Selection]:
     """Measure each of ``choices`` (labelled selections with their algorithm) beside the original
-    inside ``window`` when given, falling back along ``candidates(choice)`` (then to the
-    original) when one measures slower than the original beyond the noise (see the module
-    docstring; ``fallback=False`` keeps every choice as measured); store every measurement and
-    return the selections that stand, in order."""
-    frames = list(range(settings.validation_frames))
-    short = frames[:max(2, min(SHORT_FRAMES, len(frames)))]
-    # measurements already stored (a resumed run) are reused, keyed by what is cached
-    measured = {row.key: row for row in store.validations() if row.parts}
-    todo = {c.key for c in choices if c.parts} - set(measured)
-    per = len(frames) + REPEATS * len(short)
-    state = {"done": 0, "total": 2 * per * len(todo)}
-
-    def measure(choice: Selection) -> Selection:
-        if choice.key in measured:
-            m = measured[choice.key]
-            return choice.with_measurement(m.measured_error, m.measured_psnr, m.measured_ms, m.measured_original_ms,
-                                           m.measured_speedup, m.hit_rate, m.frames,
-                                           m.speedups or (m.measured_speedup,)).replace(
-                measured_noise=m.measured_noise, exact=m.exact or m.measured_error == 0.0,
-                measured_psnr=None if m.measured_error == 0.0 else m.measured_psnr)
-        variant, period = variant_for_selection(work, choice)
-        if choice.key not in todo:  # a fallback candidate: more work than planned
-            state["total"] += 2 * per
-
-        def step(*_, detail=""):
-            state["done"] += 2
-            if progress is not None:
-                progress(ProgressEvent("validate", state["done"], state["total"], detail))
-
-        common = dict(period=period, window=window, **settings.cache_options())
-        # the error over every validation frame, drawn exactly (rgba32f) as the error runs are
-        exact_run = compare(variant, session, work.prepared, frames, color_format=ERROR_FORMAT,
-                            on_frame=lambda *a: step(detail=f"{choice.label}: {choice.describe()} error"), **common)
-        # the speed-up in the timing format, REPEATS times over stretches spread over the frames
-        runs = []
-        for repeat in range(REPEATS):
-            start = (len(frames) - len(short)) * repeat // max(1, REPEATS - 1)
-            stretch = frames[start:start + len(short)]
-            runs.append(compare(variant, session, work.prepared, stretch, color_format=settings.timing_format,
-                                clock=settings.clock,
-                                on_frame=lambda *a, r=repeat: step(
-                                    detail=f"{choice.label}: {choice.describe()} timing [{r + 1}/{REPEATS}]"),
-                                **common))
-        speedups = tuple(r.speedup for r in runs)
-        exact = exact_run.mean_error == 0.0
-        psnr = None if exact else min(exact_run.psnr, PSNR_CAP)  # exact: PSNR ∞, kept as null
-        sel = choice.with_measurement(exact_run.mean_error, psnr, statistics.median(r.ms_per_frame for r in runs),
-                                      statistics.median(r.original_ms_per_frame for r in runs),
-                                      float(statistics.median(speedups)), exact_run.hit_rate, len(exact_run.frames),
-                                      speedups)
-        sel = sel.replace(measured_noise=max(frame_noise([f.original_ms for f in r.frames[1:]]) for r in runs),
-                          exact=exact, visible_artifacts=bool(psnr is not None and psnr < VISIBLE_DB))
-        measured[choice.key] = sel
-        return sel
-
-    out = []
-    rejected_count = 0
-    for choice in choices:
-        if not choice.parts:
-            sel = _original(choice)
-        else:
-            sel = measure(choice)
-            rejected: list[Selection] = []
-            pool = list(candidates(choice)) if candidates is not None else []
-            while fallback and sel.parts and slower_beyond_noise(sel.speedups or (sel.measured_speedup,)):
-                rejected.append(sel)
-                rejected_count += 1
-                # every measurement is kept in the store (the rejected ones under their own label)
-                store.add_validation(sel.replace(label=f"{choice.label}~{len(rejected)}"))
-                pool = [c for c in pool if c.key not in {r.key for r in rejected}]
-                if pool and len(rejected) <= MAX_FALLBACKS:
-                    sel = measure(pool.pop(0))
-                else:
-                    sel = _original(choice)
-            if rejected:
-                why = "; ".join(f"{r.describe()} measured {_range_text(r)}" for r in rejected)
-                sel = sel.replace(fallback=f"{why}: slower than the original in every repeat, so "
-                                           f"{sel.describe()} stands")
-        store.add_validation(sel)
-        out.append(sel)
-    return out
+    inside ``window`` when given and return the selections that stand at their levels (see the
+    module docstring; ``fallback=False`` keeps every choice as measured, marked)."""
+    return Validator(work, session, settings, store, progress, window, candidates, fallback, calibration).run(choices)
 
 
 def _original(choice: Selection) -> Selection:
     """The original shader as a measured selection at ``choice``'s level: exact, speed-up 1."""
     base = Selection.original(float(choice.predicted_ms) if not choice.parts else float("nan"))
     original = choice if not choice.parts else base.replace(
-        label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr, algorithm=choice.algorithm,
-        predicted_ms=choice.predicted_ms * choice.predicted_speedup)
+        label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr, max_flip=choice.max_flip,
+        algorithm=choice.algorithm, predicted_ms=choice.predicted_ms * choice.predicted_speedup)
     return original.with_measurement(0.0, None, float(original.predicted_ms), float(original.predicted_ms),
                                      1.0, 0.0, 0).replace(exact=True, predicted_psnr=None,
                                                           predicted_psnr_uncertainty=0.0, visible_artifacts=False,
                                                           predicted_error=0.0, predicted_speedup=1.0,
-                                                          predicted_speedup_range=(1.0, 1.0))
+                                                          predicted_speedup_range=(1.0, 1.0), calibration_db=None)

@@ -170,6 +170,12 @@ class Profile:
     #: of what validation measures (the frame, or the timing window): the covered fractions
     #: differ (:func:`rrcache.model.psnr.coverage_offset_db`)
     psnr_offset_db: float = 0.0
+    #: what validation taught the models (rrcache.model.calibration): ``points`` (each validated
+    #: choice's raw predicted and measured PSNR), the ``shift`` and ``spread`` (dB) of the
+    #: calibration they make, applied to the PSNR predictions of :meth:`psnr_fits`, and the
+    #: predictions' error on them, ``raw`` and ``calibrated`` (as each was predicted when it was
+    #: measured): ``{"n", "mean", "worst"}`` of |predicted − measured| dB. Empty before validation.
+    calibration: dict = field(default_factory=dict)
     #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
     #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
     #: was measured faster at the level
@@ -300,15 +306,24 @@ class Profile:
 
     def psnr_fits(self) -> list:
         """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
-        training runs, shifted by :attr:`psnr_offset_db` to the region validation measures), in
-        the order of :attr:`trained_nodes`."""
+        training runs, shifted by :attr:`psnr_offset_db` to the region validation measures, and
+        by the node's shift of the validation's calibration, :meth:`calibrated`), in the order of
+        :attr:`trained_nodes`."""
         import dataclasses as dc
 
         from rrcache.model.psnr import fit_psnr
 
         fits = [fit_psnr(n.errors, n.psnrs) for n in self.trained_nodes]
         off = float(self.psnr_offset_db or 0.0)
-        return [dc.replace(f, a=f.a + off) if off and f.quality != "no_data" else f for f in fits]
+        cal = self.calibrated()
+        shifts = [off + (cal.shift(n.id) if cal.points else 0.0) for n in self.trained_nodes]
+        return [dc.replace(f, a=f.a + d) if d and f.quality != "no_data" else f for f, d in zip(fits, shifts)]
+
+    def calibrated(self):
+        """The :class:`rrcache.model.calibration.Calibration` validation left in :attr:`calibration`."""
+        from rrcache.model.calibration import Calibration
+
+        return Calibration.from_json(self.calibration)
 
     def select_psnr(self, min_psnr: float) -> Selection:
         """The choice predicted fastest whose predicted PSNR against the original is ≥
@@ -365,9 +380,16 @@ class Profile:
             rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
         ms = float(choice.predicted_ms)
         span = speedup_range(float(self.original_ms), ms, rms, float(self.timing_noise or 0.0))
-        return {"predicted_psnr": value if math.isfinite(value) else None,
-                "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
-                "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
+        out = {"predicted_psnr": value if math.isfinite(value) else None,
+               "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
+               "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
+        cal = self.calibrated()
+        if cal.points and not isinstance(choice.parts[0], AmortizedLoop) and math.isfinite(value):
+            # psnr_fits carries the node's calibration shift: say how much, and widen the ± by its spread
+            out["calibration_db"] = cal.shift(choice.node)
+            if math.isfinite(spread):
+                out["predicted_psnr_uncertainty"] = math.hypot(spread, cal.spread)
+        return out
 
     def _psnr_terms(self, i: int, period, fit) -> tuple[float, float]:
         """(leave-one-out dB, frame spread) of trained node ``i`` at refresh ``period``
@@ -455,28 +477,15 @@ class Profile:
         model = self.estimator(part.estimator).model(part.history)
         return model.psnr if model is not None else None
 
-    def write_variant(self, choice: Selection, out_dir) -> list[str]:
+    def write_variant(self, choice: Selection, out_dir, work=None) -> list[str]:
         """Write the shader files of ``choice`` into ``out_dir``: the variant's passes and
-        ``manifest.json`` (recording the period it runs with); for the original shader only a
-        ``manifest.json`` saying so. The shader is loaded again and must still have the profiled
-        hash."""
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        if not choice.parts:
-            note = (self.verdict["answer"] if self.verdict is not None else
-                    choice.fallback or "no cached variant is predicted to beat the original at this error")
-            path = out / "manifest.json"
-            path.write_text(json.dumps({"rrcache_selection": 1, "node": None, "shader": self.shader,
-                                        "note": note}, indent=2) + "\n")
-            return [str(path)]
-        from rrcache.pipeline import load_for_session, variant_for_selection
-        from rrcache.session import load_session
+        ``manifest.json`` (recording the period and every cache option it runs with); for the
+        original shader only a ``manifest.json`` saying so. The shader is loaded again (unless
+        ``work`` is the profiled one) and must still have the profiled hash
+        (:func:`rrcache.profiles.choice.write`, the one writer of a profile's choices)."""
+        from rrcache.profiles.choice import write
 
-        work = load_for_session(self.shader, load_session(self.session), self.defines, self.include_dirs,
-                                vertex=self.vertex)
-        check_same_shader(self, work)
-        variant, period = variant_for_selection(work, choice.replace(algorithm=choice.algorithm or self.algorithm))
-        return variant.write(out, period=period, runtime=self.settings.cache_options())
+        return write(self, choice, out_dir, work)
 
     # ------------------------------------------------------------------ the document
     def to_json(self) -> dict:
@@ -742,27 +751,6 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
 
 
 # ---------------------------------------------------------------------- reading
-def check_same_shader(prof: Profile, work) -> None:
-    """Raise unless ``work`` (the shader loaded again for profile ``prof``) has the profiled hash;
-    the error says which file changed, or that none did (never blames an edit that did not
-    happen)."""
-    from rrcache.glsl.frontend import describe_change
-
-    if work.hash == prof.shader_hash:
-        return
-    what = describe_change(prof.shader_files or None, work.shader, prof.defines)
-    vertex_hash = work.vertex.hash if work.vertex is not None else None
-    if prof.vertex_hash is not None and vertex_hash != prof.vertex_hash:
-        changed = f"the vertex shader '{work.vertex.path if work.vertex is not None else prof.vertex}' changed"
-        what = changed if what.startswith("no shader file changed") else f"{what}; {changed}"
-    if what.startswith("no shader file changed") or what.startswith("the record predates"):
-        raise RRCacheError(f"the shader's hash differs from the profile's, though {what}" if what.startswith("no ")
-                           else f"the shader's hash differs from the profile's: {what}",
-                           str(prof.shader), hint="run 'rrcache profile' again to make a profile for it")
-    raise RRCacheError(f"the shader changed since it was profiled: {what}", str(prof.shader),
-                       hint="run 'rrcache profile' again, or restore the file")
-
-
 def algorithm_line(prof: Profile) -> str:
     """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
     0.377, three-pass 0.41 of the original's time)'."""

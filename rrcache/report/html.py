@@ -40,6 +40,23 @@ def _e(value) -> str:
     return html.escape(str(value), quote=True)
 
 
+#: what the data block's JSON spells as escapes: the HTML parser reads a script's text looking
+#: for ``</script`` and, after ``<!--``, for ``<script`` (the "script data escaped" states), so a
+#: shader comment ``<!--<script>`` left raw made the parser swallow the report's own script
+_SCRIPT_ESCAPES = {ord("<"): "\\u003c", ord(">"): "\\u003e", ord("&"): "\\u0026"}
+
+
+def script_json(data) -> str:
+    """``data`` as JSON safe inside ``<script type="application/json">``: no ``<``, ``>`` or ``&``
+    appears raw (nor any non-ASCII character), so no text from a shader, a file name or a session
+    can end or disable the script element; ``JSON.parse`` reads the escapes back as the same text.
+
+    >>> print(script_json({"text": "<!--<script>a && b</script>"}))
+    {"text":"\\u003c!--\\u003cscript\\u003ea \\u0026\\u0026 b\\u003c/script\\u003e"}
+    """
+    return json.dumps(data, separators=(",", ":"), allow_nan=False).translate(_SCRIPT_ESCAPES)
+
+
 def _f(value, digits: int = 4, suffix: str = "") -> str:
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
@@ -148,15 +165,14 @@ def _selection(prof, sel, shots: FrameShots) -> str:
     images = shots.selection_images(sel)  # the original, or the choice at the frame its kind shows
     what = (kind.report_html(sel, prof) if kind is not None
             else "keep the original shader (nothing is predicted faster at this level)")
-    if sel.fallback:
-        what += f'<br><span class="warn">measured slowdown, fell back: {_e(sel.fallback)}</span>'
-    if sel.visible_artifacts:
-        what += '<br><span class="warn">below 30 dB PSNR: visible artifacts (a choice, not a default)</span>'
+    what += _level_marks(sel)
     exact = sel.exact or not sel.parts
     predicted_psnr = ("∞ (exact)" if exact else
                       "–" if sel.predicted_psnr is None else
                       f"{sel.predicted_psnr:.1f} ± {sel.predicted_psnr_uncertainty or 0:.1f} dB")
-    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else _f(sel.measured_psnr, 3, " dB"))
+    measured_psnr = ("–" if sel.measured_error is None else "∞ (exact)" if exact else
+                     _f(sel.measured_psnr, 3, " dB") + (f" ± {sel.measured_psnr_uncertainty:.1f}"
+                                                       if sel.measured_psnr_uncertainty else ""))
     speedup = _x(sel.measured_speedup)
     if len(sel.speedups) > 1:
         lo, hi = sel.speedup_range
@@ -168,7 +184,7 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", predicted_speedup, speedup),
             ("PSNR", predicted_psnr, measured_psnr),
-            ("hit rate", "", _f(sel.hit_rate, 3))]
+            ("hit rate", "", _f(sel.hit_rate, 3))] + _measured_rows(sel)
     table = ("<table><tr><th></th><th class=num>predicted</th><th class=num>measured</th></tr>"
              + "".join(f"<tr><th>{a}</th><td class=num>{b}</td><td class=num>{c}</td></tr>" for a, b, c in rows)
              + "</table>")
@@ -192,6 +208,55 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
             f'<div class="shots">{"".join(figures)}</div></div>')
+
+
+def _level_marks(sel) -> str:
+    """What became of the selection's level (docs/levels.md): the choices refused and why, a
+    miss shipped as measured, visible artifacts."""
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    out = ""
+    if sel.fallback:
+        out += f'<br><span class="warn">fell back: {_e(sel.fallback)}</span>'
+    if sel.level_met is False:
+        out += f'<br><span class="warn miss">MISSED its level as measured: {_e(sel.level_note or "")}</span>'
+    if sel.visible_artifacts:
+        why = (f"mean FLIP {sel.measured_flip:.3f} ≥ {VISIBLE_FLIP:g}" if sel.measured_flip is not None
+               else "below 30 dB PSNR (predicted)")
+        out += f'<br><span class="warn">{_e(why)}: visible artifacts (a choice, not a default)</span>'
+    return out
+
+
+def _measured_rows(sel) -> list:
+    """The measured-only rows of a selection's table: FLIP, the temporal error, the level."""
+    exact = sel.exact or not sel.parts
+    flip = "0" if exact and sel.measured_error is not None else (
+        "–" if sel.measured_flip is None else
+        f"{sel.measured_flip:.4f}" + (f" ± {sel.measured_flip_uncertainty:.4f}" if sel.measured_flip_uncertainty else ""))
+    temporal = "∞ (exact)" if exact and sel.measured_error is not None else _f(sel.measured_temporal_psnr, 3, " dB")
+    if sel.level_met is None:
+        level = "–"
+    elif not sel.level_met:
+        level = "missed"
+    elif sel.parts:
+        level = "met" + (f" (candidate {sel.tries})" if sel.tries > 1 else "")
+    else:
+        level = "original" + (f" ({sel.tries} measured, none met it)" if sel.tries else "")
+    return [("mean FLIP", "", flip), ("PSNR of the frame-to-frame changes", "", temporal), ("level", "", level)]
+
+
+def _prediction_errors(prof) -> str:
+    """How far the PSNR predictions were from validation's measurements (``Profile.calibration``)."""
+    cal = getattr(prof, "calibration", None) or {}
+    raw, calibrated = cal.get("raw") or {}, cal.get("calibrated") or {}
+    if not raw.get("n"):
+        return ""
+    return (f'<p class="muted">PSNR predicted against measured on the {raw["n"]} choices validation measured: '
+            f"|predicted − measured| mean {raw['mean']:.1f} dB, worst {raw['worst']:.1f} dB from the models alone; "
+            f"mean {calibrated['mean']:.1f} dB, worst {calibrated['worst']:.1f} dB as predicted with the calibration "
+            f"of the choices measured before each. The profile now predicts with a "
+            f"{float(cal.get('shift') or 0.0):+.1f} dB calibration (± {float(cal.get('spread') or 0.0):.1f} dB; "
+            "docs/levels.md).</p>")
 
 
 def _plots(prof) -> str:
@@ -264,7 +329,7 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         data.update(chart_data(prof))
     else:
         data.update({"nodes": [], "front": [], "original_ms": float(prof.original_ms), "selections": []})
-    payload = json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    payload = script_json(data)
     name = Path(prof.shader).name
     sections = [
         "<h2>Summary</h2>", _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
@@ -280,9 +345,11 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         "source line.</p></div></div>",
         f"<h2>Shader source: {_e(name)}</h2>", _source(prof, lines),
         "<h2>Selections</h2>",
-        '<p class="muted">The four error thresholds e1..e4; predicted by the models, measured by rendering '
-        "the session with the chosen variant beside the original.</p>",
+        '<p class="muted">The four levels e1..e4; predicted by the models, measured by rendering '
+        "the session with the chosen variant beside the original. A level ships only what was measured to "
+        "meet it (docs/levels.md).</p>",
         "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        _prediction_errors(prof),
         _estimators(prof),
         "<h2>Model validation</h2>", _plots(prof),
         "<h2>Settings and training</h2>", _settings(prof),

@@ -1,0 +1,124 @@
+"""Learning from validation: a per-profile calibration of the predicted PSNR against measured.
+
+Every validated selection is a measured point of the error model over the whole session: the
+PSNR the models predicted for it (``predicted``) beside the PSNR validation measured
+(``measured``). The models' misses are mostly a factor on the error (Marble: the measured error
+about twice the predicted at every level), which is a shift in dB, so the calibration is a shift:
+
+    PSNR_calibrated = PSNR_predicted + d
+
+with ``d`` the mean of (measured − predicted) over the node's own points when it has any (the
+same node at another Δn misses by about the same factor), else over every point of the profile
+(0 without points). Its ± (:attr:`Calibration.spread`) is the RMS of the residuals around the
+shift (each point left out of its own shift when there are several), at least
+:data:`MIN_SPREAD_DB`, and :data:`ONE_POINT_SPREAD_DB` while one point is all there is.
+
+The calibration is refitted as points arrive (:meth:`Calibration.add` returns the new one):
+validation uses it to re-check the next levels' choices and the candidates after a miss
+(:mod:`rrcache.profiler.validate`), and the profile keeps it (``profile.json``:
+``calibration``) so that ``rrcache select`` predicts with it. :func:`prediction_errors` says how
+far the predictions were from the measurements, raw and as calibrated when each was made.
+
+>>> cal = Calibration().add("n1", 45.0, 40.7).add("n2", 40.9, 36.6)
+>>> round(cal.shift("n1"), 2), round(cal.shift("n3"), 2)
+(-4.3, -4.3)
+>>> round(cal.predict("n3", 50.0)[0], 1)
+45.7
+>>> Calibration().predict("n1", 41.0)
+(41.0, 0.0)
+>>> Calibration.from_json(cal.to_json()) == cal
+True
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+#: the least ± of a calibrated prediction (dB), and the ± while a single point is known
+MIN_SPREAD_DB = 0.5
+ONE_POINT_SPREAD_DB = 1.5
+
+
+@dataclass(frozen=True)
+class CalibrationPoint:
+    """One validated selection: ``key`` (what it caches, as text), ``node`` (the node it caches,
+    None for other kinds), the raw model's ``predicted`` PSNR and the ``measured`` one (dB)."""
+
+    key: str
+    node: Optional[str]
+    predicted: float
+    measured: float
+
+    def to_json(self) -> dict:
+        return {"key": self.key, "node": self.node, "predicted": self.predicted, "measured": self.measured}
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """The points so far (see the module docstring); immutable: :meth:`add` returns a new one."""
+
+    points: tuple = field(default=())
+
+    def add(self, node: Optional[str], predicted: float, measured: float, key: Optional[str] = None) -> "Calibration":
+        """This calibration with one more point of ``node`` (None: a choice of no single node)
+        under ``key`` (what is cached; default the node; a point of the same key replaces the
+        earlier one). Points whose PSNRs are not both finite carry nothing and are left out."""
+        key = str(key if key is not None else node)
+        if not (predicted is not None and measured is not None and math.isfinite(predicted)
+                and math.isfinite(measured)):
+            return self
+        kept = tuple(p for p in self.points if p.key != key)
+        return Calibration(kept + (CalibrationPoint(key, node, float(predicted), float(measured)),))
+
+    def _shift_of(self, points) -> float:
+        return float(np.mean([p.measured - p.predicted for p in points])) if points else 0.0
+
+    def shift(self, node: Optional[str] = None) -> float:
+        """``d`` (dB) for ``node``: its own points' mean miss, else every point's, else 0."""
+        own = [p for p in self.points if node is not None and p.node == node]
+        return self._shift_of(own or self.points)
+
+    @property
+    def spread(self) -> float:
+        """The ± (dB) of a calibrated prediction (see the module docstring); 0 without points."""
+        if not self.points:
+            return 0.0
+        if len(self.points) == 1:
+            return ONE_POINT_SPREAD_DB
+        residuals = []
+        for i, p in enumerate(self.points):
+            others = Calibration(self.points[:i] + self.points[i + 1:])
+            residuals.append(p.measured - (p.predicted + others.shift(p.node)))
+        return max(MIN_SPREAD_DB, float(math.sqrt(np.mean(np.square(residuals)))))
+
+    def predict(self, node: Optional[str], predicted: float) -> tuple[float, float]:
+        """(calibrated PSNR, its ±) of a raw prediction for ``node``."""
+        if predicted is None or not math.isfinite(predicted):
+            return predicted, 0.0
+        return float(predicted + self.shift(node)), self.spread
+
+    def to_json(self) -> dict:
+        return {"points": [p.to_json() for p in self.points], "shift": self.shift(), "spread": self.spread}
+
+    @classmethod
+    def from_json(cls, data: Optional[dict]) -> "Calibration":
+        if not data:
+            return cls()
+        return cls(tuple(CalibrationPoint(str(p["key"]), p.get("node"), float(p["predicted"]), float(p["measured"]))
+                         for p in data.get("points", ())))
+
+
+def prediction_errors(pairs) -> dict:
+    """``{"n", "mean", "worst"}`` of |predicted − measured| (dB) over ``pairs`` of (predicted,
+    measured) PSNRs (pairs with a missing or infinite value left out; None figures without any).
+
+    >>> prediction_errors([(45.0, 40.7), (40.9, 36.6), (35.8, 35.0)])
+    {'n': 3, 'mean': 3.13, 'worst': 4.3}
+    """
+    d = [abs(p - m) for p, m in pairs if p is not None and m is not None and math.isfinite(p) and math.isfinite(m)]
+    if not d:
+        return {"n": 0, "mean": None, "worst": None}
+    return {"n": len(d), "mean": round(float(np.mean(d)), 2), "worst": round(float(max(d)), 2)}
