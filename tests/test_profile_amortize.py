@@ -465,7 +465,8 @@ def test_frame_shots_render_an_amortized_selection(amortized_wins):
     """FrameShots renders an amortized choice for real: the run settles its history (the N/m
     cycle and the blend's memory), the cached frame is near the original but not equal to it,
     hits blend and misses evaluate every term, and the payload is the running estimate."""
-    from rrcache.report.images import HIT_COLOR, MISS_COLOR, FrameShots, settle_frame
+    from rrcache.profiler.frames import FrameShots
+    from rrcache.report.images import HIT_COLOR, MISS_COLOR, settle_frame
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
@@ -489,7 +490,7 @@ def test_frame_shots_render_an_amortized_selection(amortized_wins):
 
 
 def test_frame_shots_render_a_slots_selection(slots_win):
-    from rrcache.report.images import FrameShots
+    from rrcache.profiler.frames import FrameShots
 
     prof, _ = slots_win
     choice = prof.select(1.0)
@@ -508,11 +509,13 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
     from PIL import Image
 
+    from rrcache.profiler.frames import FrameShots
     from rrcache.report.html import report_html
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
-    page = report_html(_with_selection(prof, choice))
+    shown = _with_selection(prof, choice)
+    page = report_html(shown, frames={s.label: FrameShots(prof).selection_images(s) for s in shown.selections})
     block = re.search(r'<div class="sel" id="sel-e4".*?</div></div>', page, re.S).group(0)
     assert 'data-kind="amortize"' in block and "amortize estimator <b>e1</b>" in block
     assert f"λ = {choice.parts[0].blend:g}" in block and "no frames" not in block
@@ -525,8 +528,8 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
 
 def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
-    from rrcache.report.explore import (Explorer, default_choice, default_selection, measure_choice,
-                                        selections_figure, tradeoff_figure)
+    from rrcache.explorer import Explorer, measure_choice
+    from rrcache.report.explore import default_choice, default_selection, selections_figure, tradeoff_figure
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
@@ -556,7 +559,7 @@ def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
     assert "amortized options" in fig.axes[0].get_title()
     assert any(line.get_color() == "darkorange" for line in fig.axes[0].lines)
     # the selections figure shows the amortized selection's frames
-    fig = selections_figure(prof, ui.shots)
+    fig = selections_figure(prof, {s.label: ui.shots.selection_images(s) for s in prof.selections})
     assert sum(len(ax.images) for ax in fig.axes) == 5
 
 

@@ -147,7 +147,7 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                      err_console, quiet)
         return
     if level is not None:
-        from rrcache.profiles import choice
+        from rrcache import choice
 
         sel = choice.level(prof, level)
         if not sel.parts:

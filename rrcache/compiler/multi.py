@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from rrcache.deep import deep
+from rrcache.compiler.checks import check_algorithm
 from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.multi_locate import prepare_nodes
 from rrcache.compiler.multi_passes import build_multi_pass, has_discard, node_order
@@ -37,8 +38,6 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
     order). Raises :class:`~rrcache.errors.UnsupportedShaderError` for a node that cannot be
     cached, or not with ``algorithm`` (:func:`rrcache.compiler.check_algorithm`), or a nest that
     cannot be compiled."""
-    from rrcache.compiler import check_algorithm
-
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
     if filter not in FILTERS:

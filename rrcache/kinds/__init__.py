@@ -152,7 +152,7 @@ def spec_for(choice, algorithm: Optional[str] = None, **runtime) -> VariantSpec:
     kind = kind_of(choice)
     if kind is None:
         raise RRCacheError("the original shader has no variant", "selection",
-                           hint="the original shader needs none; write its files with Profile.write_variant")
+                           hint="the original shader needs none; rrcache.choice.write writes its files")
     algorithm = algorithm or getattr(choice, "algorithm", None) or "three-pass"
     return kind.spec(tuple(getattr(choice, "parts", choice)), algorithm, **runtime)
 

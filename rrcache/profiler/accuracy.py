@@ -30,7 +30,7 @@ from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.profiler.jobs import Meter, RunShapes
 from rrcache.profiler.plan import Plan
 from rrcache.profiler.train import timing_frame_indices
-from rrcache.profiles.choice import load_work
+from rrcache.choice import load_work
 from rrcache.runtime.spec import VariantSpec
 
 DEFAULT_PERIODS = (6, 14, 30)

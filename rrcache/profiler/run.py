@@ -35,6 +35,7 @@ from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
 from rrcache.selection import Selection
+from rrcache.choice import write as choice_write
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -276,7 +277,8 @@ def _verdict(ceiling) -> dict:
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
-    """The shader files of each selection, then (with ``plots``) the plots and the report."""
+    """The shader files of each selection, then (with ``plots``) the plots, the report's frames
+    (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
     out.mkdir(parents=True, exist_ok=True)
     kept = []
     for sel in prof.selections:
@@ -285,16 +287,18 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
             for old in folder.iterdir():
                 if old.is_file():
                     old.unlink()
-        prof.write_variant(sel, folder, work=work)
+        choice_write(prof, sel, folder, work=work)
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out
     if prof.verdict is not None:  # stopped before training: nothing to plot or report
-        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
+        choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
         plots = False
     if plots:
+        from rrcache.profiler.frames import write_frames
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
         prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_report(prof, out, work=work)
+        write_frames(prof, out, work)
+        write_report(prof, out)

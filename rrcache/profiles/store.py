@@ -110,12 +110,14 @@ CREATE TABLE error_frame (
 -- timing_run / timing_frame: one node at one timing period over the L timing frames at the
 --   session's full resolution. Each timed frame follows one untimed warm-up frame (the one
 --   before it) and is timed right after the original on the same frame (original_ms), so that
---   machine noise touches both alike.
+--   machine noise touches both alike. host: the machine that timed it (NULL: the profiling
+--   process itself).
 CREATE TABLE timing_run (
     node TEXT NOT NULL,
     period INTEGER NOT NULL,
     wall_s REAL NOT NULL,
     run_id INTEGER NOT NULL REFERENCES run_log(id),
+    host TEXT,
     PRIMARY KEY (node, period)
 );
 CREATE TABLE timing_frame (
@@ -523,10 +525,12 @@ class ProfileStore:
         self._write([("INSERT OR REPLACE INTO reference_timing VALUES (?, ?, ?)", (int(f), float(ms), int(c)))
                      for f, ms, c in rows])
 
-    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float) -> None:
-        """One timing run and its frames, in one transaction."""
+    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float,
+                       host: Optional[str] = None) -> None:
+        """One timing run and its frames (``host``: the machine that timed it), in one transaction."""
         rid = self._rid()
-        statements = [("INSERT INTO timing_run VALUES (?, ?, ?, ?)", (node, int(period), float(wall_s), rid))]
+        statements = [("INSERT INTO timing_run(node, period, wall_s, run_id, host) VALUES (?, ?, ?, ?, ?)",
+                       (node, int(period), float(wall_s), rid, host))]
         statements += [("INSERT INTO timing_frame VALUES (?, ?, ?, ?, ?, ?, ?)",
                         (node, int(period), f.frame, f.hits, f.misses, f.ms, f.original_ms)) for f in frames]
         statements.append(("UPDATE run_log SET timing_runs_computed = timing_runs_computed + 1 WHERE id = ?", (rid,)))
@@ -675,7 +679,7 @@ class ProfileStore:
         else:
             self.add_timing_run(node, int(period), [TimingFrame(r.frame, _count(r.hits), _count(r.misses), float(r.ms),
                                                                 float(r.original_ms)) for r in rows],
-                                float(result.wall_s))
+                                float(result.wall_s), result.host)
 
     def has_node_run(self, measure: str, node: str, period: int) -> bool:
         return (self.has_error_run if measure == "error" else self.has_timing_run)(node, period)
@@ -839,10 +843,12 @@ def _migrate_1(conn: sqlite3.Connection) -> None:
 
 def _migrate_2(conn: sqlite3.Connection) -> None:
     """Schema 2 → 3 in one transaction: the kinds' tables made (``amortize_run`` from before the
-    slots history rebuilt with its ``history`` column, its rows ``blend``), and the set stage's
-    record moved from ``meta('sets')`` into ``set_run``."""
+    slots history rebuilt with its ``history`` column, its rows ``blend``), the set stage's
+    record moved from ``meta('sets')`` into ``set_run``, and ``timing_run`` given its ``host``."""
     conn.execute("BEGIN IMMEDIATE")
     try:
+        if "host" not in _columns(conn, "timing_run"):
+            conn.execute("ALTER TABLE timing_run ADD COLUMN host TEXT")
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
         if "amortize_run" in tables and "history" not in _columns(conn, "amortize_run"):
             conn.execute("ALTER TABLE amortize_run RENAME TO amortize_run_old")

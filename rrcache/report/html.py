@@ -27,7 +27,7 @@ from rrcache.errors import RRCacheError
 from rrcache.profiles.document import algorithm_line
 from rrcache.report import assets
 from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
-from rrcache.report.images import CAPTIONS, FrameShots, data_uri
+from rrcache.report.images import CAPTIONS, data_uri, read_frames
 
 REPORT_NAME = "report.html"
 #: the figures of :mod:`rrcache.report.plots` the report shows, with their captions
@@ -135,9 +135,11 @@ def _source(prof, lines: list[str]) -> str:
     return legend + '<div class="src">' + "".join(rows) + "</div>"
 
 
-def _multi_selection(prof, sel) -> str:
-    """A selection of a kind without frames (several nodes): what it caches and its figures."""
-    what = sel.choice.report_html(sel, prof)
+def _multi_selection(prof, sel, note: str = "several nodes: no frames are shown for this choice") -> str:
+    """A selection shown without frames (a kind without them, several nodes; or a folder without
+    them): what it caches and its figures."""
+    what = (sel.choice.report_html(sel, prof) if sel.parts
+            else "keep the original shader (nothing is predicted faster at this level)")
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
@@ -149,7 +151,7 @@ def _multi_selection(prof, sel) -> str:
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
-            '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
+            f'<p class="muted">{_e(note)}</p></div>')
 
 
 def _level(sel) -> str:
@@ -158,11 +160,13 @@ def _level(sel) -> str:
     return f"error ≤ {_f(sel.max_error)}"
 
 
-def _selection(prof, sel, shots: FrameShots) -> str:
+def _selection(prof, sel, frames: dict) -> str:
     kind = sel.choice  # None: the original shader
     if kind is not None and not kind.has_frames:
         return _multi_selection(prof, sel)
-    images = shots.selection_images(sel)  # the original, or the choice at the frame its kind shows
+    images = frames.get(sel.label)  # rendered by the profiler into the folder (rrcache.profiler.frames)
+    if images is None:
+        return _multi_selection(prof, sel, "no frames in the profile folder: 'rrcache report' renders them")
     what = (kind.report_html(sel, prof) if kind is not None
             else "keep the original shader (nothing is predicted faster at this level)")
     what += _level_marks(sel)
@@ -319,9 +323,12 @@ def _estimators(prof) -> str:
             "<th>error model</th><th class=num>ms per 1e6 terms</th></tr>" + "".join(rows) + "</table>")
 
 
-def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
-    """The report page of ``prof`` as a string (renders the selections' frames)."""
-    shots = shots or FrameShots(prof, work)
+def report_html(prof, frames: Optional[dict] = None) -> str:
+    """The report page of ``prof`` as a string, from its folder's files: the selections' frames
+    are those the profiler rendered there (:func:`rrcache.report.images.read_frames`; ``frames``:
+    label → images given instead)."""
+    if frames is None:
+        frames = read_frames(prof.path) if prof.path is not None else {}
     lines = read_source(prof)
     timing = selection_timing(prof) if prof.trained_nodes else {"median_ms": None, "repeats": 0}
     data = {"source": lines, "details": {n.id: node_details(prof, n.id) for n in prof.nodes}}
@@ -348,7 +355,7 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         '<p class="muted">The four levels e1..e4; predicted by the models, measured by rendering '
         "the session with the chosen variant beside the original. A level ships only what was measured to "
         "meet it (docs/levels.md).</p>",
-        "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        "".join(_selection(prof, s, frames) for s in prof.selections) or "<p>No selection.</p>",
         _prediction_errors(prof),
         _estimators(prof),
         "<h2>Model validation</h2>", _plots(prof),
@@ -365,15 +372,15 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
             f"<script>{assets.JS}</script></body></html>\n")
 
 
-def write_report(profile, out_dir, work=None, filename: str = REPORT_NAME) -> Path:
+def write_report(profile, out_dir, filename: str = REPORT_NAME, frames: Optional[dict] = None) -> Path:
     """Write the report of ``profile`` into ``out_dir`` (as ``filename``, default ``report.html``)
-    and return its path. ``work`` (the profiled :class:`~rrcache.pipeline.ShaderWork`) saves
-    loading the shader again."""
+    and return its path: it reads the profile folder's files only (its frames rendered there by
+    the profiler, :mod:`rrcache.profiler.frames`; ``frames`` given instead)."""
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the report's folder is a file", str(out), hint="give a folder, or --out FILE.html")
     out.mkdir(parents=True, exist_ok=True)
-    text = report_html(profile, work)
+    text = report_html(profile, frames)
     path = out / filename
     tmp = out / (filename + ".tmp")
     tmp.write_text(text, encoding="utf-8")

@@ -1,5 +1,6 @@
 """A profile's choice at one level, exactly as the profile made it: the one place that turns a
-level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with.
+level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with. (It sits
+above the pipeline and the profile's data: the document, :mod:`rrcache.profiles`, compiles nothing.)
 
 The profile's ``optimized/eN`` folders, ``rrcache instance PROFILE --level eN``,
 ``rrcache render PROFILE --level eN``, ``rrcache select --out`` and the report's "what to do
