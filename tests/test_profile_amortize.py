@@ -273,8 +273,8 @@ def test_the_slots_history_is_trained_where_it_fits(trained):
 
 
 def _old_store(path):
-    """Rewrite the amortize_run table of the store at ``path`` as it was before the history
-    column (its blend rows only)."""
+    """Rewrite the store at ``path`` as schema 2 wrote it before the history column: its
+    amortize_run table without the column (its blend rows only), no set or adaptive tables."""
     import sqlite3
 
     conn = sqlite3.connect(str(path), isolation_level=None)
@@ -289,6 +289,9 @@ def _old_store(path):
         ms REAL NOT NULL, original_ms REAL NOT NULL, wall_s REAL NOT NULL,
         PRIMARY KEY (estimator, kind, samples, blend, frame))""")
     conn.executemany(f"INSERT INTO amortize_run ({cols}) VALUES ({', '.join('?' * 13)})", rows)
+    conn.execute("DROP TABLE IF EXISTS set_run")
+    conn.execute("DROP TABLE IF EXISTS adaptive_point")
+    conn.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
     conn.close()
     return rows
 
