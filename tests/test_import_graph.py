@@ -35,7 +35,7 @@ LAYERS = [
     {"selection"},
     {"model", "harness"},
     {"pipeline"},
-    {"alternatives", "profiles", "cluster", "choice"},
+    {"alternatives", "profiles", "cluster", "choice", "webgl"},
     {"report"},
     {"profiler"},
     {"bench", "explorer"},

@@ -36,7 +36,7 @@ from rrcache.selection import AMORTIZE_PAYLOADS
 from rrcache.choice import write as choice_write
 
 #: what --target writes: GLSL 3.30 core files, or WebGL2 (GLSL ES 3.00 and a page)
-TARGETS = ("glsl",)  # webgl2 lands with rrcache.webgl
+TARGETS = ("glsl", "webgl2")
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "estimator": "--estimator", "samples": "--samples", "blend": "--lambda",
                "history": "--history", "period": "--period", "algorithm": "--algorithm", "filter_": "--filter",

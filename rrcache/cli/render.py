@@ -67,6 +67,7 @@ from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEP
 from rrcache.session import load_session
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 from rrcache.cli.method import check_method, method_option, render_cache, samples_option
+from rrcache.cli.repeats import run_repeats
 
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm", "block": "--block",
@@ -278,22 +279,10 @@ def _compare(work, loaded, variant, what: str, setup: dict, out_dir, frame_count
         err_console.print(f"{what}\n  with {setup['said']}; colour target {color_format}, {len(indices)} frames",
                           highlight=False, markup=False, soft_wrap=True)
     label = setup.get("level") or " + ".join(nodes or [])
-    runs = []
-    with Reporter(err_console, quiet=quiet or len(indices) * repeats < 2) as reporter:
-        for repeat in range(repeats):
-            count = {"n": 0}
-
-            def done(row, got, ref, repeat=repeat):
-                if out is not None and repeat == 0:
-                    stem = out / f"frame_{row.index:04d}"
-                    write_image(stem.with_suffix(".exr"), got.image)
-                    write_image(stem.with_suffix(".png"), got.image)
-                    write_image(out / f"original_{row.index:04d}.png", ref.image)
-                count["n"] += 1
-                reporter.update(f"[{repeat + 1}/{repeats}] {label} beside the original", count["n"], len(indices))
-
-            runs.append(compare(variant, loaded, work.prepared, indices, period=setup["period"], resolution=resolution,
-                                on_frame=done, color_format=color_format, **setup["options"]))
+    runs = run_repeats(lambda done: compare(variant, loaded, work.prepared, indices, period=setup["period"],
+                                            resolution=resolution, on_frame=done, color_format=color_format,
+                                            **setup["options"]),
+                       len(indices), repeats, out, label, err_console, quiet)
     # the median repeat by speed-up stands for the run; the range is every repeat's
     speedups = sorted(r.speedup for r in runs)
     result = sorted(runs, key=lambda r: r.speedup)[len(runs) // 2]

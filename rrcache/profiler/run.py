@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import sqlite3
 import time
+import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
@@ -64,6 +65,25 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
+    # the run's warnings are kept in profile.json (the report shows them) and raised again at
+    # the end for the caller
+    raised: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
+                                include_dirs, wait, vertex, adaptive, caught)
+            finally:
+                raised = list(caught)
+    finally:
+        for w in raised:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return prof
+
+
+def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
+             vertex, adaptive, caught: list) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -103,6 +123,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
                                          window=result.plan.timing_window if result.plan is not None else None,
                                          store=store, executor=executor)
+            prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
             # how many variants this invocation compiled (each at most once: the compile cache)
             prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)

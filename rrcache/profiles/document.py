@@ -185,6 +185,10 @@ class Profile:
     #: the shader's estimators and their amortized-sampling models (:mod:`rrcache.profiles.amortize`;
     #: absent in documents written before amortization was profiled: none)
     estimators: list[EstimatorProfile] = field(default_factory=list)
+    #: the warnings the profiling run raised (a session shorter than the largest period, a
+    #: texture it could not decode ...), in order; :func:`rrcache.profiles.notices.run_warnings`
+    #: adds the ones its measurements imply
+    warnings: list[str] = field(default_factory=list)
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):
