@@ -26,7 +26,7 @@ ROOT = Path(rrcache.__file__).resolve().parent
 #: every package (or top-level module) of rrcache, lowest layer first: a module may import from
 #: its own package and from lower layers only (the same table is in docs/architecture.md)
 LAYERS = [
-    {"errors", "jsonable"},
+    {"errors", "jsonable", "files"},
     {"budgets", "deep", "atomic", "stdio", "watchdog"},
     {"glsl", "session", "gl"},
     {"analysis", "runtime"},
@@ -35,8 +35,8 @@ LAYERS = [
     {"selection"},
     {"model", "harness"},
     {"pipeline"},
-    {"alternatives", "profiles", "cluster", "choice", "webgl"},
-    {"report"},
+    {"alternatives", "profiles", "cluster", "webgl"},
+    {"report", "choice"},
     {"profiler"},
     {"bench", "explorer"},
     {"cli"},

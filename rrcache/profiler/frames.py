@@ -20,7 +20,7 @@ import json
 from pathlib import Path
 from typing import Optional
 
-from rrcache import atomic
+from rrcache.atomic import OutputFolder
 from rrcache.report.images import (CAPTIONS, FRAMES_DIR, FRAMES_JSON, MAX_WIDTH, ChoiceImages, error_map,
                                    hit_map_image, image_size, payload_image)
 
@@ -34,7 +34,12 @@ class FrameShots:
         from rrcache.session import load_session
 
         self.profile = profile
-        self.session = load_session(profile.session)
+        if work is None:  # a profile read from its folder: what it names is checked first
+            from rrcache.profiles.inputs import load_session_of
+
+            self.session = load_session_of(profile)
+        else:
+            self.session = load_session(profile.session)
         if work is None:
             from rrcache.pipeline import load_for_session
 
@@ -144,23 +149,21 @@ def write_frames(profile, out_dir, work=None, shots: Optional[FrameShots] = None
     into ``out_dir/frames/<label>/<image>.png`` and ``frames/frames.json``; returns the paths
     written. ``work``: the profiled shader already loaded."""
     shots = shots or FrameShots(profile, work)
-    folder = Path(out_dir) / FRAMES_DIR
     record, written = {}, []
-    for sel in profile.selections:
-        if sel.parts and not sel.choice.has_frames:
-            continue
-        images = shots.selection_images(sel)
-        files = {}
-        for name in CAPTIONS:
-            if name in images.arrays:
-                rel = f"{FRAMES_DIR}/{sel.label}/{name}.png"
-                path = Path(out_dir) / rel
-                path.parent.mkdir(parents=True, exist_ok=True)
-                atomic.write_bytes(str(path), images.png(name))
-                files[name] = rel
-                written.append(str(path))
-        record[sel.label] = images.to_json(files)
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / FRAMES_JSON
-    atomic.write_text(str(path), json.dumps({"rrcache_frames": 1, "selections": record}, indent=2) + "\n")
-    return written + [str(path)]
+    # by rrcache.atomic's rule: inside the profile folder, links refused, each file whole
+    with OutputFolder(out_dir) as root, root.folder(FRAMES_DIR) as frames:
+        for sel in profile.selections:
+            if sel.parts and not sel.choice.has_frames:
+                continue
+            images = shots.selection_images(sel)
+            files = {}
+            with frames.folder(sel.label) as folder:
+                folder.remove_files()
+                for name in CAPTIONS:
+                    if name in images.arrays:
+                        written.append(folder.write_bytes(f"{name}.png", images.png(name)))
+                        files[name] = f"{FRAMES_DIR}/{sel.label}/{name}.png"
+            record[sel.label] = images.to_json(files)
+        written.append(frames.write_text(FRAMES_JSON, json.dumps({"rrcache_frames": 1, "selections": record},
+                                                                 indent=2) + "\n"))
+    return written
