@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
-from rrcache.kinds.base import Kind, only as _only
+from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -48,22 +48,14 @@ class AdaptiveNode:
     @classmethod
     def from_json(cls, data: dict, where: str) -> "AdaptiveNode":
         _only(data, ("kind", "node", "period", "threshold", "fast_period", "spread", "text"), where)
-        node = data.get("node")
-        if not isinstance(node, str) or not node:
-            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
-        for key in ("period", "fast_period"):
-            value = data.get(key, 4 if key == "fast_period" else None)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise RRCacheError("must be a whole number >= 1", f"{where}.{key}")
+        node = id_of(data, "node", where, "n42")
+        period, fast_period = whole(data, "period", where), whole(data, "fast_period", where, 4)
         for key in ("threshold", "spread"):
             value = data.get(key, 0.0 if key == "spread" else None)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise RRCacheError("must be a finite number >= 0", f"{where}.{key}")
-        text = data.get("text")
-        if text is not None and not isinstance(text, str):
-            raise RRCacheError("must be a string or null", f"{where}.text")
-        return cls(node, data["period"], float(data["threshold"]), data.get("fast_period", 4),
-                   float(data.get("spread", 0.0)), text)
+        return cls(node, period, float(data["threshold"]), fast_period, float(data.get("spread", 0.0)),
+                   text_of(data, where))
 
 
 class AdaptiveKind(Kind):

@@ -25,9 +25,29 @@ def only(data: dict, keys: tuple, where: str) -> None:
         raise RRCacheError(f"unknown key {unknown[0]!r} (known: {', '.join(keys)})", where)
 
 
-def node_part_key(part) -> tuple:
-    """The identity of a node part without its text (what equality compares)."""
-    return part.key()
+def text_of(data: dict, where: str) -> Optional[str]:
+    """A part's ``text`` (None when absent); RRCacheError unless a string or null."""
+    text = data.get("text")
+    if text is not None and not isinstance(text, str):
+        raise RRCacheError("must be a string or null", f"{where}.text")
+    return text
+
+
+def whole(data: dict, key: str, where: str, default=None) -> int:
+    """A part's whole number ``key`` ≥ 1 (``default`` when absent); RRCacheError otherwise."""
+    value = data.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise RRCacheError("must be a whole number >= 1", f"{where}.{key}")
+    return value
+
+
+def id_of(data: dict, key: str, where: str, example: str) -> str:
+    """A part's id ``key`` (a non-empty string such as ``example``); RRCacheError otherwise."""
+    value = data.get(key)
+    if not isinstance(value, str) or not value:
+        raise RRCacheError(f"must be {'an' if key[0] in 'aeiou' else 'a'} {key} id (a string such as '{example}')",
+                           f"{where}.{key}")
+    return value
 
 
 class Kind:

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
-from rrcache.kinds.base import Kind, only as _only
+from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -36,16 +36,7 @@ class CachedNode:
     @classmethod
     def from_json(cls, data: dict, where: str) -> "CachedNode":
         _only(data, ("kind", "node", "period", "text"), where)
-        node = data.get("node")
-        if not isinstance(node, str) or not node:
-            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
-        period = data.get("period")
-        if isinstance(period, bool) or not isinstance(period, int) or period < 1:
-            raise RRCacheError("must be a whole number >= 1", f"{where}.period")
-        text = data.get("text")
-        if text is not None and not isinstance(text, str):
-            raise RRCacheError("must be a string or null", f"{where}.text")
-        return cls(node, period, text)
+        return cls(id_of(data, "node", where, "n42"), whole(data, "period", where), text_of(data, where))
 
 
 class CacheKind(Kind):
