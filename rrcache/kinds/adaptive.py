@@ -14,6 +14,7 @@ from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -84,9 +85,10 @@ CREATE TABLE IF NOT EXISTS adaptive_point (
 );
 """
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
         (p,) = parts
-        return VariantSpec(self.name, (p.node,), algorithm, periods=(int(p.period),), threshold=float(p.threshold),
+        return VariantSpec(self.name, (p.node,), algorithm, filter or DEFAULT_FILTER, periods=(int(p.period),),
+                           threshold=float(p.threshold),
                            fast_period=int(p.fast_period), spread=float(p.spread), **runtime)
 
     def compile(self, work, spec: VariantSpec):
@@ -95,11 +97,11 @@ CREATE TABLE IF NOT EXISTS adaptive_point (
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
                         pack_depth=spec.pack_depth, adaptive=True)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=DEFAULT_FILTER) -> list:
         """``subject`` = (node, period, thresholds, fast_period): each threshold measured beside the
         original (``compare``)."""
         node, period, thresholds, fast_period = subject
-        base = VariantSpec(self.name, (node,), algorithm, periods=(int(period),), fast_period=int(fast_period),
+        base = VariantSpec(self.name, (node,), algorithm, filter, periods=(int(period),), fast_period=int(fast_period),
                            **settings.cache_options())
         return [("compare", base.with_runtime(threshold=float(t)), ("adaptive", node, int(period), float(t)))
                 for t in thresholds]

@@ -106,7 +106,8 @@ CREATE TABLE IF NOT EXISTS amortize_run (
 );
 """
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
+        # (its part names its own filter: the profile's, a node cache's, does not apply)
         (p,) = parts
         return VariantSpec(self.name, (), algorithm, p.filter, p.payload, estimator=p.estimator,
                            samples=int(p.samples), history=p.history, phase=p.phase, blend=float(p.blend), **runtime)
@@ -118,7 +119,7 @@ CREATE TABLE IF NOT EXISTS amortize_run (
                                   phase=spec.phase, history=spec.history, filter=spec.filter,
                                   payload_dtype=spec.payload, vertex=work.vertex)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=None) -> list:
         """``subject`` = (estimator id, history, payload, [(m, [λ, ...]), ...], timed m list): the
         error runs at each (m, λ) and the timing runs at each timed m."""
         estimator, history, payload, errors, timed = subject

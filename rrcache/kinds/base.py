@@ -15,6 +15,7 @@ import html
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -78,9 +79,10 @@ class Kind:
         exactly one part of :attr:`part`."""
         return self.part is not None and len(parts) == 1 and isinstance(parts[0], self.part)
 
-    def spec(self, parts: tuple, algorithm: str, **runtime) -> VariantSpec:
-        """The variant spec of ``parts`` run with ``algorithm``, with the runtime's fields
-        ``runtime`` (``block``, ``refresh``, ``depth_epsilon``)."""
+    def spec(self, parts: tuple, algorithm: str, filter: Optional[str] = None, **runtime) -> VariantSpec:
+        """The variant spec of ``parts`` run with ``algorithm``, the profile's cache ``filter`` where
+        the kind caches nodes with it (None: the default; an amortized loop's part names its own),
+        and the runtime's fields ``runtime`` (``block``, ``refresh``, ``depth_epsilon``)."""
         raise NotImplementedError
 
     def compile(self, work, spec: VariantSpec):
@@ -89,9 +91,10 @@ class Kind:
         raise NotImplementedError
 
     # ---------------------------------------------------------------- training and the store
-    def training(self, subject, settings, algorithm: str) -> list[tuple[str, VariantSpec, tuple]]:
+    def training(self, subject, settings, algorithm: str, filter: str = DEFAULT_FILTER) -> list:
         """The runs training ``subject`` with ``settings`` (a
-        :class:`~rrcache.profiles.settings.TrainingSettings`) and ``algorithm`` plans:
+        :class:`~rrcache.profiles.settings.TrainingSettings`), ``algorithm`` and the profile's cache
+        ``filter`` plans:
         ``(measure, spec, key)`` each (``measure`` of :data:`rrcache.runs.MEASURES`; ``key``
         what the collector files the result under). Kinds without training return []."""
         return []

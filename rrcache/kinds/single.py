@@ -12,6 +12,7 @@ from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -45,9 +46,9 @@ class CacheKind(Kind):
     title = "one cached node"
     one_node = True
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
         (p,) = parts
-        return VariantSpec(self.name, (p.node,), algorithm, periods=(int(p.period),), **runtime)
+        return VariantSpec(self.name, (p.node,), algorithm, filter or DEFAULT_FILTER, periods=(int(p.period),), **runtime)
 
     def compile(self, work, spec: VariantSpec):
         from rrcache.compiler import instance
@@ -55,9 +56,9 @@ class CacheKind(Kind):
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
                         pack_depth=spec.pack_depth)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=DEFAULT_FILTER) -> list:
         """A node (``subject``, its id) at each training period (error) and timing period (timing)."""
-        base = VariantSpec(self.name, (subject,), algorithm, **settings.cache_options())
+        base = VariantSpec(self.name, (subject,), algorithm, filter, **settings.cache_options())
         return ([("error", base.with_runtime(periods=(p,)), ("node", subject, p)) for p in settings.periods]
                 + [("timing", base.with_runtime(periods=(p,)), ("node", subject, p)) for p in settings.timing_periods])
 

@@ -206,6 +206,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
+        filter=(plan.filter if plan is not None and plan.filter else "bilinear"),
         nodes=nodes, defines=dict(work.defines), include_dirs=list(work.include_dirs), plan=plan.to_json() if plan is not None else None,
         untrained=list(result.untrained), budget_stopped=result.budget_stopped,
         mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,
