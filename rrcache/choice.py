@@ -71,7 +71,7 @@ def load_work(prof, include_dirs=()):
     # what profile.json names is the profiled shader and session, before anything parses them
     session = load_session_of(prof)
     work = load_for_session(prof.shader, session, prof.defines, list(include_dirs) + list(prof.include_dirs),
-                            vertex=prof.vertex)
+                            vertex=prof.vertex, term_scores=prof.term_scores)
     check_same_shader(prof, work)
     work.filter = prof.filter  # the variants compile as the profile trained them
     return work, session
@@ -135,8 +135,8 @@ def write(prof, sel: Selection, out_dir, work=None) -> list[str]:
 
 def describe_options(prof, sel: Selection) -> str:
     """The cache's options for ``sel`` in words: 'two-pass (the profile's choice: auto measured
-    two-pass 0.377, three-pass 0.41 of the original's time), refresh block 4, random refresh,
-    depth tolerance 0.001'."""
+    two-pass 0.377, three-pass 0.41 of the original's time), bilinear filter, refresh block 4,
+    random refresh, depth tolerance 0.001'."""
     algorithm = algorithm_of(prof, sel)
     times = prof.algorithm_times or {}
     if sel.algorithm and sel.algorithm != prof.algorithm:
@@ -147,7 +147,9 @@ def describe_options(prof, sel: Selection) -> str:
     else:
         why = "the profile's"
     opts = runtime_options(prof, sel)
-    text = (f"{algorithm} ({why}), refresh block {opts['block']}, {opts['refresh']} refresh, "
+    part = sel.parts[0] if sel.parts else None
+    filter_ = getattr(part, "filter", None) or getattr(prof, "filter", None) or "bilinear"
+    text = (f"{algorithm} ({why}), {filter_} filter, refresh block {opts['block']}, {opts['refresh']} refresh, "
             f"depth tolerance {opts['depth_epsilon']:g}")
     if "threshold" in opts:
         text += (f", adaptive refresh: threshold {opts['threshold']:g}, fast period {opts['fast_period']}, "

@@ -24,7 +24,7 @@ manifest when the variant is written (:meth:`rrcache.compiler.Variant.write`, ``
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Mapping, Optional
 
@@ -55,11 +55,12 @@ class ShaderWork:
     include_dirs: tuple = ()
     #: the unroll limit the table was analysed with (part of the compile cache's key)
     max_unroll: int = DEFAULT_MAX_ITERATIONS
-    #: the measured order of sums the table was analysed with (``term_scores``; part of the key)
-    term_scores: tuple = ()
     #: the cache filter every variant of this work compiles with unless told otherwise (a
     #: profile's: ``Profile.filter``, chosen by rrcache.profiler.filters)
     filter: str = DEFAULT_FILTER
+    #: the measured order of its sums (rrcache.profiler.terms; node ids refer to the program it
+    #: ordered; part of the compile cache's key); empty: none measured
+    term_scores: dict = field(default_factory=dict)
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -99,14 +100,7 @@ def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, s
     moving = sorted(per_frame_uniforms(session)) if session is not None else ()
     table = cacheable_nodes(shader, max_iterations=max_unroll, moving=moving, scores=term_scores or None)
     return ShaderWork(shader, table, all_defines, user, tuple(os.path.abspath(d) for d in include_dirs or ()),
-                      int(max_unroll), _scores_key(term_scores))
-
-
-def _scores_key(term_scores) -> tuple:
-    """``term_scores`` as a hashable record (the compile cache's key: node ids depend on it)."""
-    if not term_scores:
-        return ()
-    return tuple(sorted((str(k), repr(v)) for k, v in dict(term_scores).items()))
+                      max_unroll=int(max_unroll), term_scores=dict(term_scores or {}))
 
 
 def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:

@@ -467,6 +467,8 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         warnings.simplefilter("always")
         prof = profile(scene.shader, session_path, folder, training, progress=on_event, plots=settings.plots)
     result.notes += [f"profile: {w.message}" for w in caught]
+    if prof.term_scores:  # the profile measured the order of its sums: its node ids refer to it
+        work = load_for_session(scene.shader, session, term_scores=prof.term_scores)
     work.filter = prof.filter  # the selections compile with the profile's filter
     result.filter = prof.filter
     result.filter_times = (prof.plan or {}).get("filter_times")
@@ -516,6 +518,7 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
                             base_filter=prof.filter, limit_filter=prof.filter, misses=True,
+                            term_scores=prof.term_scores,
                             progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
     result.misses = [asdict(m) for m in bench.misses]
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),

@@ -22,6 +22,7 @@ import warnings
 import click
 from rich.console import Console
 
+from rrcache.cli import interrupt
 from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.cli.tables import TextTable
@@ -95,6 +96,9 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--filter", "filter_", type=click.Choice(FILTER_CHOICES), default="auto", show_default=True,
               help="The cache's hit test and payload reconstruction: auto measures bilinear against plane on "
                    "the first node and keeps plane where faster at about the same PSNR (docs/misses.md).")
+@click.option("--measure-terms", is_flag=True,
+              help="Before training, order the terms of sums whose weights do not fold by what caching each "
+                   "alone costs in error (docs/sums.md).")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
@@ -132,12 +136,13 @@ def _fmt(value, spec=".3g", none="–"):
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, filter_, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
             wait, max_sets, defines, adaptive, clock, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
+                  measure_terms=measure_terms,
                   validate=not no_validate, validation_frames=validation_frames, levels=levels, clock=clock)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),
@@ -162,7 +167,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
     except KeyboardInterrupt:
         _interrupted(out, err_console)
-        sys.exit(130)
+        sys.exit(interrupt.exit_code())
     console = Console()
     if not console.is_terminal:  # a pipe, a file: whole lines, never wrapped or cut
         console = Console(soft_wrap=True)
@@ -174,7 +179,7 @@ def _interrupted(out, err_console) -> None:
 
     from rrcache.profiles.store import read_store
 
-    err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
+    err_console.print(f"rrcache: {interrupt.word()}; the run in flight was dropped", highlight=False)
     path = Path(out) / STORE_NAME
     try:
         with read_store(path) as store:

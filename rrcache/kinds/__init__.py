@@ -181,7 +181,9 @@ class CompileCache:
         if not shader:
             return ("object", id(work), spec.compiled())
         paths = (str(getattr(work.shader, "path", None)), str(getattr(getattr(work, "vertex", None), "path", None)))
-        return (shader, *paths, getattr(work, "max_unroll", None), getattr(work, "term_scores", ()), spec.compiled())
+        scores = getattr(work, "term_scores", None) or {}
+        order = tuple(sorted((str(k), repr(v)) for k, v in dict(scores).items()))
+        return (shader, *paths, getattr(work, "max_unroll", None), order, spec.compiled())
 
     def get(self, work, spec: VariantSpec):
         key = self.key(work, spec)

@@ -44,7 +44,8 @@ class FrameShots:
             from rrcache.pipeline import load_for_session
 
             work = load_for_session(profile.shader, self.session, profile.defines,
-                                    getattr(profile, "include_dirs", ()), vertex=profile.vertex)
+                                    getattr(profile, "include_dirs", ()), vertex=profile.vertex,
+                                    term_scores=getattr(profile, "term_scores", None))
             work.filter = getattr(profile, "filter", work.filter)
         self.work = work
         self.size = image_size(self.session.resolution, max_width)

@@ -109,6 +109,8 @@ class RunPlan:
                  completed: Optional[Callable[[], int]] = None):
         self.groups = []
         self.skipped: list[Group] = []
+        #: groups an error dropped (``on_error`` of :meth:`execute`)
+        self.dropped: list[Group] = []
         self.resumed = 0
         for group in groups:
             todo = [r for r in group.runs if not done(r)]
@@ -126,9 +128,12 @@ class RunPlan:
         return sum(r.cost for g in self.groups for r in g.runs)
 
     def execute(self, executor, collect: Callable[[RunResult], None], meter: Optional[Meter] = None,
-                after_group: Optional[Callable[[Group], None]] = None) -> list[RunResult]:
+                after_group: Optional[Callable[[Group], None]] = None,
+                on_error: Optional[Callable[[Group, BaseException], bool]] = None) -> list[RunResult]:
         """Run every group the budget reaches (results to ``collect`` as they come); returns the
-        results."""
+        results. A group whose run raises an error ``on_error(group, err)`` takes (returns True:
+        a variant the driver refuses) is dropped, its runs not done leaving the total
+        (``dropped`` lists it); any other error propagates."""
         out = []
         finished = 0
         for k, group in enumerate(self.groups):
@@ -137,9 +142,19 @@ class RunPlan:
                 if meter is not None:
                     meter.shrink(sum(r.cost for r in group.runs))
                 continue
-            for result in executor.run(group.runs, on_frame=meter.on_frame() if meter is not None else None):
-                collect(result)
-                out.append(result)
+            done = 0
+            try:
+                for result in executor.run(group.runs, on_frame=meter.on_frame() if meter is not None else None):
+                    collect(result)
+                    out.append(result)
+                    done += 1
+            except Exception as err:
+                if on_error is None or not on_error(group, err):
+                    raise
+                self.dropped.append(group)
+                if meter is not None:
+                    meter.shrink(sum(r.cost for r in group.runs[done:]))
+                continue
             finished += 1
             if after_group is not None:
                 after_group(group)

@@ -108,26 +108,35 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
     try:
         store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
         started = time.time()
-        # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
-        # the original's reference frames rendered once
         compiled = sum(kinds.compile_counts().values())
-        executor = executor(work, session) if executor is not None else LocalExecutor(Bench(work, session))
+        make_executor, runner = executor, None
         try:
             store.begin_run()
-            result = train(work, session, resolved, store, progress, executor=executor)
+            if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
+                from rrcache.profiler.terms import scores_for
+
+                scores = scores_for(work, session, store, progress)
+                if scores:
+                    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
+                                            term_scores=scores)
+            # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+            # the original's reference frames rendered once
+            runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
+            result = train(work, session, resolved, store, progress, executor=runner)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
-            prof.sets = _sets(prof, work, session, resolved, store, progress, executor)
+            prof.term_scores = dict(work.term_scores)
+            prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=executor)
-            executor.close()  # validation renders side by side with its own renderers
+            prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
+            runner.close()  # validation renders side by side with its own renderers
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
                                          window=result.plan.timing_window if result.plan is not None else None,
-                                         store=store, executor=executor)
+                                         store=store, executor=runner)
             prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
             # how many variants this invocation compiled (each at most once: the compile cache)
@@ -142,7 +151,8 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
             _end_quietly(store, "failed")
             raise
         finally:
-            executor.close()
+            if runner is not None:
+                runner.close()
         store.close()
     finally:
         lock.release()

@@ -50,7 +50,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from rrcache import kinds
-from rrcache.errors import RRCacheError
+from rrcache.errors import GLError, RRCacheError
 from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork
@@ -238,6 +238,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
 
     # the training is planned once the ceiling has said whether it happens, and for which nodes
     meter = Meter(progress, len(timing) if need_ref_timing else 0)
+    refused: dict[str, str] = {}  # node -> why the driver refused its variant
     notes = dict(order.skipped)
     collector = Collector(store)
     bench = None
@@ -262,7 +263,12 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             plan = Plan.from_json(stored_plan)
         shapes = RunShapes.of(settings, session, plan, timing)
         if order.nodes and len(timing) > 0:
-            ceiling = _ceiling(work, session, settings, store, plan, order.nodes[0], timing, meter)
+            ceiling = _ceiling_of_a_compiling_node(work, session, settings, store, plan, order, timing, meter,
+                                                   refused)
+            notes.update(refused)
+            for nid in refused:
+                todo_error[nid], todo_timing[nid] = [], []
+            ids = [n.id for n in order.nodes]
             if settings.min_gain > 0 and not ceiling.reaches:
                 # nothing can pay: answer now, before any training
                 if plan.algorithm is None:
@@ -323,7 +329,16 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                        budget=settings.budget_s, spent=store.spent_s,
                        completed=lambda: sum(1 for n in ids if _node_complete(store, n, settings)))
         runs.tail = len(timing) if need_overhead else 0
-        runs.execute(executor, collector, meter)
+
+        def refuse(group, err) -> bool:
+            # the driver refuses this node's variant (it failed to compile: none of its runs was
+            # stored): the node is dropped with the reason, and training goes on with the next
+            if not isinstance(err, GLError) or not _driver_refused(err):
+                return False
+            refused[group.name] = _dropped(err)
+            return True
+
+        runs.execute(executor, collector, meter, on_error=refuse)
         budget_stopped = bool(runs.skipped)
 
         trained = [i for i in ids if _node_complete(store, i, settings)]
@@ -341,7 +356,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
 
     for i in ids:
         if i not in trained:
-            notes[i] = "not reached within the training budget (--budget)"
+            notes[i] = refused.get(i, "not reached within the training budget (--budget)")
     skipped_ids = _skipped_ids(work, order)
     result = TrainingResult(order=ids + skipped_ids, trained=trained,
                             untrained=[i for i in ids + skipped_ids if i not in trained],
@@ -351,6 +366,34 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     result.wall_s = clock() - start
     result.spent_s = store.spent_s()
     return result
+
+
+def _driver_refused(err: GLError) -> bool:
+    """Whether ``err`` is the driver refusing a pass of a variant (not another GL failure)."""
+    return getattr(err, "pass_name", None) is not None
+
+
+def _dropped(err: GLError) -> str:
+    """The node table's note for a node whose variant the driver refused."""
+    return f"dropped: the driver refused its variant ({err.message})"
+
+
+def _ceiling_of_a_compiling_node(work, session, settings, store, plan, order, timing, meter, refused) -> Ceiling:
+    """The ceiling (:func:`_ceiling`) measured on the costliest node whose variant the driver
+    compiles: a node it refuses is dropped (``refused``: id → note; it leaves ``order``); when the
+    driver refuses every node's variant its first refusal is the error."""
+    first = None
+    for node in list(order.nodes):
+        try:
+            return _ceiling(work, session, settings, store, plan, node, timing, meter)
+        except GLError as err:
+            if not _driver_refused(err):
+                raise
+            first = first or err
+            refused[node.id] = _dropped(err)
+            order.nodes.remove(node)
+            order.skipped[node.id] = refused[node.id]
+    raise first
 
 
 def _skipped_ids(work: ShaderWork, order: TrainingOrder) -> list[str]:

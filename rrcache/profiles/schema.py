@@ -196,8 +196,23 @@ _RANGES: dict[str, dict[str, tuple]] = {
                    "measured_ms": (_REAL, 0.0, None), "measured_original_ms": (_REAL, 0.0, None),
                    "measured_speedup": (_REAL, 0.0, None), "hit_rate": (_REAL, 0.0, 1.0), "frames": (_INT, 0, None)},
 }
+#: what :meth:`ProfileStore.check_stored` checks besides :data:`_RANGES` when a run resumes on a
+#: store: the tables of no reader's range check, and the columns that key a run
+_STORED_RANGES: dict[str, dict[str, tuple]] = {
+    "reference_frame": {"frame": (_INT, 0, None), "covered": (_INT, 0, None)},
+    "timing_run": {"period": (_INT, 1, None), "wall_s": (_REAL, 0.0, None)},
+    "amortize_run": {"samples": (_INT, 1, None), "blend": (_REAL, 0.0, 1.0), "frame": (_INT, -1, None),
+                     "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None), "hit_rate": (_REAL, 0.0, 1.0),
+                     "hits": (_INT, 0, None), "misses": (_INT, 0, None), "ms": (_REAL, 0.0, None),
+                     "original_ms": (_REAL, 0.0, None), "wall_s": (_REAL, 0.0, None)},
+}
+#: the text columns that name what a row is about (never empty)
+_TEXT_KEYS = {"error_run": ("node",), "error_frame": ("node",), "timing_run": ("node",), "timing_frame": ("node",),
+              "overhead": ("node",), "validation": ("label", "parts"), "amortize_run": ("estimator", "kind")}
+#: the meta keys that hold JSON (a store's own records of the run)
+_JSON_META = ("plan", "sets", "validation_figures")
 #: the columns that name a row in an error message
-_KEYS = ("node", "period", "frame", "label")
+_KEYS = ("node", "period", "frame", "label", "estimator", "samples")
 
 
 def _out_of_range(value, kind: str, low, high) -> Optional[str]:
@@ -206,7 +221,7 @@ def _out_of_range(value, kind: str, low, high) -> Optional[str]:
     if value is None:
         return None if kind == _INT else "is missing"
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return f"is not a {kind}"
+        return f"is not {'an' if kind[0] in 'aeiou' else 'a'} {kind}"
     if kind == _INT and not isinstance(value, int):
         return "is not an integer"
     if isinstance(value, float) and value != value:

@@ -119,6 +119,9 @@ class TrainingSettings:
       measures ``bilinear`` against ``plane`` on the first node to train and keeps ``plane``
       where it was faster at about the same PSNR (:mod:`rrcache.profiler.filters`; the choice is
       kept in the plan).
+    - ``measure_terms``: before training, order the terms of every sum whose weights do not fold
+      by what caching each alone costs in error (:mod:`rrcache.profiler.terms`, kept in the
+      store and in ``Profile.term_scores``); off by default.
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -145,6 +148,9 @@ class TrainingSettings:
     #: the cache's hit test and payload reconstruction: ``auto`` measures ``bilinear`` against
     #: ``plane`` on the first node (rrcache.profiler.filters), or one of rrcache.runtime.glsl.FILTERS
     filter: str = "auto"
+    #: order the terms of sums whose weights do not fold by a short measurement of each term
+    #: (rrcache.profiler.terms) before training; node ids then refer to that order
+    measure_terms: bool = False
 
     def cache_options(self) -> dict:
         """The cache's run-time parameters besides the period, as the keyword arguments of
@@ -280,6 +286,8 @@ class TrainingSettings:
             del data["clock"]
         if data.get("filter") == "auto":  # the default keys as before it existed: older stores resume
             del data["filter"]
+        if not data.get("measure_terms"):
+            data.pop("measure_terms", None)
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def key_hash(self) -> str:
