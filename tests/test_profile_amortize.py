@@ -215,7 +215,7 @@ def test_the_profile_command_shows_estimators_and_an_amortized_row(amortized_win
     assert "fastest option e1 m=1" in line
     prof.selections = [prof.select(1.0).replace(label="e4")]
     console = Console(record=True, width=200)
-    console.print(_table(prof))
+    _table(prof).print(console)
     text = console.export_text()
     assert "e1 m=" in text and "/8 λ=" in text
 
@@ -432,7 +432,7 @@ def test_the_cli_and_report_show_the_slots_history(slots_win):
     assert "amortization trained at m = 1, 2, 4" in line and "slots history at m = 2, 4" in line
     prof.selections = [prof.select(1.0).replace(label="e1")]
     console = Console(record=True, width=200)
-    console.print(_table(prof))
+    _table(prof).print(console)
     assert "slots" in console.export_text()
     table = _estimators(prof)
     assert "<td>slots</td>" in table and "<td>blend</td>" in table and "c<sub>2</sub>" in table
