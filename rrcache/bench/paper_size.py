@@ -161,7 +161,9 @@ def main(argv=None) -> int:
         print(str(err))
         return 2
     if args.json:
-        Path(args.json).write_text(json.dumps(result.to_json(), indent=2) + "\n", encoding="utf-8")
+        from rrcache.atomic import write_text
+
+        write_text(args.json, json.dumps(result.to_json(), indent=2) + "\n")
     print(result.markdown())
     return 0
 
