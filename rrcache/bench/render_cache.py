@@ -63,6 +63,7 @@ import numpy as np
 from rrcache.bench.scenes import resolve_scenes, scaled_session
 from rrcache.errors import RRCacheError
 from rrcache.gl.program import fullscreen_vertex
+from rrcache.report.agg import save_figure
 
 #: how ``rrcache bench`` sizes each scene (its FULL settings): chess smaller and shorter
 SCENE_SIZES = {"chess": ((320, 240), 60)}
@@ -269,7 +270,7 @@ def contact_sheet(results: list, images: dict, path) -> str:
                 bottom.imshow(np.clip(diff, 0, 1), interpolation="nearest")
                 bottom.set_title(f"|{method} − original| × {ERROR_GAIN:g}", fontsize=7)
         fig.tight_layout()
-        fig.savefig(path)
+        save_figure(fig, path)
     finally:
         plt.close(fig)
     return str(path)
@@ -654,7 +655,7 @@ def _sweep_plot(doc: dict, path) -> None:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(path)
+        save_figure(fig, path)
     finally:
         plt.close(fig)
 

@@ -62,7 +62,7 @@ from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, render
-from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD,
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
@@ -100,7 +100,7 @@ _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm
               help=f"Refresh block size k in pixels (default: the profile's, else {DEFAULT_BLOCK}).")
 @click.option("--refresh", type=click.Choice(REFRESH_MODES), default=None,
               help=f"Refresh pattern (default: the profile's, else {DEFAULT_REFRESH}).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True,
               help="Payload reconstruction filter.")
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
               help="Cache precision: 32- or 16-bit float.")

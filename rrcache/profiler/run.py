@@ -24,6 +24,7 @@ import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
@@ -286,21 +287,21 @@ def _verdict(ceiling) -> dict:
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    out.mkdir(parents=True, exist_ok=True)
     kept = []
-    for sel in prof.selections:
-        folder = out / "optimized" / sel.label
-        if folder.exists():
-            for old in folder.iterdir():
-                if old.is_file():
-                    old.unlink()
-        prof.write_variant(sel, folder, work=work)
-        kept.append(sel.replace(files=str(folder.relative_to(out))))
+    # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
+    # refused, never followed, and the old files of a selection are removed only inside it
+    with OutputFolder(out) as root, root.folder("optimized") as optimized:
+        for sel in prof.selections:
+            with optimized.folder(sel.label) as folder:
+                folder.remove_files()
+                prof.write_variant(sel, folder, work=work)
+            kept.append(sel.replace(files=f"optimized/{sel.label}"))
+        if prof.verdict is not None:  # stopped before training: nothing to plot or report
+            with optimized.folder("original") as folder:
+                prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), folder)
+            plots = False
     prof.selections = kept
     prof.path = out
-    if prof.verdict is not None:  # stopped before training: nothing to plot or report
-        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
-        plots = False
     if plots:
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots

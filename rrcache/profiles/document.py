@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional
 
-from rrcache.errors import RRCacheError
+from rrcache import atomic
+from rrcache.errors import RRCacheError, printable
 from rrcache.jsonable import finite_json
 from rrcache.model.sets import SetOption
 from rrcache.profiles.amortize import SLOTS_PAYLOADS, EstimatorProfile
@@ -501,13 +502,9 @@ class Profile:
         out = Path(folder) if folder is not None else self.path
         if out is None:
             raise ValueError("Profile.write needs a folder")
-        out.mkdir(parents=True, exist_ok=True)
         self.path = out
-        target = out / JSON_NAME
-        tmp = out / (JSON_NAME + ".tmp")
-        tmp.write_text(json.dumps(self.to_json(), indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, target)
-        return target
+        atomic.write_text(out / JSON_NAME, json.dumps(self.to_json(), indent=2) + "\n")
+        return out / JSON_NAME
 
     @classmethod
     def from_json(cls, data: Any, file: str = JSON_NAME) -> "Profile":
@@ -771,13 +768,24 @@ def load_profile(path) -> Profile:
 
     >>> p = load_profile("marble-marble.rrprofile")    # doctest: +SKIP
     """
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     path = Path(path)
     file = path / JSON_NAME if path.is_dir() else path
-    if not file.exists():
+    if not file.exists() and not file.is_symlink():
         raise RRCacheError("no profile here", str(file), hint="give the folder 'rrcache profile' wrote (--out)")
+    try:  # by rrcache.files' rule: a regular file inside the profile's folder, within the budget
+        raw = read_file(file, budget.document_bytes, [os.path.realpath(file.parent)]).data
+    except Refused as err:
+        what = f"it resolves to {printable(err.real)}, outside the profile's folder" if err.kind == "outside" else \
+            f"it {err.reason}"
+        raise RRCacheError(f"cannot read the profile: {what}", str(file),
+                           hint="raise the budget with 'rrcache --max-document-bytes N ...'" if err.kind == "size"
+                           else "give the folder 'rrcache profile' wrote (--out)") from None
     try:
-        data = json.loads(file.read_text(encoding="utf-8"), parse_constant=_no_constant)
-    except (OSError, UnicodeDecodeError, ValueError) as err:
+        data = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
+    except (UnicodeDecodeError, ValueError) as err:
         raise RRCacheError(f"cannot read the profile ({err})", str(file), hint="run 'rrcache profile' again") from None
     except RecursionError:  # JSON nested thousands deep: no profile looks like that
         raise RRCacheError("cannot read the profile (its JSON is nested too deeply)", str(file),

@@ -23,7 +23,10 @@ import time
 from pathlib import Path
 from typing import Optional
 
+from rrcache.atomic import OutputFolder
+from rrcache.budgets import budget
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
 from rrcache.jsonable import script_json  # noqa: F401  (the data block; tests import it from here too)
 from rrcache.profiles.document import algorithm_line
 from rrcache.profiles.notices import run_warnings
@@ -283,14 +286,20 @@ def _prediction_errors(prof) -> str:
 
 def _plots(prof) -> str:
     folder = Path(prof.path) if prof.path is not None else None
-    have = {name: folder / name for name, _ in PLOTS if folder is not None and (folder / name).exists()}
+    have = {}
+    for name, _ in PLOTS:  # the folder's plots, read by rrcache.files' rule inside it (a link out is redrawn)
+        if folder is not None:
+            try:
+                have[name] = read_file(folder / name, budget.asset_bytes, [os.path.realpath(folder)]).data
+            except Refused:
+                pass
     with tempfile.TemporaryDirectory() as tmp:
         if len(have) < len(PLOTS) and prof.trained_nodes:
             from rrcache.report.plots import write_plots
 
             for path in write_plots(prof, tmp):
-                have.setdefault(Path(path).name, Path(path))
-        parts = [f'<figure><img alt="{_e(name)}" src="{data_uri(have[name].read_bytes())}">'
+                have.setdefault(Path(path).name, read_file(path, None).data)
+        parts = [f'<figure><img alt="{_e(name)}" src="{data_uri(have[name])}">'
                  f"<figcaption>{_e(caption)}</figcaption></figure>" for name, caption in PLOTS if name in have]
     return '<div class="plots">' + "".join(parts) + "</div>" if parts else "<p>No plots (no trained node).</p>"
 
@@ -394,10 +403,7 @@ def write_report(profile, out_dir, work=None, filename: str = REPORT_NAME) -> Pa
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the report's folder is a file", str(out), hint="give a folder, or --out FILE.html")
-    out.mkdir(parents=True, exist_ok=True)
-    text = report_html(profile, work)
-    path = out / filename
-    tmp = out / (filename + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    return path
+    with OutputFolder(out) as folder:
+        folder.regular_or_missing(filename)  # a device or a link as --out: refused before rendering
+        folder.write_text(filename, report_html(profile, work))
+    return out / filename
