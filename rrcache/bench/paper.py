@@ -371,7 +371,7 @@ def render_cache_row(work, session, frames, search, target, settings, progress, 
                          max_steps=settings.max_steps, progress=step)
     final = compare(work.prepared, session, frames, replace(base, samples=found.value), on_frame=on_frame)
     row = MethodRow(RENDER_CACHE, f"{found.value:.2%} of the pixels per frame ({final.budget} pixels, "
-                                  f"{base.block}×{base.block} blocks, {base.points_per_pixel:g} points per pixel)",
+                                  f"{base.block}×{base.block} blocks, a cache of {base.points_per_pixel:g}× the pixels)",
                     final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
                     final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                     [list(s) for s in found.steps])
