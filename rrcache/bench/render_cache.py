@@ -358,7 +358,7 @@ def projection_cost(scene, out, repeats: int = 9, frames: int = 8, samples: floa
     from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.gl.resources import GLScope
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -503,7 +503,7 @@ def filters_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float =
     from rrcache.alternatives.render_cache.filters import depth_cull, reconstruct
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.gl.resources import GLScope
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -608,7 +608,7 @@ def sweep(scene, out, configs: list, shares, frames: int = 40) -> dict:
     """Each config at each share beside the original (see the module docstring)."""
     from rrcache.alternatives.render_cache import RenderCacheSettings
     from rrcache.alternatives.render_cache.tune import compare
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.harness.renderer import Renderer
     from rrcache.session import load_session
 
