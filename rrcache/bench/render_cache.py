@@ -264,8 +264,9 @@ def contact_sheet(results: list, images: dict, path) -> str:
                     top.set_title(f"{r.name}, frame {r.sheet_frame}: original", fontsize=8)
                     bottom.axis("off")
                     continue
-                err, db = r.sheet[method]
-                top.set_title(f"{method}: error {err:.4f}, {min(db, 100):.1f} dB", fontsize=8)
+                err, db = r.sheet[method]  # an exact image's PSNR is infinite (null once written)
+                db_text = "∞" if db is None or db == float("inf") else f"{db:.1f}"
+                top.set_title(f"{method}: error {err:.4f}, {db_text} dB", fontsize=8)
                 diff = np.abs(np.nan_to_num(image[..., :3]) - np.nan_to_num(original[..., :3])) * ERROR_GAIN
                 bottom.imshow(np.clip(diff, 0, 1), interpolation="nearest")
                 bottom.set_title(f"|{method} − original| × {ERROR_GAIN:g}", fontsize=7)

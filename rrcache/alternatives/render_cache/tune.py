@@ -20,7 +20,7 @@ from typing import Callable, Optional
 
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.render_cache.renderer import STAGES, RenderCacheRenderer
-from rrcache.alternatives.render_cache.settings import RenderCacheSettings
+from rrcache.kinds.render_cache import RenderCacheSettings
 from rrcache.alternatives.search import SearchResult, match_scale
 from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.harness.cached import Comparison
