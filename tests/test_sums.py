@@ -202,3 +202,19 @@ def test_a_profile_measures_the_order_when_asked_and_keeps_it(tmp_path):
     again = profile(CORPUS / "many_lights_loop.glsl", CORPUS / "many_lights_loop.json", tmp_path / "out",
                     settings, plots=False)
     assert again.term_scores == prof.term_scores
+
+
+def test_a_static_part_written_in_one_expression_is_named():
+    """The chess shader keeps the king's occlusion apart (``aoStatic * aoKing``): the static
+    part's node is named as such (rrcache.analysis.static_parts), without a session it is not."""
+    from rrcache.glsl.frontend import load_shader
+    from rrcache.analysis import cacheable_nodes
+
+    root = Path(__file__).resolve().parents[1]
+    session = load_session(root / "sessions" / "chess.json")
+    work = load_for_session(root / "shaders" / "ambient_occlusion.glsl", session)
+    named = [n.text for n in work.table.nodes if "the static part" in n.text]
+    assert named == ["1.0 - clamp(OCCLUSION_GAIN * staticOcclusion(receiver, N), 0.0, 1.0), "
+                     "the static part of aoStatic * aoKing (without u_kingOffset)"]
+    bare = cacheable_nodes(load_shader(root / "shaders" / "ambient_occlusion.glsl"))
+    assert not any("static part" in n.text for n in bare.nodes)

@@ -148,12 +148,31 @@ def command(ctx, shader, level, node, estimator, samples, blend, history, period
 
 
 def _write(variant, out_dir, target, session, work, period, runtime) -> list:
-    """Write ``variant`` for ``target``: the GLSL files, or the WebGL2 page and its passes."""
+    """Write ``variant`` for ``target``: the GLSL files, or the WebGL2 page and its passes; each
+    pass is compiled and linked by the driver first (:func:`_compile`), so nothing is written
+    for a variant the driver refuses."""
+    _compile(variant)
     if target == "webgl2":
         from rrcache.webgl import write_page
 
         return write_page(variant, session, work, out_dir, period=period, runtime=runtime)
     return variant.write(out_dir, period=period, runtime=runtime)
+
+
+def _compile(variant) -> None:
+    """Compile and link every pass of ``variant`` with this machine's driver and release the
+    programs: a refused pass is the driver's one-line error naming the node and the pass (exit 2,
+    nothing written). Without OpenGL here the files are written unchecked, and the command says so."""
+    from rrcache.errors import GLError
+    from rrcache.gl.context import get_context
+
+    try:
+        ctx = get_context()
+    except GLError as err:
+        click.echo(f"note: the passes were not compiled here (no OpenGL: {err.message})", err=True)
+        return
+    for program in variant.build_programs(ctx).values():
+        program.release()
 
 
 def _write_level(prof, level, include_dirs, out_dir, target) -> None:

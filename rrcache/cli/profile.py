@@ -22,6 +22,7 @@ import warnings
 import click
 from rich.console import Console
 
+from rrcache.cli import interrupt
 from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.cli.tables import TextTable
@@ -161,7 +162,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
     except KeyboardInterrupt:
         _interrupted(out, err_console)
-        sys.exit(130)
+        sys.exit(interrupt.exit_code())
     console = Console()
     if not console.is_terminal:  # a pipe, a file: whole lines, never wrapped or cut
         console = Console(soft_wrap=True)
@@ -173,7 +174,7 @@ def _interrupted(out, err_console) -> None:
 
     from rrcache.profiles.store import read_store
 
-    err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
+    err_console.print(f"rrcache: {interrupt.word()}; the run in flight was dropped", highlight=False)
     path = Path(out) / STORE_NAME
     try:
         with read_store(path) as store:

@@ -49,7 +49,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from rrcache.errors import RRCacheError
+from rrcache.errors import GLError, RRCacheError
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
@@ -306,6 +306,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     # the training is planned once the ceiling has said whether it happens, and for which nodes
     meter = _Meter(progress, len(timing) if need_ref_timing else 0)
     budget_stopped = False
+    refused: dict[str, str] = {}  # node -> why the driver refused its variant
     notes = dict(order.skipped)
 
     original: Optional[Renderer] = None
@@ -333,7 +334,12 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt)
         timed_original = original
         if order.nodes and len(timing) > 0:
-            ceiling = _ceiling(work, session, settings, store, plan, order.nodes[0], timing, meter)
+            ceiling = _ceiling_of_a_compiling_node(work, session, settings, store, plan, order, timing, meter,
+                                                   refused)
+            notes.update(refused)
+            for nid in refused:
+                todo_error[nid], todo_timing[nid] = [], []
+            ids = [n.id for n in order.nodes]
             if settings.min_gain > 0 and not ceiling.reaches:
                 # nothing can pay: answer now, before any training
                 if plan.algorithm is None:
@@ -399,27 +405,40 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 continue
             # one compiled variant serves every period: the period is the runtime's (set per run)
             variant = variant_for(work, nid, algorithm)
-            if todo_error[nid]:
-                built = clock()
-                with CachedRenderer(variant, session, work.prepared, settings.resolution,
-                                    period=todo_error[nid][0], window=plan.error_window,
-                                    **settings.cache_options()) as cached:
-                    compile_s = clock() - built
-                    for period in todo_error[nid]:
-                        run, frames = _error_run(cached, nid, period, refs, meter)
-                        run.wall_s += compile_s
-                        compile_s = 0.0
-                        store.add_error_run(run, frames)
-            if todo_timing[nid]:
-                built = clock()
-                with CachedRenderer(variant, session, work.prepared, full, period=todo_timing[nid][0],
-                                    window=plan.timing_window, color_format=fmt, **settings.cache_options()) as cached:
-                    compile_s = clock() - built
-                    for period in todo_timing[nid]:
-                        t0 = clock()
-                        frames = _timing_run(cached, timed_original, nid, period, timing, meter)
-                        store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
-                        compile_s = 0.0
+            errors_done = False
+            try:
+                if todo_error[nid]:
+                    built = clock()
+                    with CachedRenderer(variant, session, work.prepared, settings.resolution,
+                                        period=todo_error[nid][0], window=plan.error_window,
+                                        **settings.cache_options()) as cached:
+                        compile_s = clock() - built
+                        for period in todo_error[nid]:
+                            run, frames = _error_run(cached, nid, period, refs, meter)
+                            run.wall_s += compile_s
+                            compile_s = 0.0
+                            store.add_error_run(run, frames)
+                errors_done = True
+                if todo_timing[nid]:
+                    built = clock()
+                    with CachedRenderer(variant, session, work.prepared, full, period=todo_timing[nid][0],
+                                        window=plan.timing_window, color_format=fmt, **settings.cache_options()) as cached:
+                        compile_s = clock() - built
+                        for period in todo_timing[nid]:
+                            t0 = clock()
+                            frames = _timing_run(cached, timed_original, nid, period, timing, meter)
+                            store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
+                            compile_s = 0.0
+            except GLError as err:
+                if not _driver_refused(err):
+                    raise
+                # the driver refuses this node's variant (it failed to compile: none of its runs was
+                # stored): the node is dropped with the reason, and training goes on with the next
+                refused[nid] = _dropped(err)
+                meter.shrink((0 if errors_done else len(todo_error[nid]) * len(train_frames))
+                             + len(todo_timing[nid]) * 3 * len(timing))
+                todo_error[nid], todo_timing[nid] = [], []
+                continue
             _plan_within_budget(meter, store, settings, order.nodes, node, todo_error, todo_timing,
                                 len(train_frames), len(timing))
     finally:
@@ -429,7 +448,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     trained = [i for i in ids if _node_complete(store, i, settings)]
     for i in ids:
         if i not in trained:
-            notes[i] = "not reached within the training budget (--budget)"
+            notes[i] = refused.get(i, "not reached within the training budget (--budget)")
     if trained and need_overhead:
         _measure_overhead(work, session, settings, store, trained[0], timing, meter, plan.algorithm)
 
@@ -462,6 +481,34 @@ def _plan_within_budget(meter: _Meter, store: ProfileStore, settings: TrainingSe
     expected = min(len(rest), fit) * per_node
     tail = n_timing if store.overhead() is None else 0  # the overhead measurement still to come
     meter.total = max(meter.done, meter.done + min(planned, expected) + tail)
+
+
+def _driver_refused(err: GLError) -> bool:
+    """Whether ``err`` is the driver refusing a pass of a variant (not another GL failure)."""
+    return getattr(err, "pass_name", None) is not None
+
+
+def _dropped(err: GLError) -> str:
+    """The node table's note for a node whose variant the driver refused."""
+    return f"dropped: the driver refused its variant ({err.message})"
+
+
+def _ceiling_of_a_compiling_node(work, session, settings, store, plan, order, timing, meter, refused) -> Ceiling:
+    """The ceiling (:func:`_ceiling`) measured on the costliest node whose variant the driver
+    compiles: a node it refuses is dropped (``refused``: id → note; it leaves ``order``); when the
+    driver refuses every node's variant its first refusal is the error."""
+    first = None
+    for node in list(order.nodes):
+        try:
+            return _ceiling(work, session, settings, store, plan, node, timing, meter)
+        except GLError as err:
+            if not _driver_refused(err):
+                raise
+            first = first or err
+            refused[node.id] = _dropped(err)
+            order.nodes.remove(node)
+            order.skipped[node.id] = refused[node.id]
+    raise first
 
 
 def _skipped_ids(work: ShaderWork, order: TrainingOrder) -> list[str]:

@@ -644,6 +644,8 @@ _MODEL_NUMBERS = {
     "perf_fit": {"t_hit": (0, None), "t_miss": (0, None), "t_overhead": (0, None)},
     "hit_fit": {"mu": (0, 1)},
 }
+#: a node's lists of its measured runs, one value per entry of its ``periods``
+_RUN_LISTS = ("errors", "hit_rates", "psnrs", "frame_spreads")
 #: what a trained node must carry (null only for a node that was not trained)
 _TRAINED_NUMBERS = ("alpha", "lam", "t_hit", "t_miss")
 
@@ -662,6 +664,13 @@ def _check_models(prof: "Profile", file: str) -> None:
                 raise _fail(file, f"{at}.{key}", "must be a finite number" + _bounds({"minimum": low, "maximum": high}))
 
     for i, node in enumerate(prof.nodes):
+        # one value per measured period in each of a node's run lists (frame_spreads: or none, in
+        # documents written before rrcache kept them)
+        for name in _RUN_LISTS:
+            got, want = len(getattr(node, name)), len(node.periods)
+            if got != want and not (name == "frame_spreads" and got == 0):
+                raise _fail(file, f"nodes[{i}].{name}", f"has {got} value{'s' if got != 1 else ''}, but "
+                            f"nodes[{i}].periods has {want} (one value per period)")
         if node.trained:
             for name in _TRAINED_NUMBERS:
                 if getattr(node, name) is None:

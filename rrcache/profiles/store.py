@@ -264,8 +264,23 @@ _RANGES: dict[str, dict[str, tuple]] = {
                    "measured_ms": (_REAL, 0.0, None), "measured_original_ms": (_REAL, 0.0, None),
                    "measured_speedup": (_REAL, 0.0, None), "hit_rate": (_REAL, 0.0, 1.0), "frames": (_INT, 0, None)},
 }
+#: what :meth:`ProfileStore.check_stored` checks besides :data:`_RANGES` when a run resumes on a
+#: store: the tables of no reader's range check, and the columns that key a run
+_STORED_RANGES: dict[str, dict[str, tuple]] = {
+    "reference_frame": {"frame": (_INT, 0, None), "covered": (_INT, 0, None)},
+    "timing_run": {"period": (_INT, 1, None), "wall_s": (_REAL, 0.0, None)},
+    "amortize_run": {"samples": (_INT, 1, None), "blend": (_REAL, 0.0, 1.0), "frame": (_INT, -1, None),
+                     "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None), "hit_rate": (_REAL, 0.0, 1.0),
+                     "hits": (_INT, 0, None), "misses": (_INT, 0, None), "ms": (_REAL, 0.0, None),
+                     "original_ms": (_REAL, 0.0, None), "wall_s": (_REAL, 0.0, None)},
+}
+#: the text columns that name what a row is about (never empty)
+_TEXT_KEYS = {"error_run": ("node",), "error_frame": ("node",), "timing_run": ("node",), "timing_frame": ("node",),
+              "overhead": ("node",), "validation": ("label", "parts"), "amortize_run": ("estimator", "kind")}
+#: the meta keys that hold JSON (a store's own records of the run)
+_JSON_META = ("plan", "sets", "validation_figures")
 #: the columns that name a row in an error message
-_KEYS = ("node", "period", "frame", "label")
+_KEYS = ("node", "period", "frame", "label", "estimator", "samples")
 
 
 def _out_of_range(value, kind: str, low, high) -> Optional[str]:
@@ -274,7 +289,7 @@ def _out_of_range(value, kind: str, low, high) -> Optional[str]:
     if value is None:
         return None if kind == _INT else "is missing"
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return f"is not a {kind}"
+        return f"is not {'an' if kind[0] in 'aeiou' else 'a'} {kind}"
     if kind == _INT and not isinstance(value, int):
         return "is not an integer"
     if isinstance(value, float) and value != value:
@@ -423,6 +438,7 @@ class ProfileStore:
         differences = key.compare(meta)
         if differences:
             raise _refuse(path, "the profile store was made for other inputs: " + "; ".join(differences), _FRESH_HINT)
+        self.check_stored(meta)
         self.conn.execute("PRAGMA journal_mode=WAL")
 
     # ------------------------------------------------------------------ transactions
@@ -563,7 +579,44 @@ class ProfileStore:
         return self.conn.execute("SELECT 1 FROM timing_run WHERE node = ? AND period = ?",
                                  (node, int(period))).fetchone() is not None
 
-    def _rows(self, table: str, sql: str, args: tuple = ()) -> list[tuple]:
+    def check_stored(self, meta: Optional[dict] = None) -> None:
+        """Every stored row before a run resumes on them: each value of the right type, finite and
+        in range (:data:`_RANGES`, :data:`_STORED_RANGES`), the keys of each row named, each error
+        run with its frames and each timing run with its frames, the JSON records parsed. A damaged
+        or edited store is refused with the table, the row and the column, never used."""
+        tables = {r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        for table in sorted(tables & (set(_RANGES) | set(_STORED_RANGES))):
+            rules = {**_RANGES.get(table, {}), **_STORED_RANGES.get(table, {})}
+            for row in self._rows(table, f"SELECT * FROM {table}", rules=rules):
+                pass
+            for column in _TEXT_KEYS.get(table, ()):
+                bad = self.conn.execute(f"SELECT rowid, {column} FROM {table} WHERE typeof({column}) != 'text' "
+                                        f"OR {column} = '' LIMIT 1").fetchone()
+                if bad is not None:
+                    raise _refuse(self.path, f"stored row {table}(rowid={bad[0]}): {column} = {bad[1]!r} is not a name",
+                                  "the store was damaged or edited; " + _FRESH_HINT)
+        for node, period, frames in self.conn.execute(
+                "SELECT r.node, r.period, r.frames FROM error_run r WHERE r.frames != (SELECT COUNT(*) FROM error_frame f "
+                "WHERE f.node = r.node AND f.period = r.period) LIMIT 1"):
+            held = self.conn.execute("SELECT COUNT(*) FROM error_frame WHERE node = ? AND period = ?",
+                                     (node, period)).fetchone()[0]
+            raise _refuse(self.path, f"stored row error_run(node={node!r}, period={period!r}) records {frames} frames, "
+                          f"the store holds {held} of them", "the store was damaged or edited; " + _FRESH_HINT)
+        for node, period in self.conn.execute(
+                "SELECT r.node, r.period FROM timing_run r WHERE NOT EXISTS (SELECT 1 FROM timing_frame f "
+                "WHERE f.node = r.node AND f.period = r.period) LIMIT 1"):
+            raise _refuse(self.path, f"stored row timing_run(node={node!r}, period={period!r}) has no timed frames",
+                          "the store was damaged or edited; " + _FRESH_HINT)
+        meta = meta if meta is not None else dict(self.conn.execute("SELECT key, value FROM meta"))
+        for key in _JSON_META:
+            if key in meta:
+                try:
+                    json.loads(meta[key])
+                except (TypeError, ValueError):
+                    raise _refuse(self.path, f"stored meta({key!r}) is not JSON",
+                                  "the store was damaged or edited; " + _FRESH_HINT) from None
+
+    def _rows(self, table: str, sql: str, args: tuple = (), rules: Optional[dict] = None) -> list[tuple]:
         """The rows of ``sql``, each checked against :data:`_RANGES` for ``table``: a stored value
         of the wrong type, not finite or out of its range (a tampered or damaged store) is refused
         with the table, the row and the column, never used."""
@@ -573,7 +626,7 @@ class ProfileStore:
             rows = cur.fetchall()
         except sqlite3.DatabaseError as err:
             raise _refuse(self.path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
-        ranges = _RANGES[table]
+        ranges = rules if rules is not None else _RANGES[table]
         for row in rows:
             for name, value in zip(names, row):
                 rule = ranges.get(name)
