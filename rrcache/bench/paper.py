@@ -503,12 +503,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     if medium.label != MEDIUM:
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
-    if medium.kind != "cache":  # an amortized estimator or several nodes: the algorithms and limit are one node's
-        what = ("amortized sampling" if medium.kind == "amortize" else "several cached nodes" if medium.multi
-                else f"a selection of kind {medium.kind}")
+    if not medium.choice.one_node:  # an amortized estimator, several nodes: the algorithms and limit are one node's
         if medium.multi:  # the all-hit limit of the set (the algorithms and the misses are one node's)
             _set_limit(prof, work, session, frames, medium, result, progress)
-        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({what}): the "
+        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({medium.choice.title}): the "
                             "algorithms and the miss breakdown are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:
             result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)

@@ -27,6 +27,7 @@ from rrcache.cli.options import include_dirs_option, parse_defines, resolution_o
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
+from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK, UNRELIABLE_NOISE
 from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
@@ -127,18 +128,22 @@ def _fmt(value, spec=".3g", none="–"):
               help="After validation, measure each selection's node with adaptive refresh at these "
                    "thresholds (e.g. 0.005,0.01,0.02) and keep it where faster at the same level "
                    "(docs/adaptive.md).")
+@click.option("--clock", type=click.Choice(sorted(CLOCKS)), default=DEFAULT_CLOCK, show_default=True,
+              help="The frame clock of every timed run: wall = wall time around glFinish (the only one that "
+                   "means anything on a software rasterizer); gl-timer = GL timer queries (real GPUs). "
+                   "Recorded in the profile.")
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
             algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, max_sets, defines, adaptive, quiet, vert, include_dirs):
+            wait, max_sets, defines, adaptive, clock, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
                   measure_terms=measure_terms,
-                  validate=not no_validate, validation_frames=validation_frames, levels=levels)
+                  validate=not no_validate, validation_frames=validation_frames, levels=levels, clock=clock)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),
                         ("max_sets", max_sets)):
@@ -365,17 +370,7 @@ def _table(prof) -> TextTable:
                           "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
                           "FLIP meas.", "level met")])
     for s in prof.selections:
-        if s.multi:  # several nodes, each at its own period
-            node = " + ".join(f"{p.node}: {p.text or prof.node(p.node).text}" for p in s.parts)
-            period = "/".join(str(p) for p in s.periods)
-        elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
-            part = s.parts[0]
-            slots = " slots" if part.history == "slots" else ""
-            node, period = (f"{part.estimator} m={part.samples}/{prof.estimator(part.estimator).samples} "
-                            f"λ={part.blend:g}{slots}: {part.text or ''}"), "–"
-        else:
-            node = "(original)" if s.node is None else f"{s.node}: {s.text}"
-            period = _fmt(s.period, "d")
+        node, period = s.choice.cells(s, prof) if s.parts else ("(original)", "–")
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),

@@ -24,8 +24,10 @@ import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache import kinds
 from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -35,6 +37,7 @@ from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
 from rrcache.selection import Selection
+from rrcache.choice import write as choice_write
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -49,7 +52,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None) -> Profile:
+            vertex=None, adaptive=None, executor=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -59,7 +62,10 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`).
+    same level (:mod:`rrcache.profiler.adaptive`). ``executor``: a callable ``(work, session) ->
+    executor`` making what runs the training's :class:`~rrcache.runs.RunSpec` s (its
+    ``run(specs, on_frame=None)`` yields a :class:`~rrcache.runs.RunResult` per spec, in any order;
+    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -70,8 +76,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught)
+                prof = _profile(shader_path, session_path, out_dir, settings, caught, defines=defines,
+                                progress=progress, fresh=fresh, plots=plots, include_dirs=include_dirs, wait=wait,
+                                vertex=vertex, adaptive=adaptive, executor=executor)
             finally:
                 raised = list(caught)
     finally:
@@ -80,8 +87,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     return prof
 
 
-def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list) -> Profile:
+def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defines, progress, fresh, plots,
+             include_dirs, wait, vertex, adaptive, executor) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -101,6 +108,8 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
     try:
         store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
         started = time.time()
+        compiled = sum(kinds.compile_counts().values())
+        make_executor, runner = executor, None
         try:
             store.begin_run()
             if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
@@ -110,21 +119,28 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
                 if scores:
                     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
                                             term_scores=scores)
-            result = train(work, session, resolved, store, progress)
+            # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+            # the original's reference frames rendered once
+            runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
+            result = train(work, session, resolved, store, progress, executor=runner)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
             prof.term_scores = dict(work.term_scores)
-            prof.sets = _sets(prof, work, session, resolved, store, progress)
+            prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress)
+            prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
+            runner.close()  # validation renders side by side with its own renderers
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
-                                         window=result.plan.timing_window if result.plan is not None else None)
+                                         window=result.plan.timing_window if result.plan is not None else None,
+                                         store=store, executor=runner)
             prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
+            # how many variants this invocation compiled (each at most once: the compile cache)
+            prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
             prof.write(out)
@@ -134,6 +150,9 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
         except BaseException:
             _end_quietly(store, "failed")
             raise
+        finally:
+            if runner is not None:
+                runner.close()
         store.close()
     finally:
         lock.release()
@@ -212,12 +231,12 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     return prof
 
 
-def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+def _sets(prof: Profile, work, session, settings, store, progress, executor=None) -> list:
     """The sets of several cached nodes predicted to improve the front, the few picked trained
     (:mod:`rrcache.profiler.sets`)."""
     from rrcache.profiler.sets import train_sets
 
-    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets, executor=executor)
 
 
 def _psnr_offset(store, settings, result: TrainingResult) -> float:
@@ -295,7 +314,8 @@ def _verdict(ceiling) -> dict:
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
-    """The shader files of each selection, then (with ``plots``) the plots and the report."""
+    """The shader files of each selection, then (with ``plots``) the plots, the report's frames
+    (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
     kept = []
     # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
     # refused, never followed, and the old files of a selection are removed only inside it
@@ -303,17 +323,19 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         for sel in prof.selections:
             with optimized.folder(sel.label) as folder:
                 folder.remove_files()
-                prof.write_variant(sel, folder, work=work)
+                choice_write(prof, sel, folder, work=work)
             kept.append(sel.replace(files=f"optimized/{sel.label}"))
         if prof.verdict is not None:  # stopped before training: nothing to plot or report
             with optimized.folder("original") as folder:
-                prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), folder)
+                choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), folder)
             plots = False
     prof.selections = kept
     prof.path = out
     if plots:
+        from rrcache.profiler.frames import write_frames
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
         prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_report(prof, out, work=work)
+        write_frames(prof, out, work)
+        write_report(prof, out)
