@@ -49,7 +49,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None) -> Profile:
+            vertex=None, adaptive=None, cluster=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -59,7 +59,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`).
+    same level (:mod:`rrcache.profiler.adaptive`). ``cluster`` (:func:`rrcache.cluster.maybe_cluster`)
+    makes the runs on a Dask cluster instead of in this process, and its workers buy a larger
+    default plan (:mod:`rrcache.profiler.capacity`), recorded in ``Profile.cluster``.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -69,7 +71,13 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
     session = load_session(session_path)
     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
-    resolved = (settings or TrainingSettings()).resolved(session)
+    settings = settings or TrainingSettings()
+    capacity = None
+    if cluster is not None:  # more workers: more frames and more nodes (rrcache.profiler.capacity)
+        from rrcache.profiler.capacity import scaled
+
+        settings, capacity = scaled(settings, session, cluster.capacity)
+    resolved = settings.resolved(session)
     from rrcache.profiler.amortize import estimator_table
 
     estimator_table(work)  # a malformed '#pragma rrcache estimator': said before anything is trained
@@ -85,7 +93,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
         # the original's reference frames rendered once
         compiled = sum(kinds.compile_counts().values())
-        executor = LocalExecutor(Bench(work, session))
+        executor = cluster.executor(work, session) if cluster is not None else LocalExecutor(Bench(work, session))
         try:
             store.begin_run()
             result = train(work, session, resolved, store, progress, executor=executor)
@@ -107,6 +115,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
+            if cluster is not None:
+                prof.cluster = _cluster_record(cluster, capacity, executor.placements)
             prof.write(out)
         except KeyboardInterrupt:
             _end_quietly(store, "interrupted")
@@ -120,6 +130,18 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     finally:
         lock.release()
     return prof
+
+
+def _cluster_record(cluster, capacity, placements) -> dict:
+    """What profile.json says of the cluster a profile's runs were made on: the workers and
+    hosts, what their capacity bought (training frames, budget factor), and where this
+    invocation's timed runs ran (host → the runs' labels)."""
+    timed = {}
+    for p in placements:
+        if p.kind == "timing":
+            timed.setdefault(p.host, []).append(p.label)
+    return {"workers": len(cluster.workers), "hosts": cluster.hosts, "dashboard": cluster.dashboard,
+            "capacity": capacity.to_json() if capacity is not None else None, "timing_hosts": timed}
 
 
 def _end_quietly(store, status: str) -> None:

@@ -183,6 +183,9 @@ class Profile:
     #: the shader's estimators and their amortized-sampling models (:mod:`rrcache.profiles.amortize`;
     #: absent in documents written before amortization was profiled: none)
     estimators: list[EstimatorProfile] = field(default_factory=list)
+    #: the Dask cluster the runs were made on (rrcache.profiler.run._cluster_record: workers, hosts,
+    #: what their capacity bought, the hosts of the timed runs); None: made in one process
+    cluster: Optional[dict] = None
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):

@@ -1,0 +1,154 @@
+"""A profile through Dask (a real LocalCluster: two worker processes, tiny renders) against the
+same profile in this process:
+
+- the same nodes trained, every error run equal within 1e-6 (frame by frame), the same
+  selections (a seeded scene whose costliest node dominates, so the choice rests on the error
+  models, which are deterministic);
+- a worker killed (SIGKILL) mid-profile: the profile completes with the same result;
+- no timing run beside another run on one host, from the recorded start and end times, and the
+  store records the host of every timing run;
+- a scheduler and two workers started as separate processes profile the bundled demo scene end
+  to end through ``rrcache profile --scheduler``.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from rrcache.profiler import profile
+from rrcache.profiles import TrainingSettings, read_store
+from scene_files import WAVE, fragment, session_doc, write_scene
+
+#: eight octaves of wave noise: the whole noise costs far more than any other node
+SHADER = fragment("""void main() {
+    vec3 p = v_objectPosition * u_scale;
+    float n = 0.0;
+    float a = 0.5;
+    float f = 1.0;
+    n += a * wave(p, f); a *= 0.5; f *= 2.03;
+    n += a * wave(p, f); a *= 0.5; f *= 2.03;
+    n += a * wave(p, f); a *= 0.5; f *= 2.03;
+    n += a * wave(p, f); a *= 0.5; f *= 2.03;
+    n += a * wave(p, f); a *= 0.5; f *= 2.03;
+    n += a * wave(p, f); a *= 0.5; f *= 2.03;
+    vec3 albedo = mix(vec3(0.9, 0.8, 0.6), vec3(0.3, 0.2, 0.1), 0.5 + 0.5 * n);
+    float diffuse = max(dot(normalize(v_normal), normalize(u_light - v_position.xyz)), 0.0);
+    fragColor = vec4(albedo * (0.2 + 0.8 * diffuse), 1.0);
+}""", helpers=WAVE)
+SETTINGS = TrainingSettings(periods=(2, 4, 8), resolution=(32, 24), frames=12, timing_frames=4,
+                            timing_periods=(2, 8), min_gain=0.0, algorithm="three-pass", budget_s=600.0,
+                            max_sets=0, validate=False)
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("scene")
+    return write_scene(folder, SHADER, session_doc(frames=12))
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    from rrcache.cluster.client import connect
+
+    lock = tmp_path_factory.mktemp("hostlock") / "host.lock"
+    with connect(workers=2, lock_path=str(lock), dashboard_address=":0") as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def in_process(scene, tmp_path_factory):
+    shader, session = scene
+    return profile(shader, session, tmp_path_factory.mktemp("local") / "p", SETTINGS, plots=False)
+
+
+def _error_frames(folder) -> dict:
+    with read_store(folder / "profile.sqlite") as store:
+        return {(r.node, r.period): [f.mean_error for f in store.error_frames(r.node, r.period)]
+                for r in store.error_runs()}
+
+
+def _same(local, remote) -> None:
+    assert [n.id for n in remote.trained_nodes] == [n.id for n in local.trained_nodes]
+    assert len(local.trained_nodes) >= 3
+    ours, theirs = _error_frames(local.path), _error_frames(remote.path)
+    assert set(ours) == set(theirs)
+    for key, frames in ours.items():
+        assert len(theirs[key]) == len(frames)
+        assert max(abs(a - b) for a, b in zip(frames, theirs[key])) <= 1e-6, key
+    for a, b in zip(local.trained_nodes, remote.trained_nodes):
+        assert a.errors == pytest.approx(b.errors, abs=1e-6) and a.hit_rates == pytest.approx(b.hit_rates, abs=1e-9)
+    assert [s.describe() for s in remote.selections] == [s.describe() for s in local.selections]
+
+
+def _overlap(a, b) -> bool:
+    return a.started < b.finished and b.started < a.finished
+
+
+def test_a_profile_through_dask_equals_the_one_in_process(scene, cluster, in_process, tmp_path):
+    shader, session = scene
+    before = len(cluster.placements)
+    remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, cluster=cluster)
+    _same(in_process, remote)
+    placed = cluster.placements[before:]
+    assert {p.kind for p in placed} == {"error", "timing"} and len({p.pid for p in placed}) == 2
+    for a in placed:  # a timing run had its host to itself
+        if a.kind == "timing":
+            assert not [b for b in placed if b is not a and b.host == a.host and _overlap(a, b)], a
+    with sqlite3.connect(tmp_path / "p" / "profile.sqlite") as db:
+        hosts = [h for (h,) in db.execute("SELECT host FROM timing_run")]
+    assert hosts and all(h == placed[0].host for h in hosts)
+
+
+def test_a_worker_killed_mid_profile(scene, cluster, in_process, tmp_path):
+    shader, session = scene
+    cluster.client.wait_for_workers(2, timeout=60)
+    victims = []
+
+    def kill_a_busy_worker():
+        deadline = time.time() + 120
+        while time.time() < deadline and not victims:
+            busy = sorted(w for w, keys in cluster.client.processing().items() if any("error" in k for k in keys))
+            if busy:
+                pid = cluster.client.run(os.getpid, workers=[busy[0]])[busy[0]]
+                os.kill(pid, signal.SIGKILL)
+                victims.append(pid)
+            time.sleep(0.02)
+
+    killer = threading.Thread(target=kill_a_busy_worker)
+    killer.start()
+    try:
+        remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, cluster=cluster)
+    finally:
+        killer.join()
+    assert victims, "no worker was seen busy with an error run"
+    _same(in_process, remote)
+    cluster.client.wait_for_workers(2, timeout=60)
+
+
+def test_a_farm_profiles_the_demo_scene_end_to_end(tmp_path):
+    from farm import local_farm
+
+    from rrcache.profiler.demo import DEMO_SESSION, DEMO_SHADER
+
+    env = {"RRCACHE_HOST_LOCK": str(tmp_path / "host.lock"), "LP_NUM_THREADS": "1"}
+    with local_farm(tmp_path / "farm", env=env) as address:
+        proc = subprocess.run(
+            [sys.executable, "-m", "rrcache", "profile", str(DEMO_SHADER), str(DEMO_SESSION), "--out",
+             str(tmp_path / "demo"), "--scheduler", address, "--periods", "2,4,8", "--frames", "12",
+             "--timing-frames", "3", "--timing-periods", "2,8", "--budget", "20", "--sets", "0",
+             "--min-gain", "0", "--validation-frames", "6"],
+            capture_output=True, text=True, timeout=600, env=dict(os.environ, **env))
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert f"scheduler {address}" in proc.stderr
+    doc = json.loads((tmp_path / "demo" / "profile.json").read_text())
+    assert [s["label"] for s in doc["selections"]] == ["e1", "e2", "e3", "e4"]
+    assert any(n["trained"] for n in doc["nodes"])
+    assert (tmp_path / "demo" / "report.html").exists()
