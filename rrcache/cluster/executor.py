@@ -18,7 +18,6 @@ import hashlib
 from dataclasses import dataclass
 from typing import Iterable, Iterator, Optional
 
-from rrcache.cluster.client import Cluster
 from rrcache.cluster.worker import CONTEXT_PREFIX, Placed, ProfileContext, run_task
 
 
@@ -33,9 +32,9 @@ class RunFailure:
 
 
 class DaskRuns:
-    """Runs on ``cluster`` (see the module docstring)."""
+    """Runs on ``cluster`` (a :class:`rrcache.cluster.client.Cluster`; see the module docstring)."""
 
-    def __init__(self, cluster: Cluster):
+    def __init__(self, cluster):
         self.cluster = cluster
         self.client = cluster.client
         self.placements: list[Placed] = []
@@ -141,7 +140,7 @@ class DaskExecutor:
     :meth:`close` releases what the workers built for the profile; a later :meth:`run` sends the
     context again."""
 
-    def __init__(self, cluster: Cluster, work, session, on_frame=None):
+    def __init__(self, cluster, work, session, on_frame=None):
         self.runs = DaskRuns(cluster)
         self.on_frame = on_frame
         self.key = f"{work.hash[:12]}-{session.hash[:12]}"
