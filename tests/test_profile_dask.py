@@ -14,17 +14,15 @@ from __future__ import annotations
 
 import json
 import os
-import signal
 import sqlite3
 import subprocess
 import sys
-import threading
-import time
 
 import pytest
 
 from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings, read_store
+from farm import killing_a_busy_worker, local_farm
 from scene_files import WAVE, fragment, session_doc, write_scene
 
 #: eight octaves of wave noise: the whole noise costs far more than any other node
@@ -117,32 +115,14 @@ def test_a_profile_through_dask_equals_the_one_in_process(scene, cluster, in_pro
 def test_a_worker_killed_mid_profile(scene, cluster, in_process, tmp_path):
     shader, session = scene
     cluster.client.wait_for_workers(2, timeout=60)
-    victims = []
-
-    def kill_a_busy_worker():
-        deadline = time.time() + 120
-        while time.time() < deadline and not victims:
-            busy = sorted(w for w, keys in cluster.client.processing().items() if any("error" in k for k in keys))
-            if busy:
-                pid = cluster.client.run(os.getpid, workers=[busy[0]])[busy[0]]
-                os.kill(pid, signal.SIGKILL)
-                victims.append(pid)
-            time.sleep(0.02)
-
-    killer = threading.Thread(target=kill_a_busy_worker)
-    killer.start()
-    try:
+    with killing_a_busy_worker(cluster.client, matching="error") as victims:
         remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, cluster=cluster)
-    finally:
-        killer.join()
     assert victims, "no worker was seen busy with an error run"
     _same(in_process, remote)
     cluster.client.wait_for_workers(2, timeout=60)
 
 
 def test_a_farm_profiles_the_demo_scene_end_to_end(tmp_path):
-    from farm import local_farm
-
     from rrcache.profiler.demo import DEMO_SESSION, DEMO_SHADER
 
     env = {"RRCACHE_HOST_LOCK": str(tmp_path / "host.lock"), "LP_NUM_THREADS": "1"}
