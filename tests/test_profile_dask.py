@@ -139,3 +139,18 @@ def test_a_farm_profiles_the_demo_scene_end_to_end(tmp_path):
     assert [s["label"] for s in doc["selections"]] == ["e1", "e2", "e3", "e4"]
     assert any(n["trained"] for n in doc["nodes"])
     assert (tmp_path / "demo" / "report.html").exists()
+
+
+def test_profile_library_with_workers_prints_the_dashboard(scene, tmp_path):
+    shader, session = scene
+    proc = subprocess.run(
+        [sys.executable, "-m", "rrcache", "profile-library", "--shaders", str(shader), "--sessions", str(session),
+         "--out", str(tmp_path / "lib"), "--workers", "2", "--periods", "2,4,8", "--frames", "8",
+         "--timing-frames", "3", "--timing-periods", "2,8", "--budget", "5", "--min-gain", "0", "--no-validate",
+         "--no-plots"],
+        capture_output=True, text=True, timeout=600, env=dict(os.environ, LP_NUM_THREADS="1"))
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "Dask cluster (started here): 2 workers on 1 host" in proc.stderr and "/status" in proc.stderr
+    assert "[1/1] noise-orbit" in proc.stderr and "noise-orbit" in proc.stdout
+    doc = json.loads((tmp_path / "lib" / "noise-orbit" / "profile.json").read_text())
+    assert doc["cluster"]["workers"] == 2 and doc["settings"]["frames"] == 8
