@@ -15,6 +15,8 @@ Every placement (host, worker, start and end) is kept in :attr:`DaskRuns.placeme
 from __future__ import annotations
 
 import hashlib
+import itertools
+import uuid
 from dataclasses import dataclass
 from typing import Iterable, Iterator, Optional
 
@@ -39,6 +41,8 @@ class DaskRuns:
         self.client = cluster.client
         self.placements: list[Placed] = []
         self._contexts: list[str] = []
+        # task keys unique over every map() of this object and across clients
+        self._numbers, self._token = itertools.count(), uuid.uuid4().hex[:8]
 
     def open(self, key: str, context) -> str:
         """Send ``context`` (pickled here, with cloudpickle) to every worker once, under ``key``;
@@ -74,11 +78,11 @@ class DaskRuns:
         if not context.startswith(CONTEXT_PREFIX):
             raise ValueError(f"{context!r} is not a context opened by DaskRuns.open")
         futures, names = {}, {}
-        for i, (spec, kind) in enumerate(runs):
+        for spec, kind in runs:
             text = label(spec, kind) if label is not None else kind
             name = text.replace(" ", "_")
             future = self.client.submit(run_task, context, spec, kind, pure=False,
-                                        key=f"{name}-{context[len(CONTEXT_PREFIX):]}-{i}")
+                                        key=f"{name}-{self._token}-{next(self._numbers)}")
             futures[future] = (spec, kind)
             names[future] = text
         pending = set(futures)
