@@ -35,8 +35,10 @@ from rrcache.compiler import Variant
 from rrcache.compiler.prepared import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 from rrcache.selection import Selection
+from rrcache.session.changes import per_frame_uniforms
 
 
 @dataclass
@@ -53,6 +55,8 @@ class ShaderWork:
     include_dirs: tuple = ()
     #: the unroll limit the table was analysed with (part of the compile cache's key)
     max_unroll: int = DEFAULT_MAX_ITERATIONS
+    #: the measured order of sums the table was analysed with (``term_scores``; part of the key)
+    term_scores: tuple = ()
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -76,17 +80,30 @@ class ShaderWork:
 
 
 def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, str]] = None,
-                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None) -> ShaderWork:
+                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None,
+                     term_scores=None) -> ShaderWork:
     """Load and analyse ``shader_path`` (loops of at most ``max_unroll`` iterations unrolled);
     with a ``session`` its meshes' attributes set the ``MODEL_VERTEX_*`` defines (``defines``
     win over them). Includes are looked up next to the including file, then in ``include_dirs``
     (``-I``), then in the session's ``"include_dirs"``. ``vertex`` is the path of the user's
-    vertex shader (None: the session's ``"vertex"``, else a generated one)."""
+    vertex shader (None: the session's ``"vertex"``, else a generated one). ``term_scores``: the
+    measured order of sums whose weights do not fold (:mod:`rrcache.profiler.terms`; node ids
+    then refer to the program ordered by them)."""
     dirs = all_include_dirs(include_dirs, session)
     shader, all_defines = load_for_meshes(shader_path, session, defines, dirs)
     user = load_user_vertex(vertex, session, all_defines, dirs)
-    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user,
-                      tuple(os.path.abspath(d) for d in include_dirs or ()), int(max_unroll))
+    # what changes between the session's frames: the terms of a sum that read it go last
+    moving = sorted(per_frame_uniforms(session)) if session is not None else ()
+    table = cacheable_nodes(shader, max_iterations=max_unroll, moving=moving, scores=term_scores or None)
+    return ShaderWork(shader, table, all_defines, user, tuple(os.path.abspath(d) for d in include_dirs or ()),
+                      int(max_unroll), _scores_key(term_scores))
+
+
+def _scores_key(term_scores) -> tuple:
+    """``term_scores`` as a hashable record (the compile cache's key: node ids depend on it)."""
+    if not term_scores:
+        return ()
+    return tuple(sorted((str(k), repr(v)) for k, v in dict(term_scores).items()))
 
 
 def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
@@ -94,7 +111,7 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
     return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
-def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",
+def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
     """The variant of ``work`` caching ``node_id`` (an id such as ``n42``; ``adaptive``: refreshed
     by :mod:`rrcache.runtime.adaptive`'s rule), compiled once (:func:`rrcache.kinds.compile`)."""
@@ -102,7 +119,7 @@ def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", f
     return kinds.compile(work, spec)
 
 
-def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = "bilinear",
+def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
                       payload_dtype: str = "f4") -> Variant:
     """The variant of ``work`` caching every node of ``node_ids`` (two or more; one:
     :func:`variant_for`), each with its own payload and period
@@ -137,6 +154,8 @@ class WorkSource:
     include_dirs: tuple = ()
     vertex: Optional[str] = None
     max_unroll: int = DEFAULT_MAX_ITERATIONS
+    #: the measured order of sums (``load_for_session(term_scores=)``; None: the analysis's own)
+    term_scores: Optional[dict] = None
 
     @classmethod
     def of(cls, work: ShaderWork, session, user_defines=None) -> "WorkSource":
@@ -150,7 +169,7 @@ class WorkSource:
 
         session = load_session(self.session)
         work = load_for_session(self.shader, session, dict(self.defines), self.include_dirs, self.max_unroll,
-                                vertex=self.vertex)
+                                vertex=self.vertex, term_scores=self.term_scores)
         return work, session
 
 

@@ -112,8 +112,9 @@ class FrameRow:
 class RunResult:
     """What one run measured: its ``spec``, one :class:`FrameRow` per frame rendered, ``wall_s``
     (seconds it took, ``setup_s`` of them compiling, linking and allocating), the ``payload`` the
-    cache kept (``f4`` when a narrower one did not fit), ``notes`` (what the renderers said), and
-    ``complete`` (False when ``strict_payload`` stopped it)."""
+    cache kept (``f4`` when a narrower one did not fit), ``notes`` (what the renderers said),
+    ``complete`` (False when ``strict_payload`` stopped it), and where and when it ran: ``host``
+    (the machine's name; None in this process), ``started``/``finished`` (Unix seconds)."""
 
     spec: RunSpec
     frames: tuple = ()
@@ -122,6 +123,9 @@ class RunResult:
     payload: Optional[str] = None
     notes: tuple = ()
     complete: bool = True
+    host: Optional[str] = None
+    started: Optional[float] = None
+    finished: Optional[float] = None
 
     @property
     def steady(self) -> tuple:

@@ -112,7 +112,7 @@ def test_a_run_that_always_kills_its_worker_is_reported(cluster):
 
 def test_the_default_path_imports_no_dask(tmp_path):
     """A whole in-process profile (and the commands' modules) without a Dask module loaded."""
-    from test_profile import write_scene
+    from scene_files import write_scene
 
     shader, session = write_scene(tmp_path / "scene")
     code = ("import sys, rrcache\n"

@@ -28,21 +28,9 @@ from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings, load_profile
 from rrcache.selection import AmortizedLoop
 
-from test_profile import SESSION
+from scene_files import SESSION, WAVE, fragment, write_scene
 
-SHADER = """#version 330
-in vec4 v_position;
-in vec3 v_normal;
-in vec3 v_objectPosition;
-uniform vec3 u_light;
-uniform float u_scale;
-out vec4 fragColor;
-
-float wave(vec3 p, float f) {
-    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
-}
-
-void main() {
+SHADER = fragment("""void main() {
     vec3 p = v_objectPosition * u_scale;
     vec3 nrm = normalize(v_normal);
     vec3 l = normalize(u_light - v_position.xyz);
@@ -53,7 +41,7 @@ void main() {
     }
     fragColor = vec4(vec3(0.9, 0.8, 0.6) * (0.2 + 0.1 * shade), 1.0);
 }
-"""
+""", WAVE)
 
 #: 64×64 at full resolution (the error runs in a window at full pixel density), a 1 s budget:
 #: the costliest node and the estimator are trained
@@ -61,11 +49,7 @@ SETTINGS = dict(periods=(2, 4, 8), timing_frames=6, timing_periods=(2, 8), min_g
 
 
 def _scene(folder):
-    folder.mkdir(parents=True, exist_ok=True)
-    shader, session = folder / "soft.frag", folder / "orbit.json"
-    shader.write_text(SHADER)
-    session.write_text(json.dumps({**SESSION, "resolution": [64, 64]}))
-    return shader, session
+    return write_scene(folder, SHADER, {**SESSION, "resolution": [64, 64]}, "soft.frag")
 
 
 @pytest.fixture(scope="module")
@@ -273,8 +257,8 @@ def test_the_slots_history_is_trained_where_it_fits(trained):
 
 
 def _old_store(path):
-    """Rewrite the amortize_run table of the store at ``path`` as it was before the history
-    column (its blend rows only)."""
+    """Rewrite the store at ``path`` as schema 2 wrote it before the history column: its
+    amortize_run table without the column (its blend rows only), no set or adaptive tables."""
     import sqlite3
 
     conn = sqlite3.connect(str(path), isolation_level=None)
@@ -289,6 +273,9 @@ def _old_store(path):
         ms REAL NOT NULL, original_ms REAL NOT NULL, wall_s REAL NOT NULL,
         PRIMARY KEY (estimator, kind, samples, blend, frame))""")
     conn.executemany(f"INSERT INTO amortize_run ({cols}) VALUES ({', '.join('?' * 13)})", rows)
+    conn.execute("DROP TABLE IF EXISTS set_run")
+    conn.execute("DROP TABLE IF EXISTS adaptive_point")
+    conn.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
     conn.close()
     return rows
 
@@ -465,7 +452,8 @@ def test_frame_shots_render_an_amortized_selection(amortized_wins):
     """FrameShots renders an amortized choice for real: the run settles its history (the N/m
     cycle and the blend's memory), the cached frame is near the original but not equal to it,
     hits blend and misses evaluate every term, and the payload is the running estimate."""
-    from rrcache.report.images import HIT_COLOR, MISS_COLOR, FrameShots, settle_frame
+    from rrcache.profiler.frames import FrameShots
+    from rrcache.report.images import HIT_COLOR, MISS_COLOR, settle_frame
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
@@ -489,7 +477,7 @@ def test_frame_shots_render_an_amortized_selection(amortized_wins):
 
 
 def test_frame_shots_render_a_slots_selection(slots_win):
-    from rrcache.report.images import FrameShots
+    from rrcache.profiler.frames import FrameShots
 
     prof, _ = slots_win
     choice = prof.select(1.0)
@@ -508,11 +496,13 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
     from PIL import Image
 
+    from rrcache.profiler.frames import FrameShots
     from rrcache.report.html import report_html
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
-    page = report_html(_with_selection(prof, choice))
+    shown = _with_selection(prof, choice)
+    page = report_html(shown, frames={s.label: FrameShots(prof).selection_images(s) for s in shown.selections})
     block = re.search(r'<div class="sel" id="sel-e4".*?</div></div>', page, re.S).group(0)
     assert 'data-kind="amortize"' in block and "amortize estimator <b>e1</b>" in block
     assert f"λ = {choice.parts[0].blend:g}" in block and "no frames" not in block
@@ -525,8 +515,8 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
 
 def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
-    from rrcache.report.explore import (Explorer, default_choice, default_selection, measure_choice,
-                                        selections_figure, tradeoff_figure)
+    from rrcache.explorer import Explorer, measure_choice
+    from rrcache.report.explore import default_choice, default_selection, selections_figure, tradeoff_figure
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
@@ -556,7 +546,7 @@ def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
     assert "amortized options" in fig.axes[0].get_title()
     assert any(line.get_color() == "darkorange" for line in fig.axes[0].lines)
     # the selections figure shows the amortized selection's frames
-    fig = selections_figure(prof, ui.shots)
+    fig = selections_figure(prof, {s.label: ui.shots.selection_images(s) for s in prof.selections})
     assert sum(len(ax.images) for ax in fig.axes) == 5
 
 

@@ -254,7 +254,9 @@ def _as_schema_2(path) -> None:
     (the sets in meta('sets')), the amortize_run table from before its history column."""
     conn = sqlite3.connect(str(path))
     conn.executescript("""
-        DROP TABLE set_run; DROP TABLE adaptive_point; DROP TABLE amortize_run;
+        DROP TABLE set_run; DROP TABLE adaptive_point; DROP TABLE amortize_run; DROP TABLE timing_run;
+        CREATE TABLE timing_run (node TEXT NOT NULL, period INTEGER NOT NULL, wall_s REAL NOT NULL,
+            run_id INTEGER NOT NULL REFERENCES run_log(id), PRIMARY KEY (node, period));
         CREATE TABLE amortize_run (estimator TEXT NOT NULL, kind TEXT NOT NULL, samples INTEGER NOT NULL,
             blend REAL NOT NULL, frame INTEGER NOT NULL, mean_error REAL NOT NULL, psnr REAL NOT NULL,
             hit_rate REAL NOT NULL, hits INTEGER NOT NULL, misses INTEGER NOT NULL, ms REAL NOT NULL,
@@ -286,6 +288,7 @@ def test_a_schema_2_store_is_read_as_it_is_and_upgraded_when_written(tmp_path):
         assert [(d["nodes"], d["trained_error"]) for d in store.set_runs()] == [(["n1", "n2"], 0.02)]
         assert [(r["history"], r["samples"]) for r in store.amortize_rows("e1", "error")] == [("blend", 4)]
         columns = [r[1] for r in store.conn.execute("PRAGMA table_info(amortize_run)")]
+        assert "host" in [r[1] for r in store.conn.execute("PRAGMA table_info(timing_run)")]
         assert "history" in columns and store.conn.execute("SELECT COUNT(*) FROM adaptive_point").fetchone() == (0,)
         store.add_set_run({"nodes": ["n1", "n3"], "periods": [8, 8], "trained": False, "note": "x"})
         assert len(store.set_runs()) == 2

@@ -107,6 +107,26 @@ def test_a_budget_of_every_pixel_reproduces_the_original(scene, gl_ctx, which):
             assert got.filled["point"] == rc.pixels
 
 
+def test_every_pixel_of_a_shader_that_discards_is_the_original(tmp_path, gl_ctx):
+    """Where the shader discards, the original shows the background: so does the render cache
+    (a background sample), and after it its points are background points."""
+    shader, session_path = _cli_files(tmp_path)
+    shader.write_text(SHADER.replace("    vec3 n = normalize(v_normal);", "    if (stripes > 0.8) discard;\n"
+                                     "    vec3 n = normalize(v_normal);"))
+    session = load_session(session_path)
+    prepared = prepare_file(shader, session)
+    with Renderer(prepared, session) as original, \
+            RenderCacheRenderer(prepared, session, settings=RenderCacheSettings(samples=1.0)) as rc:
+        for index in range(3):
+            ref, got = original.render_frame(index), rc.render_frame(index)
+            assert np.abs(got.image[..., :3] - ref.image[..., :3]).max() <= 1e-6
+        # a pixel the shader discarded is not covered (no depth written): one background point each
+        assert (rc.cache.object == BACKGROUND).sum() == rc.pixels - int(ref.mask.sum())
+    whole = prepare_file(_cli_files(tmp_path / "plain")[0], session)
+    with Renderer(whole, session) as plain:
+        assert plain.render_frame(2).mask.sum() > ref.mask.sum()  # the shader did discard pixels
+
+
 def test_a_small_budget_is_not_the_original_but_close(scene, gl_ctx):
     """The comparison's error is real: below every pixel the image differs, yet stays near the
     original (a broken projection would put it far off)."""
@@ -334,6 +354,7 @@ def test_bad_settings_are_refused_with_the_knob_named():
 
 # ---------------------------------------------------------------- the command
 def _cli_files(tmp_path):
+    tmp_path.mkdir(parents=True, exist_ok=True)
     (tmp_path / "lighting.glsl").write_text(LIGHTING)
     (tmp_path / "shader.frag").write_text(SHADER)
     (tmp_path / "moving.json").write_text(json.dumps(_session(True, True)))
@@ -380,3 +401,29 @@ def test_render_method_bad_input_is_one_line_exit_2(tmp_path, capsys, args, mess
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "Traceback" not in err
+
+
+def test_the_equal_time_tool_writes_its_table_sheet_and_stages(gl_ctx, tmp_path):
+    """``python -m rrcache.bench.render_cache equal-time`` on the small scene: the reprojection
+    cache, dynamic resolution and the render cache in one table (shapes only: timings are not
+    asserted), the per-stage table, the contact sheet."""
+    from rrcache.bench import render_cache as bench
+    from rrcache.pipeline import load_for_session
+
+    shader, session = _cli_files(tmp_path)
+    work = load_for_session(shader, load_session(session))
+    (node,) = [n.id for n in work.table.nodes if n.text == "m.albedo * (0.15 + 0.85 * diffuse)"]
+    assert bench.main(["equal-time", "--choice", f"{shader}:{session}={node}:4", "--search-frames", "3",
+                       "--out", str(tmp_path / "out")]) == 0
+    doc = json.loads((tmp_path / "out" / "equal_time.json").read_text())
+    (scene,) = doc["scenes"]
+    assert [r["method"] for r in scene["rows"]] == ["reprojection cache (ours)", "dynamic resolution",
+                                                     "render cache (Walter 2002)"]
+    assert scene["texts"] == ["m.albedo * (0.15 + 0.85 * diffuse)"] and scene["sheet_frame"] == 3
+    assert set(scene["sheet"]) == {"reprojection cache", "dynamic resolution", "render cache"}
+    assert scene["rows"][2]["stages"]["shade"] > 0 and scene["rows"][0]["speedup"] == scene["target_speedup"]
+    md = (tmp_path / "out" / "equal_time.md").read_text()
+    assert "| shader (48×36, 6 frames) | render cache (Walter 2002)" in md and "| shader | " in md
+    assert (tmp_path / "out" / "contact_sheet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(RRCacheError, match="not a choice"):
+        bench.Choice.parse("n66")

@@ -64,6 +64,24 @@ def test_one_renderer_serves_every_period(gl_ctx, bench):
     assert a.frames[2].error == 0.0 and b.frames[2].error > 0.0  # Δn = 1 recomputes everything
 
 
+@pytest.mark.parametrize("window", [None, (40, 30, 160, 120)])
+def test_a_run_on_a_used_renderer_measures_what_a_fresh_one_does(gl_ctx, window):
+    """The cache's reset clears its targets: a run after another run on the same renderer (the
+    training's runs share one) gives the per-frame errors of the same run on a new renderer, to
+    the bit, in a window too."""
+    session = load_session(SESSION)
+    work = load_for_session(SHADER, session)
+    node = max(work.table.nodes, key=lambda n: n.cost).id
+    base = VariantSpec("cache", (node,), "three-pass")
+    first, second = (RunSpec("error", base.with_runtime(periods=(p,)), tuple(range(6)), (320, 240), window)
+                     for p in (2, 50))
+    with Bench(work, session) as used:
+        _, after = LocalExecutor(used).run([first, second])
+    with Bench(work, session) as fresh:
+        alone = execute(second, fresh)
+    assert after.setup_s == 0 and [r.error for r in after.frames] == [r.error for r in alone.frames]
+
+
 def test_timing_runs_time_each_frame_beside_the_original(gl_ctx, bench):
     spec = VariantSpec("cache", (_node(bench),), "two-pass", periods=(8,))
     timing = execute(RunSpec("timing", spec, (1, 3), SIZE, color_format="rgba8"), bench)

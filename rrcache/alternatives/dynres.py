@@ -28,7 +28,7 @@ import numpy as np
 
 from rrcache.errors import RRCacheError
 from rrcache.gl.context import get_context
-from rrcache.gl.program import build_program
+from rrcache.gl.program import build_program, fullscreen_vertex
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import FrameResult, Renderer, check_frame_index, session_background
@@ -36,13 +36,6 @@ from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
 from rrcache.compiler.vertex import vertex_for
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, match_scale
-
-_UPSAMPLE_VERTEX = """#version 330 core
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-"""
 
 _UPSAMPLE_FRAGMENT = """#version 330 core
 uniform sampler2D rr_low;
@@ -105,7 +98,7 @@ class DynresRenderer:
         self._low_fbo = scope.own(ctx.framebuffer([self._low], self._low_depth))
         self._color = scope.own(ctx.texture(self.size, 4, dtype="f4"))
         self._fbo = scope.own(ctx.framebuffer([self._color]))
-        self._upsample = scope.own(build_program(ctx, _UPSAMPLE_VERTEX, _UPSAMPLE_FRAGMENT,
+        self._upsample = scope.own(build_program(ctx, fullscreen_vertex(0.0), _UPSAMPLE_FRAGMENT,
                                                  fragment_name="<rrcache bilinear upsample>"))
         self._upsample["rr_low"].value = 0
         self._upsample["rr_targetSize"].value = tuple(float(v) for v in self.size)

@@ -91,6 +91,7 @@ from rrcache.analysis.cost import CACHE_LOOKUP_COST, loop_trips, op_cost
 from rrcache.analysis.loops import Constants, global_scalars
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text
+from rrcache.analysis.sums import name_partial_sums
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
 __all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "cacheable_nodes",
@@ -223,12 +224,16 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
 
 @deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                    cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False) -> NodeTable:
+                    cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False, moving=(),
+                    scores=None) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
 
     The shader is first analysed (:func:`analyse`: inlining, unrolling loops of at most
-    ``max_iterations`` iterations) unless ``analysed`` says it already is. Nodes whose cost is
-    below ``cheap_below`` are left out as ``cheap``. See the module docstring for the rules.
+    ``max_iterations`` iterations, the terms of sums ordered by ``moving`` and ``scores``: see
+    :mod:`rrcache.analysis.sums`) unless ``analysed`` says it already is. Nodes whose cost is
+    below ``cheap_below`` are left out as ``cheap``. A partial sum of a reordered sum is named by
+    the terms it holds (``radiance: 24 of 25 terms, all but (i=2, j=2)``). See the module
+    docstring for the rules.
 
     >>> from rrcache.glsl.frontend import parse_shader
     >>> t = cacheable_nodes(parse_shader("uniform float u;\\nvoid main() {"
@@ -237,10 +242,11 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     [('vec4(sin(u))', 'uniform'), ('sin(u)', 'uniform'), ('u', 'uniform')]
     """
     with paused_gc():
-        target = shader if analysed else analyse(shader, max_iterations)
+        target = shader if analysed else analyse(shader, max_iterations, moving=moving, scores=scores)
         table = _Classifier(target, cheap_below).run()
         if not analysed:  # the text as written, and the file, of nodes from inlined code
             attach_source_text(table, shader.unit)
+        name_partial_sums(table, target.unit, moving, scores)
         return table
 
 

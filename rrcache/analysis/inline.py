@@ -16,7 +16,10 @@ input, built as follows.
           b = _rr_q_9;                     // ``out``/``inout`` write-backs, in parameter order
       }
 
-  and the call itself becomes ``_rr_f_7``. Calls are hoisted in evaluation order (arguments
+  and the call itself becomes ``_rr_f_7``. A sampler, image or atomic-counter argument (or a
+  struct holding one) is not copied (GLSL has no local variables of those types): the argument
+  itself stands for the parameter in the body (``texture(u_tex, uv)``). Calls are hoisted in
+  evaluation order (arguments
   first, left to right). When a hoisted call has side effects (it writes a global or an
   ``out`` parameter, or calls a side-effecting built-in) or an operand evaluated before it has
   side effects (an assignment, ``++``), those earlier operands are hoisted into temporaries too,
@@ -31,7 +34,18 @@ input, built as follows.
   cacheable-node analysis treats such guards like code after a ``return``: not dynamic).
   A function with a ``return`` inside a loop or ``switch`` is *not inlined*: it stays a function,
   and the cacheable-node analysis marks the nodes in its body ``dynamic``.
-- Functions no longer called are removed. Names starting with ``_rr`` are reserved.
+- A call of a function without effects whose arguments print the same as those of an earlier
+  call in the same statement (``map(p).x + map(p).y``) reads that call's result: one inlined
+  body, not two.
+- Bounded: before anything is inlined, the syntax nodes all call sites would copy (each call
+  copies its callee's body, the callee's own calls inlined) are counted against
+  ``budget.analysis_nodes`` (``rrcache --max-ast-nodes``); beyond it the shader is refused with
+  a :class:`~rrcache.errors.GLSLError` naming the deepest chain of calls (a chain of 2,000
+  functions each calling the previous would copy 12 million). A function's body is moved, not
+  copied, into its last call site.
+- Functions no longer called are removed. Names starting with ``_rr`` are reserved. A function
+  kept (a ``return`` inside a loop) gets a prototype before its first use when a call to it
+  now stands above its definition (an inlined body defined later called it).
 - A body inlined into another function keeps meaning what it meant: a local or parameter of
   the caller named like a global or a function the body uses (``float pos`` where the body
   reads the global ``vec3 pos``; ``float step`` where it calls ``step()``) is renamed first,
@@ -52,7 +66,10 @@ from __future__ import annotations
 import dataclasses
 from typing import Optional
 
+from rrcache.budgets import budget
+from rrcache.errors import GLSLError, UnsupportedShaderError
 from rrcache.glsl import ast as A
+from rrcache.glsl.printer import print_expr
 from rrcache.glsl.semantic import check
 
 from rrcache.glsl.ast import children, is_literal, walk
@@ -92,19 +109,27 @@ def inline_unit(unit: A.TranslationUnit) -> A.TranslationUnit:
 
 
 class _Template:
-    """A function body prepared for inlining: returns converted to placeholder assignments."""
+    """A function body (callee-first: its own calls already inlined) ready to be inlined; each
+    instance has its returns converted to placeholder assignments."""
 
-    def __init__(self, decl: A.FunctionDecl, body: A.Compound, needs_flag: bool, uses: int):
+    def __init__(self, decl: A.FunctionDecl, needs_flag: bool, uses: int):
         self.decl = decl
-        self.body = body
         self.needs_flag = needs_flag
+        self.is_void = decl.return_type.spec.name == "void"
         # call sites still to inline it: the last one takes the body itself instead of a copy
-        # (each node would otherwise be copied once per level of nesting)
+        # (each node would otherwise be copied once per level of nesting, and every function
+        # of a chain would keep its whole inlined body)
         self.uses = uses
+
+    def release(self) -> None:
+        """One call site less (a shared one): on the last, the body is no longer kept."""
+        self.uses -= 1
+        if self.uses <= 0:
+            self.decl.body = A.Compound([], loc=self.decl.body.loc)
 
     def instantiate(self, site: str) -> A.Compound:
         """The body for one call site, every location tagged with ``site``."""
-        if self.body is None:
+        if self.uses <= 0:
             raise AssertionError(f"inlining template of {self.decl.name} used more often than it is called")
         self.uses -= 1
         # nodes that share a location (an expression and its first operand) share its tagged
@@ -118,11 +143,14 @@ class _Template:
             return pair[1]
 
         if self.uses > 0:
-            return clone(self.body, tag)
-        body, self.body = self.body, None
-        for n in walk(body, decl_types=False):
-            if n.loc is not None:
-                n.loc = tag(n.loc)
+            body = clone(self.decl.body, tag)
+        else:   # the function is no longer called: its definition goes (the inliner prunes it)
+            body = self.decl.body
+            self.decl.body = A.Compound([], loc=body.loc)
+            for n in walk(body, decl_types=False):
+                if n.loc is not None:
+                    n.loc = tag(n.loc)
+        body.stmts = _convert_returns(body.stmts, self.is_void, self.needs_flag)
         return body
 
 
@@ -219,6 +247,20 @@ def _convert_returns(stmts: list, is_void: bool, needs_flag: bool) -> list:
     return _ConvertReturns(is_void, needs_flag).block(stmts)
 
 
+def _statements(body: A.Stmt):
+    """Every statement under ``body`` (itself included), without recursion."""
+    stack = [body]
+    while stack:
+        s = stack.pop()
+        yield s
+        if isinstance(s, A.Compound):
+            stack.extend(reversed(s.stmts))
+            continue
+        stack.extend(sub for _, sub in reversed(A.branches(s)))
+        if isinstance(s, A.For) and s.init is not None:
+            stack.append(s.init)
+
+
 def _wrap(stmts: list, loc) -> A.Stmt:
     return stmts[0] if len(stmts) == 1 else A.Compound(stmts, loc=loc)
 
@@ -242,6 +284,10 @@ class _Inliner(NodeVisitor):
         self.inlinable: dict[int, bool] = {}
         self.effectful: dict[int, bool] = {}
         self._calls_memo: dict[int, tuple] = {}
+        # the statement being lowered when identical calls in it may share one inlined body,
+        # and the results made so far: (id(pre), share key) -> (pre, result name)
+        self.sharing: Optional[A.Stmt] = None
+        self.shared: dict[tuple, tuple] = {}
         self._effects_memo: dict[int, tuple] = {}
 
     # ------------------------------------------------------------------ driver
@@ -256,12 +302,36 @@ class _Inliner(NodeVisitor):
         for d in self.defs:
             self.inlinable[id(d)] = d.name != "main" and not _returns_in_loops(d.body)
         self._unshadow_globals()
-        done: set[int] = set()
-        for d in self.defs:
-            self._process(d, done)
+        for d in self._callees_first():
+            self._process(d)
         self._prune()
         self._define_after_globals()
+        self._declare_before_use()
         return self.unit
+
+    def _declare_before_use(self) -> None:
+        """Give a function the inliner kept a prototype before its first use where its
+        definition now stands after a function calling it: a call inlined from a body defined
+        later (``void mainImage(out vec4 c, vec2 p);`` declared first, ``main`` calling it,
+        ``mainImage`` calling a helper that returns from inside a loop, so kept: the call of the
+        helper moves into ``main``, before the helper's definition, and ``mainImage``'s prototype
+        goes with ``mainImage``)."""
+        seen: set = set()
+        out: list = []
+        for d in self.unit.decls:
+            if isinstance(d, A.FunctionDecl):
+                if d.body is not None:
+                    for n in walk(d.body, decl_types=False):
+                        if n.__class__ is not A.Call:
+                            continue
+                        t = self._target(n)
+                        if t is not None and t is not d and _signature(t) not in seen:
+                            seen.add(_signature(t))
+                            out.append(A.FunctionDecl(t.return_type, t.name, clone(t.params),
+                                                      None, loc=t.loc))
+                seen.add(_signature(d))
+            out.append(d)
+        self.unit.decls = out
 
     def _global_names_read(self, d: A.FunctionDecl) -> set[str]:
         """The global names the body of ``d`` uses: globals (by their semantic symbols) and the
@@ -340,25 +410,100 @@ class _Inliner(NodeVisitor):
             return None
         return self.copy_of.get(id(call.target), call.target if call.target.body else None)
 
-    def _process(self, d: A.FunctionDecl, done: set) -> None:
-        if id(d) in done:
+    def _callees_first(self) -> list:
+        """Every definition after the functions it calls (without recursion: a chain of
+        thousands of functions is fine), each function's effects found on the way; refuses a
+        program whose inlining would copy more syntax nodes than the analysis budget."""
+        order: list = []
+        state: dict[int, int] = {}
+        for root in self.defs:
+            stack = [(root, False)]
+            while stack:
+                d, done = stack.pop()
+                if done:
+                    order.append(d)
+                    state[id(d)] = 2
+                    self.effectful[id(d)] = self._body_effectful(d)
+                    continue
+                if state.get(id(d)):
+                    continue
+                state[id(d)] = 1
+                stack.append((d, True))
+                for n in walk(d.body, decl_types=False):
+                    if n.__class__ is A.Call:
+                        t = self._target(n)
+                        if t is not None and not state.get(id(t)):
+                            stack.append((t, False))
+        self._check_copies(order)
+        return order
+
+    def _check_copies(self, order: list) -> None:
+        """The syntax nodes the call sites will copy (each inlined call copies its callee's body,
+        its own calls inlined; calls shared as :meth:`inline` shares them count once), checked
+        against ``budget.analysis_nodes`` before any is made."""
+        size: dict[int, int] = {}
+        depth: dict[int, tuple] = {}
+        copies = 0
+        for d in order:
+            own, extra, deepest = 0, 0, (0, None)
+            seen: set = set()
+            for stmt in _statements(d.body):
+                shareable = self._shareable(stmt)
+                for part in A.own_parts(stmt):
+                    for n in walk(part, decl_types=False):
+                        own += 1
+                        t = self._target(n) if n.__class__ is A.Call else None
+                        if t is None or not self.inlinable.get(id(t), False):
+                            continue
+                        key = self._share_key(stmt, t, n.args) if shareable else None
+                        if key is not None and key in seen:
+                            continue
+                        seen.add(key)
+                        extra += size[id(t)]
+                        if depth[id(t)][0] + 1 > deepest[0]:
+                            deepest = (depth[id(t)][0] + 1, t)
+            size[id(d)] = own + extra
+            depth[id(d)] = deepest
+            copies += extra
+        if copies <= budget.analysis_nodes:
             return
-        done.add(id(d))
-        for n in walk(d.body, decl_types=False):
-            if isinstance(n, A.Call):
-                t = self._target(n)
-                if t is not None:
-                    self._process(t, done)
-        self.effectful[id(d)] = self._body_effectful(d)
+        d = max(order, key=lambda x: (depth[id(x)][0], x.name == "main"))
+        chain = [d.name]
+        t = depth[id(d)][1]
+        while t is not None:
+            chain.append(t.name)
+            t = depth[id(t)][1]
+        shown = " → ".join(chain[:3] + (["…"] if len(chain) > 4 else []) + chain[3:][-1:])
+        amount = f"{copies:,}" if copies < 10 ** 15 else f"about 10^{len(str(copies)) - 1}"
+        raise GLSLError(
+            f"inlining the function calls would copy {amount} syntax nodes (calls nested "
+            f"{len(chain) - 1:,} deep: {shown}), more than the analysis budget of "
+            f"{budget.analysis_nodes:,}", d.loc,
+            "raise it with 'rrcache --max-ast-nodes N ...' if the machine has the memory, or call "
+            "the deepest functions fewer times")
+
+    def _shareable(self, stmt) -> bool:
+        """Whether identical calls of a function without effects in ``stmt`` may share one
+        inlined body: nothing the statement evaluates has an effect (but its assignment)."""
+        if isinstance(stmt, A.ExprStmt) and isinstance(stmt.expr, A.Assign) and stmt.expr.op == "=":
+            return not self.has_effects(stmt.expr.value)
+        return not any(self.has_effects(p) for p in A.own_parts(stmt))
+
+    def _share_key(self, stmt, fd: A.FunctionDecl, args: list) -> Optional[tuple]:
+        """What two calls must have alike to share one inlined body: the statement, the function
+        (one without effects) and the arguments as printed."""
+        if self.effectful.get(id(fd), True):
+            return None
+        return (id(stmt), id(fd), tuple(print_expr(a) for a in args))
+
+    def _process(self, d: A.FunctionDecl) -> None:
+        """Inline the calls in ``d`` (its callees are done); make its template."""
         d.body = A.Compound(self.block(d.body.stmts), loc=d.body.loc)
         if self.inlinable[id(d)]:
             stmts = d.body.stmts
             last_only = all(not _has_return(s) for s in stmts[:-1]) and (
                 not stmts or isinstance(stmts[-1], A.Return) or not _has_return(stmts[-1]))
-            is_void = d.return_type.spec.name == "void"
-            body = clone(d.body)
-            body.stmts = _convert_returns(body.stmts, is_void, not last_only)
-            self.templates[id(d)] = _Template(d, body, not last_only, self.call_sites.get(id(d), 0))
+            self.templates[id(d)] = _Template(d, not last_only, self.call_sites.get(id(d), 0))
 
     def _body_effectful(self, d: A.FunctionDecl) -> bool:
         """Whether calling ``d`` has an effect beyond its result: it has an ``out``/``inout``
@@ -449,7 +594,12 @@ class _Inliner(NodeVisitor):
         return out
 
     def stmt(self, s) -> list:
-        return self.visit(s)
+        saved = self.sharing
+        self.sharing = s if self._shareable(s) else None
+        try:
+            return self.visit(s)
+        finally:
+            self.sharing = saved
 
     def generic_visit(self, s, *args):
         return [s]
@@ -551,8 +701,9 @@ class _Inliner(NodeVisitor):
 
     # ------------------------------------------------------------------ expressions
     def hoist(self, e: A.Expr, pre: list) -> A.Expr:
-        """Evaluate ``e`` now, into a fresh temporary."""
-        if is_literal(e) or e.type is None or getattr(e, "_rr_temp", False):
+        """Evaluate ``e`` now, into a fresh temporary (a sampler or an image stays as it is: GLSL
+        has no local variables of those types)."""
+        if is_literal(e) or e.type is None or getattr(e, "_rr_temp", False) or holds_opaque(e.type):
             return e
         name = self.names.fresh("t")
         pre.append(declare_typed(name, e.type, e, e.loc))
@@ -687,10 +838,19 @@ class _Inliner(NodeVisitor):
         tpl = self.templates[id(fd)]
         site = f"{fd.name} ({call.loc.line}:{call.loc.col})" if call.loc else fd.name
         is_void = fd.return_type.spec.name == "void"
+        key = None
+        if self.sharing is not None and not is_void:
+            key = self._share_key(self.sharing, fd, args)
+            got = self.shared.get((id(pre), key)) if key is not None else None
+            if got is not None and got[0] is pre:   # f(x) again, with nothing changed: its value
+                tpl.release()
+                return A.Ident(got[1], loc=call.loc, type=call.type)
         mapping: dict = {}
         ret = None
         if not is_void:
             ret = self.names.fresh(fd.name)
+            if key is not None:
+                self.shared[(id(pre), key)] = (pre, ret)
             rtype = A.FullType([q for q in fd.return_type.qualifiers
                                 if q in ("lowp", "mediump", "highp")], fd.return_type.spec,
                                loc=fd.return_type.loc)
@@ -699,6 +859,17 @@ class _Inliner(NodeVisitor):
         block: list = []
         writebacks: list = []
         for p, arg, q in zip(fd.params, args, quals):
+            if holds_opaque(arg.type):
+                # a sampler, image or atomic counter (or a struct holding one) cannot be copied
+                # into a local: the argument itself stands for the parameter in the body (an
+                # index into an array of samplers stays as written: GLSL 3.30 wants a constant)
+                if self.has_effects(arg):
+                    raise UnsupportedShaderError(
+                        f"the {arg.type} argument of '{fd.name}' has a side effect", arg.loc,
+                        "compute the index before the call")
+                if p.name:
+                    mapping[p.name] = _substitute(arg)
+                continue
             name = self.names.fresh(p.name or "arg")
             if p.name:
                 mapping[p.name] = name
@@ -723,6 +894,28 @@ class _Inliner(NodeVisitor):
         if ret is None:
             return None
         return A.Ident(ret, loc=call.loc, type=call.type)
+
+
+def _signature(d: A.FunctionDecl) -> tuple:
+    """A function's name and parameter types as written (what tells overloads apart)."""
+    return (d.name,) + tuple((p.type.spec.name, p.type.spec.struct is not None,
+                              len(p.array_dims or ()) + len(p.type.spec.array_dims or ()))
+                             for p in d.params)
+
+
+def holds_opaque(t) -> bool:
+    """Whether a value of type ``t`` is or holds an opaque type (a sampler, an image, an atomic
+    counter), which GLSL allows only as uniforms and parameters."""
+    if t is None:
+        return False
+    if t.is_opaque:
+        return True
+    return t.base == "struct" and any(holds_opaque(ft) for _, ft in (t.fields or ()))
+
+
+def _substitute(arg: A.Expr):
+    """A replacement for every use of a parameter: a copy of the argument."""
+    return lambda ident: clone(arg)
 
 
 def _lvalue_positions(call: A.Call) -> set:

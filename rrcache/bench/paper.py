@@ -46,6 +46,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from rrcache import atomic
 from rrcache.bench.scenes import Scene, scaled_session
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json as _finite
@@ -569,6 +570,4 @@ def run(scenes: list, settings: BenchSettings = FULL, out="rrcache-bench", progr
 
 
 def _write(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    atomic.write_text(path, text)

@@ -7,6 +7,7 @@ costs llvmpipe, and the tiled against the untiled z-buffer.
     python -m rrcache.bench.render_cache zbuffer --scene marble --out OUT
     python -m rrcache.bench.render_cache sweep --scene marble --config block=1 --config block=2 --out OUT
     python -m rrcache.bench.render_cache projection --scene marble --out OUT
+    python -m rrcache.bench.render_cache filters --scene marble --out OUT
 
 ``equal-time``: per scene, the reprojection cache's choice (``--choice NAME=NODE:PERIOD[+NODE:PERIOD]
 [@ALGORITHM]``: a bench profile's medium selection, e.g. from ``rrcache bench``'s table) measured
@@ -30,6 +31,13 @@ untiled and bucket-sorted into tiles first (the paper's §3.2), side by side, re
 with image atomics (two passes: nearest depth, then the owner), side by side, repeated; every
 variant checked to find the same nearest depth per pixel.
 
+``filters``: where the depth cull, the 3×3 interpolation with the priority image and the 7×7
+prefilter run fastest here: numpy (what the render cache uses) against the same filters as GL
+fragment passes (the projected points uploaded, the cull, the interpolation writing the image and
+the priority, the prefilter as two separable 7-tap passes composed where the 3×3 filter found
+nothing, the priority read back for the dither), on the projected points of a real frame, side by
+side, repeated; the GL image is checked against numpy's.
+
 ``sweep``: the render cache's own settings compared: each ``--config`` (settings given as
 ``key=value,...``) at each ``--shares`` share, beside the original over the first ``--frames``
 frames: error and speed-up per point (``sweep.json``, ``sweep.png``: error against frame time),
@@ -52,6 +60,8 @@ import numpy as np
 
 from rrcache.bench.scenes import resolve_scenes, scaled_session
 from rrcache.errors import RRCacheError
+from rrcache.gl.program import fullscreen_vertex
+from rrcache.report.agg import save_figure
 
 #: how ``rrcache bench`` sizes each scene (its FULL settings): chess smaller and shorter
 SCENE_SIZES = {"chess": ((320, 240), 60)}
@@ -113,6 +123,20 @@ def _sizes(scene, out) -> str:
     session = load_session(scene.session)
     return str(scaled_session(scene.session, Path(out) / "sessions" / f"{scene.name}.json", size,
                               min(frames, session.frames)))
+
+
+def _side_by_side(variants: list, repeats: int) -> dict:
+    """Median ms of each ``(name, function)`` in ``variants``, run in turn ``repeats`` times (after
+    one untimed call each)."""
+    for _, fn in variants:
+        fn()
+    times = {name: [] for name, _ in variants}
+    for _ in range(repeats):
+        for name, fn in variants:
+            start = time.perf_counter()
+            fn()
+            times[name].append((time.perf_counter() - start) * 1000.0)
+    return {name: statistics.median(t) for name, t in times.items()}
 
 
 def _load() -> str:
@@ -205,33 +229,46 @@ def _markdown(results: list) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: the error maps' gain: |image − original| × this, per channel
+ERROR_GAIN = 4.0
+
+
 def contact_sheet(results: list, images: dict, path) -> str:
-    """One row per scene: the original, the reprojection cache, the render cache and dynamic
-    resolution at the scene's sheet frame, each titled with its error and PSNR."""
+    """Two rows per scene: the original, the reprojection cache, the render cache and dynamic
+    resolution at the scene's sheet frame, each titled with its error and PSNR; under each
+    method its error map (``|image − original| ×`` :data:`ERROR_GAIN`)."""
     from rrcache.report.agg import agg_pyplot
 
     plt = agg_pyplot()
     methods = ["original", "reprojection cache", "render cache", "dynamic resolution"]
-    fig, axes = plt.subplots(len(results), len(methods), figsize=(3.2 * len(methods), 2.6 * len(results)),
+    fig, axes = plt.subplots(2 * len(results), len(methods), figsize=(3.2 * len(methods), 5.0 * len(results)),
                              dpi=100, squeeze=False)
     try:
         for i, r in enumerate(results):
+            shots = images.get(r.name, {})
+            original = shots.get("original")
             for j, method in enumerate(methods):
-                ax = axes[i][j]
-                image = images.get(r.name, {}).get(method)
-                ax.set_xticks([])
-                ax.set_yticks([])
+                top, bottom = axes[2 * i][j], axes[2 * i + 1][j]
+                for ax in (top, bottom):
+                    ax.set_xticks([])
+                    ax.set_yticks([])
+                image = shots.get(method)
                 if image is None:
-                    ax.set_title(f"{method}: not measured", fontsize=8)
+                    top.set_title(f"{method}: not measured", fontsize=8)
+                    bottom.axis("off")
                     continue
-                ax.imshow(np.clip(np.nan_to_num(image[..., :3]), 0, 1) ** (1 / 1.0), interpolation="nearest")
+                top.imshow(np.clip(np.nan_to_num(image[..., :3]), 0, 1), interpolation="nearest")
                 if method == "original":
-                    ax.set_title(f"{r.name}, frame {r.sheet_frame}: original", fontsize=8)
-                else:
-                    err, db = r.sheet[method]
-                    ax.set_title(f"{method}: error {err:.4f}, {min(db, 100):.1f} dB", fontsize=8)
+                    top.set_title(f"{r.name}, frame {r.sheet_frame}: original", fontsize=8)
+                    bottom.axis("off")
+                    continue
+                err, db = r.sheet[method]
+                top.set_title(f"{method}: error {err:.4f}, {min(db, 100):.1f} dB", fontsize=8)
+                diff = np.abs(np.nan_to_num(image[..., :3]) - np.nan_to_num(original[..., :3])) * ERROR_GAIN
+                bottom.imshow(np.clip(diff, 0, 1), interpolation="nearest")
+                bottom.set_title(f"|{method} − original| × {ERROR_GAIN:g}", fontsize=7)
         fig.tight_layout()
-        fig.savefig(path)
+        save_figure(fig, path)
     finally:
         plt.close(fig)
     return str(path)
@@ -308,19 +345,16 @@ def zbuffer_cost(scene, out, tiles=(16, 32, 64), repeats: int = 9, frames: int =
             pix, depth, slots = rc.projector.project(rc.cache, screen, rc.size, moving)
             project_ms.append((time.perf_counter() - start) * 1000.0)
         w, h = rc.size
-        variants = [("untiled", dict())] + [(f"tiled {t}×{t}", dict(tiled=True, width=w, tile=t)) for t in tiles]
-        times = {name: [] for name, _ in variants}
         reference = zbuffer(pix, depth, slots, w * h)
-        for _ in range(repeats):
-            for name, kwargs in variants:
-                start = time.perf_counter()
-                got = zbuffer(pix, depth, slots, w * h, **kwargs)
-                times[name].append((time.perf_counter() - start) * 1000.0)
-                if not (np.array_equal(got[0], reference[0]) and np.array_equal(got[1], reference[1])):
-                    raise AssertionError(f"{name} z-buffer differs from the untiled one")
+        variants = [("untiled", {})] + [(f"tiled {t}×{t}", dict(tiled=True, width=w, tile=t)) for t in tiles]
+        for name, kwargs in variants:
+            got = zbuffer(pix, depth, slots, w * h, **kwargs)
+            if not (np.array_equal(got[0], reference[0]) and np.array_equal(got[1], reference[1])):
+                raise AssertionError(f"the {name} z-buffer differs from the untiled one")
+        ms = _side_by_side([(name, lambda kw=kwargs: zbuffer(pix, depth, slots, w * h, **kw))
+                            for name, kwargs in variants], repeats)
     return {"scene": scene.name, "resolution": [w, h], "points": int(len(pix)), "capacity": rc.cache.capacity,
-            "load": _load(), "project_ms": statistics.median(project_ms),
-            "zbuffer_ms": {name: statistics.median(t) for name, t in times.items()}}
+            "load": _load(), "project_ms": statistics.median(project_ms), "zbuffer_ms": ms}
 
 
 _POINTS_VERTEX = """#version 330 core
@@ -440,16 +474,157 @@ def projection_cost(scene, out, repeats: int = 9, frames: int = 8, samples: floa
             found = np.where(got.view(np.uint32) == 0xFFFFFFFF, np.inf, got)
             if not np.allclose(found, expected, rtol=1e-5, equal_nan=True):
                 raise AssertionError("the compute shader's z-buffer differs from numpy's")
-        for _, fn in variants:
-            fn()
-        times = {name: [] for name, _ in variants}
-        for _ in range(repeats):
-            for name, fn in variants:
-                start = time.perf_counter()
-                fn()
-                times[name].append((time.perf_counter() - start) * 1000.0)
-    return {"scene": scene.name, "resolution": [w, h], "points": int(len(points)), "load": _load(),
-            "ms": {name: statistics.median(t) for name, t in times.items()}}
+        ms = _side_by_side(variants, repeats)
+    return {"scene": scene.name, "resolution": [w, h], "points": int(len(points)), "load": _load(), "ms": ms}
+
+
+# the projected points: rgb = colour (0 where none), a = depth (0 where none; negative: shaded this
+# frame, exempt from the cull)
+_CULL = """#version 330 core
+uniform sampler2D rr_points;
+uniform float rr_tolerance;
+out vec4 rr_kept;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 c = texelFetch(rr_points, p, 0);
+    float total = 0.0, count = 0.0;
+    for (int j = -1; j <= 1; j++)
+        for (int i = -1; i <= 1; i++) {
+            float d = abs(texelFetch(rr_points, p + ivec2(i, j), 0).a);
+            if (d > 0.0) { total += d; count += 1.0; }
+        }
+    bool keep = c.a < 0.0 || (c.a > 0.0 && c.a * count <= (1.0 + rr_tolerance) * total);
+    rr_kept = keep ? vec4(c.rgb, 1.0) : vec4(0.0);
+}
+"""
+_INTERPOLATE = """#version 330 core
+uniform sampler2D rr_kept;
+uniform sampler2D rr_ages;
+layout(location = 0) out vec4 rr_image;
+layout(location = 1) out float rr_priority;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 own = texelFetch(rr_kept, p, 0);
+    vec4 sum = vec4(0.0);
+    for (int j = -1; j <= 1; j++)
+        for (int i = -1; i <= 1; i++)
+            sum += float((2 - abs(i)) * (2 - abs(j))) * texelFetch(rr_kept, p + ivec2(i, j), 0);
+    rr_image = own.a > 0.0 ? vec4(own.rgb, 1.0) : (sum.a > 0.0 ? vec4(sum.rgb / sum.a, 1.0) : vec4(0.0));
+    rr_priority = own.a > 0.0 ? texelFetch(rr_ages, p, 0).r / 255.0 : 1.0;
+}
+"""
+_BOX_ROWS = """#version 330 core
+uniform sampler2D rr_kept;
+out vec4 rr_sum;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 s = vec4(0.0);
+    for (int i = -3; i <= 3; i++) s += texelFetch(rr_kept, p + ivec2(i, 0), 0);
+    rr_sum = s;
+}
+"""
+_BOX_COLUMNS = """#version 330 core
+uniform sampler2D rr_rows;
+uniform sampler2D rr_image;
+uniform sampler2D rr_previous;
+out vec4 rr_final;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 image = texelFetch(rr_image, p, 0);
+    if (image.a > 0.0) { rr_final = image; return; }
+    vec4 s = vec4(0.0);
+    for (int j = -3; j <= 3; j++) s += texelFetch(rr_rows, p + ivec2(0, j), 0);
+    rr_final = s.a > 0.0 ? vec4(s.rgb / s.a, 1.0) : texelFetch(rr_previous, p, 0);
+}
+"""
+
+
+def filters_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float = 0.03) -> dict:
+    """numpy against GL fragment passes for the depth cull, interpolation and prefilter (see the
+    module docstring)."""
+    import moderngl
+
+    from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
+    from rrcache.alternatives.render_cache.filters import depth_cull, reconstruct
+    from rrcache.alternatives.render_cache.projection import zbuffer
+    from rrcache.gl.resources import GLScope
+    from rrcache.compiler.prepared import prepare_file
+    from rrcache.session import load_session
+
+    session = load_session(_sizes(scene, out))
+    prepared = prepare_file(scene.shader, session)
+    settings = RenderCacheSettings(samples=samples)
+    with RenderCacheRenderer(prepared, session, settings=settings) as rc, GLScope() as scope:
+        for i in range(frames):
+            rc.render_frame(i)
+        ctx, cache, (w, h) = rc.ctx, rc.cache, rc.size
+        screen, moving = rc._matrices(frames - 1)
+        pix, depth, slots = rc.projector.project(cache, screen, rc.size, moving)
+        owner, nearest = zbuffer(pix, depth, slots, w * h)
+        has = owner >= 0
+        safe = np.where(has, owner, 0)
+        colors = np.where(has, cache.color[:, safe], 0).astype(np.float32).reshape(3, h, w)
+        ages_all = np.where(has, cache.age[safe], 0).astype(np.float32)
+        exempt = (has & (cache.frame[safe] == frames - 1)).reshape(h, w)
+        previous = rc._previous.copy()
+        depth_image = np.where(has, nearest, 0).astype(np.float32).reshape(h, w)
+
+        def numpy_way():
+            keep = depth_cull(depth_image, has.reshape(h, w), settings.cull, exempt)
+            kept_colors = colors * keep
+            ages = np.where(keep, ages_all.reshape(h, w), 0).astype(np.float32)
+            return reconstruct(kept_colors, keep, ages, previous)
+
+        def target(components=4):
+            t = scope.own(ctx.texture((w, h), components, dtype="f4"))
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            t.repeat_x = t.repeat_y = False
+            t.border_color = (0.0, 0.0, 0.0, 0.0)
+            return t
+
+        def program(fragment):
+            return scope.own(ctx.program(vertex_shader=fullscreen_vertex(0.0), fragment_shader=fragment))
+
+        points_tex, kept_tex, image_tex, rows_tex, final_tex, previous_tex = (target() for _ in range(6))
+        ages_tex, priority_tex = target(1), target(1)
+        cull, interpolate, box_rows, box_columns = (program(f) for f in (_CULL, _INTERPOLATE, _BOX_ROWS, _BOX_COLUMNS))
+        cull["rr_tolerance"].value = settings.cull
+        interpolate["rr_kept"].value, interpolate["rr_ages"].value = 0, 1
+        box_columns["rr_rows"].value, box_columns["rr_image"].value, box_columns["rr_previous"].value = 0, 1, 2
+        fbos = [scope.own(ctx.framebuffer(t)) for t in ([kept_tex], [image_tex, priority_tex], [rows_tex], [final_tex])]
+        vaos = [scope.own(ctx.vertex_array(p, [])) for p in (cull, interpolate, box_rows, box_columns)]
+        packed = np.empty((h, w, 4), np.float32)
+        packed[..., :3] = np.moveaxis(colors, 0, -1)
+        packed[..., 3] = np.where(exempt, -depth_image, depth_image)
+        previous_rgba = np.ones((h, w, 4), np.float32)
+        previous_rgba[..., :3] = np.moveaxis(previous, 0, -1)
+        previous_tex.write(previous_rgba)
+
+        def gl_way():
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+            points_tex.write(packed)
+            ages_tex.write(ages_all)
+            steps = [(0, [points_tex]), (1, [kept_tex, ages_tex]), (2, [kept_tex]), (3, [rows_tex, image_tex, previous_tex])]
+            for (k, inputs), fbo in zip(steps, fbos):
+                fbo.use()
+                fbo.viewport = (0, 0, w, h)
+                for unit, tex in enumerate(inputs):
+                    tex.use(location=unit)
+                vaos[k].render(moderngl.TRIANGLES, vertices=3)
+            priority = np.frombuffer(priority_tex.read(), np.float32)
+            ctx.finish()
+            return priority
+
+        image_np, priority_np, _ = numpy_way()
+        priority_gl = gl_way()
+        image_gl = np.frombuffer(final_tex.read(), np.float32).reshape(h, w, 4)[..., :3]
+        if not (np.allclose(np.moveaxis(image_np, 0, -1), image_gl, atol=1e-4)
+                and np.allclose(priority_np.reshape(-1), priority_gl, atol=1e-6)):
+            raise AssertionError("the GL filters' image differs from numpy's")
+        variants = [("numpy (cull, interpolate, prefilter)", numpy_way),
+                    ("GL passes (upload, cull, interpolate, prefilter, read the priority)", gl_way)]
+        ms = _side_by_side(variants, repeats)
+    return {"scene": scene.name, "resolution": [w, h], "load": _load(), "ms": ms}
 
 
 def screen_matrix4(screen: np.ndarray) -> np.ndarray:
@@ -525,7 +700,7 @@ def _sweep_plot(doc: dict, path) -> None:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(path)
+        save_figure(fig, path)
     finally:
         plt.close(fig)
 
@@ -539,7 +714,7 @@ def main(argv=None) -> int:
     eq.add_argument("--search-frames", type=int, default=24)
     eq.add_argument("--sheet-frame", type=int, default=None)
     eq.add_argument("--out", required=True)
-    for name in ("mask", "zbuffer", "sweep", "projection"):
+    for name in ("mask", "zbuffer", "sweep", "projection", "filters"):
         p = sub.add_parser(name)
         p.add_argument("--scene", default="marble")
         p.add_argument("--out", required=True)
@@ -571,7 +746,8 @@ def main(argv=None) -> int:
                     [float(x) for x in args.shares.split(",")], args.frames)
         _sweep_plot(doc, out / "sweep.png")
     else:
-        doc = {"mask": mask_cost, "zbuffer": zbuffer_cost, "projection": projection_cost}[args.what](scene, out)
+        doc = {"mask": mask_cost, "zbuffer": zbuffer_cost, "projection": projection_cost,
+               "filters": filters_cost}[args.what](scene, out)
 
     write_text(out / f"{args.what}.json", json.dumps(doc, indent=2) + "\n")
     print(json.dumps(doc, indent=2))

@@ -23,9 +23,8 @@ from pathlib import Path
 import click
 from rich.console import Console
 
-from rrcache.cli.progress import Reporter
+from rrcache.cli.repeats import run_repeats
 from rrcache.cli.tables import TextTable
-from rrcache.harness.images import write_image
 from rrcache.harness.renderer import frame_indices
 from rrcache.harness.timing import load_warning
 from rrcache.jsonable import finite_json
@@ -82,22 +81,9 @@ def render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_j
     if not quiet:
         err_console.print(f"{prepared.path}: {said}; colour target {color_format}, {len(indices)} frames",
                           highlight=False, markup=False, soft_wrap=True)
-    runs = []
-    with Reporter(err_console, quiet=quiet or len(indices) * repeats < 2) as reporter:
-        for repeat in range(repeats):
-            count = {"n": 0}
-
-            def done(row, got, ref, repeat=repeat):
-                if out is not None and repeat == 0:
-                    stem = out / f"frame_{row.index:04d}"
-                    write_image(stem.with_suffix(".exr"), got.image)
-                    write_image(stem.with_suffix(".png"), got.image)
-                    write_image(out / f"original_{row.index:04d}.png", ref.image)
-                count["n"] += 1
-                reporter.update(f"[{repeat + 1}/{repeats}] render cache beside the original", count["n"], len(indices))
-
-            runs.append(compare(prepared, loaded, indices, settings, resolution, on_frame=done,
-                                color_format=color_format))
+    runs = run_repeats(lambda done: compare(prepared, loaded, indices, settings, resolution, on_frame=done,
+                                            color_format=color_format),
+                       len(indices), repeats, out, "render cache", err_console, quiet)
     speedups = sorted(r.speedup for r in runs)
     result = sorted(runs, key=lambda r: r.speedup)[len(runs) // 2]
     for note in result.notes:

@@ -21,18 +21,19 @@ import warnings
 
 import click
 from rich.console import Console
-from rich.table import Table
 
 from rrcache.cli.options import (cluster_options, include_dirs_option, parse_defines, resolution_option as _resolution,
                                  vert_option)
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.cli.tables import TextTable
 from rrcache.cluster import maybe_cluster
 from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK, UNRELIABLE_NOISE
-from rrcache.model.psnr import VISIBLE_DB, psnr_text
+from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
 from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.notices import ceiling_noise, run_warnings
 from rrcache.profiles.store import STORE_NAME
 from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_KINDS, TrainingSettings, parse_periods
 
@@ -164,8 +165,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         _interrupted(out, err_console)
         sys.exit(130)
     console = Console()
-    if not console.is_terminal:
-        console = Console(width=120)
+    if not console.is_terminal:  # a pipe, a file: whole lines, never wrapped or cut
+        console = Console(soft_wrap=True)
     _summary(prof, console)
 
 
@@ -192,18 +193,12 @@ def _verdict(prof, console: Console) -> None:
     console.print(f"answer: {v['answer']}", highlight=False)
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-    _ceiling_noise(ceiling, console)
+    for line in ceiling_noise(ceiling):
+        console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
     console.print(f"why: {v['reason']}", highlight=False)
     console.print("what would change it:", highlight=False)
     for change in v["changes"]:
         console.print(f"  - {change}", highlight=False)
-
-
-def _ceiling_noise(ceiling, console: Console) -> None:
-    if ceiling is not None and ceiling.noise > UNRELIABLE_NOISE:
-        console.print(f"warning: the original's repeated frames varied by ±{ceiling.noise:.0%} while the ceiling was "
-                      "measured: other work on the machine made it unreliable; profile again on a quieter machine "
-                      "(the profile folder keeps it: use --fresh)", highlight=False)
 
 
 def _summary(prof, console: Console) -> None:
@@ -225,7 +220,7 @@ def _summary(prof, console: Console) -> None:
                   f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
                   "runs were stored and skipped", highlight=False)
     console.print(f"μ = {_fmt(prof.mu)} ({prof.mu_quality}); overhead {_fmt(prof.overhead_ms, '.3f')} ms; "
-                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
+                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {prof.pixels:,.0f} covered pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
     for line in _estimator_lines(prof):
@@ -233,36 +228,18 @@ def _summary(prof, console: Console) -> None:
     ceiling = prof.measured_ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-        _ceiling_noise(ceiling, console)
-    noise = prof.timing_noise
-    if noise is not None and not prof.timing_reliable:
-        console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "
-                      "other work on the machine made the timings unreliable; profile again on a quieter machine",
-                      highlight=False)
-    console.print(_table(prof))
-    for s in prof.selections:
-        if s.fallback:
-            console.print(f"{s.label}: {s.fallback}", highlight=False)
-        if s.level_met is False:
-            console.print(f"{s.label}: MISSED its level: {s.level_note}", highlight=False)
+    _table(prof).print(console)
     for line in calibration_lines(prof):
-        console.print(line, highlight=False)
-    if any(s.visible_artifacts for s in prof.selections):
-        marked = ", ".join(s.label for s in prof.selections if s.visible_artifacts)
-        console.print(f"{marked}: {_visible_words(prof)}: visible artifacts (a choice, not a default)",
-                      highlight=False)
-    noisy = [s.label for s in prof.selections if s.measured_noise is not None and s.measured_noise > UNRELIABLE_NOISE]
-    if noisy:
-        console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
-                      f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
-
-
-def _visible_words(prof) -> str:
-    from rrcache.model.levels import VISIBLE_FLIP
-
-    if any(s.visible_artifacts and s.measured_flip is not None for s in prof.selections):
-        return f"mean FLIP ≥ {VISIBLE_FLIP:g} as measured (below {VISIBLE_DB:.0f} dB PSNR where only predicted)"
-    return f"below {VISIBLE_DB:.0f} dB PSNR (predicted)"
+        console.print(line, highlight=False, markup=False, soft_wrap=True)
+    # what the measurements imply (the run's own warnings were printed as they came)
+    for line in run_warnings(prof, stored=False):
+        console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
+    level = next((s.label for s in prof.selections if s.parts), None)
+    if level is not None:
+        console.print(f"next: {prof.path / 'report.html'} says what each level's files are and how to run them; "
+                      f"'rrcache instance {prof.path} --level {level} --out DIR' writes a level's shaders again "
+                      "(--target webgl2: a page that runs them in a browser)", highlight=False, markup=False,
+                      soft_wrap=True)
 
 
 def calibration_lines(prof) -> list[str]:
@@ -382,14 +359,11 @@ def level_status(s) -> str:
     return f"met, try {s.tries}" if s.tries > 1 else "met"
 
 
-def _table(prof) -> Table:
-    table = Table(title="selections (pred. = predicted by the models, meas. = measured by validation)")
-    for name in ("level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
-                 "FLIP meas.", "level met"):
-        if name == "node":
-            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=36)
-        else:
-            table.add_column(name, justify="right")
+def _table(prof) -> TextTable:
+    table = TextTable("selections (pred. = predicted by the models, meas. = measured by validation)",
+                      [(name, "left" if name in ("level", "node") else "right") for name in (
+                          "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
+                          "FLIP meas.", "level met")])
     for s in prof.selections:
         node, period = s.choice.cells(s, prof) if s.parts else ("(original)", "–")
         if s.fallback:

@@ -62,11 +62,12 @@ from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import frame_indices, render
-from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD,
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 from rrcache.cli.method import check_method, method_option, render_cache, samples_option
+from rrcache.cli.repeats import run_repeats
 
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm", "block": "--block",
@@ -99,7 +100,7 @@ _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm
               help=f"Refresh block size k in pixels (default: the profile's, else {DEFAULT_BLOCK}).")
 @click.option("--refresh", type=click.Choice(REFRESH_MODES), default=None,
               help=f"Refresh pattern (default: the profile's, else {DEFAULT_REFRESH}).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True,
               help="Payload reconstruction filter.")
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
               help="Cache precision: 32- or 16-bit float.")
@@ -147,7 +148,7 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                      err_console, quiet)
         return
     if level is not None:
-        from rrcache.profiles import choice
+        from rrcache import choice
 
         sel = choice.level(prof, level)
         if not sel.parts:
@@ -278,22 +279,10 @@ def _compare(work, loaded, variant, what: str, setup: dict, out_dir, frame_count
         err_console.print(f"{what}\n  with {setup['said']}; colour target {color_format}, {len(indices)} frames",
                           highlight=False, markup=False, soft_wrap=True)
     label = setup.get("level") or " + ".join(nodes or [])
-    runs = []
-    with Reporter(err_console, quiet=quiet or len(indices) * repeats < 2) as reporter:
-        for repeat in range(repeats):
-            count = {"n": 0}
-
-            def done(row, got, ref, repeat=repeat):
-                if out is not None and repeat == 0:
-                    stem = out / f"frame_{row.index:04d}"
-                    write_image(stem.with_suffix(".exr"), got.image)
-                    write_image(stem.with_suffix(".png"), got.image)
-                    write_image(out / f"original_{row.index:04d}.png", ref.image)
-                count["n"] += 1
-                reporter.update(f"[{repeat + 1}/{repeats}] {label} beside the original", count["n"], len(indices))
-
-            runs.append(compare(variant, loaded, work.prepared, indices, period=setup["period"], resolution=resolution,
-                                on_frame=done, color_format=color_format, **setup["options"]))
+    runs = run_repeats(lambda done: compare(variant, loaded, work.prepared, indices, period=setup["period"],
+                                            resolution=resolution, on_frame=done, color_format=color_format,
+                                            **setup["options"]),
+                       len(indices), repeats, out, label, err_console, quiet)
     # the median repeat by speed-up stands for the run; the range is every repeat's
     speedups = sorted(r.speedup for r in runs)
     result = sorted(runs, key=lambda r: r.speedup)[len(runs) // 2]

@@ -43,7 +43,7 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
     prof = load_profile(profile_path)
     prof.include_dirs = list(include_dirs) + prof.include_dirs
     choice = prof.select(max_error) if max_error is not None else prof.select_psnr(min_psnr)
-    written = prof.write_variant(choice, out_dir) if out_dir else []
+    written = choice_write(prof, choice, out_dir) if out_dir else []
     level = f"error {max_error:g}" if max_error is not None else f"PSNR ≥ {min_psnr:g} dB"
     if as_json:
         figures = {"predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
@@ -72,3 +72,4 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
 
 
 from rrcache.kinds.amortize import history_words as _history  # noqa: E402,F401 (the words, the kind's)
+from rrcache.choice import write as choice_write

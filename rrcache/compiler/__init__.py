@@ -34,33 +34,21 @@ from typing import Any, Union
 from rrcache.errors import UnsupportedShaderError
 from rrcache.deep import deep
 from rrcache.glsl import ast as A
+from rrcache.compiler.checks import check_algorithm
 from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.locate import prepare
 from rrcache.compiler.passes import build_pass
 from rrcache.compiler.variant import PassSource, Variant
-from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.cache import ALGORITHMS, DEFAULT_FILTER, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS, depth_channel_for
 from rrcache.runtime.spec import VariantSpec
 
 __all__ = ["instance", "instance_nodes", "check_algorithm", "Variant", "PassSource"]
 
 
-def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: str) -> None:
-    """Raise :class:`UnsupportedShaderError` when ``analysed`` is a node table whose entry for
-    ``node_id`` is not valid for ``algorithm`` (a node that needs screen-space derivatives
-    cannot be cached by one-pass), naming the reason and the algorithms that can."""
-    for n in getattr(analysed, "nodes", None) or ():
-        if (n.id == node_id or n.node is node_id) and algorithm in getattr(n, "invalid", {}):
-            valid = getattr(n, "algorithms", [])
-            raise UnsupportedShaderError(
-                f"node {n.id} '{n.text}' cannot be cached with {algorithm}: "
-                f"{n.invalid[algorithm]}", n.node.loc,
-                f"use --algorithm {' or '.join(valid)}" if valid else "pick another node")
-
-
 @deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None, pack_depth: bool = False,
+             filter: str = DEFAULT_FILTER, payload_dtype: str = "f4", vertex=None, pack_depth: bool = False,
              adaptive: bool = False) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 
@@ -115,4 +103,4 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
                          algorithm, filter, payload_dtype, pack_depth))
 
 
-from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)
+from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes)

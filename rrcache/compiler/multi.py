@@ -11,12 +11,13 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from rrcache.deep import deep
+from rrcache.compiler.checks import check_algorithm
 from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.multi_locate import prepare_nodes
 from rrcache.compiler.multi_passes import build_multi_pass, has_discard, node_order
 from rrcache.compiler.multi_variant import MultiVariant
 from rrcache.compiler.variant import PassSource
-from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.cache import ALGORITHMS, DEFAULT_FILTER, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS
 from rrcache.runtime.spec import VariantSpec
 
@@ -30,15 +31,13 @@ def _table_entry(analysed: Any, node_id: Any):
 
 @deep
 def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "three-pass",
-                   filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> MultiVariant:
+                   filter: str = DEFAULT_FILTER, payload_dtype: str = "f4", vertex=None) -> MultiVariant:
     """Compile the variant of ``analysed`` that caches every node of ``node_ids`` (at least two;
     ids of the node table, or expression nodes), each with its own payload and, at run time, its
     own period (:class:`rrcache.runtime.CacheRuntime` with ``period=(Δn_0, Δn_1, …)`` in this
     order). Raises :class:`~rrcache.errors.UnsupportedShaderError` for a node that cannot be
     cached, or not with ``algorithm`` (:func:`rrcache.compiler.check_algorithm`), or a nest that
     cannot be compiled."""
-    from rrcache.compiler import check_algorithm
-
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
     if filter not in FILTERS:

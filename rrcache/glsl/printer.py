@@ -203,27 +203,36 @@ def _expr(e: A.Expr, pe=None) -> str:
     return _EXPR_TEXT.visit(e, pe or print_expr, pe is None)
 
 
-def memo_printer():
+def memo_printer(ident_text=None):
     """A :func:`print_expr` that remembers the text of every expression it prints (by ``id``),
     so that printing every node of a tree, each with its operands, costs each node's own text
     once. Only for a tree that stays alive and unchanged while the printer is used; recursive,
     so for expressions of bounded depth (the node table's texts of at most a few hundred nodes).
+    ``ident_text(ident, need)``, when given, may print an identifier otherwise (a text, or None
+    to print its name).
 
     >>> pe = memo_printer()
     >>> e = A.Binary("*", A.Binary("+", A.Ident("a"), A.Ident("b")), A.Ident("c"))
     >>> pe(e), pe(e.left), pe(e.left, P_POSTFIX)
     ('(a + b) * c', 'a + b', '(a + b)')
+    >>> memo_printer(lambda i, need: "x" if i.name == "b" else None)(e)
+    '(a + x) * c'
     """
     cache: dict[int, str] = {}
     get = cache.get
+    precedence = _PRECEDENCE.visit
+    ident = A.Ident
 
     def pe(e: A.Expr, need: int = P_SEQUENCE) -> str:
+        if ident_text is not None and e.__class__ is ident:
+            text = ident_text(e, need)
+            if text is not None:
+                return text
         text = get(id(e))
         if text is None:
             text = cache[id(e)] = _expr(e, pe)
         return f"({text})" if precedence(e) < need else text
 
-    precedence = _PRECEDENCE.visit
     return pe
 
 

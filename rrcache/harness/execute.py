@@ -17,6 +17,7 @@ records.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Callable, Iterable, Iterator, Optional
@@ -102,7 +103,14 @@ class Bench:
 
 def execute(spec: RunSpec, bench: Bench, on_frame: Optional[FrameCallback] = None) -> RunResult:
     """Run ``spec`` on ``bench`` and return what it measured (see :mod:`rrcache.runs` for what each
-    measure renders). ``on_frame(spec, units)`` after each step, for progress."""
+    measure renders), with when it ran (``started``/``finished``; ``host`` is an executor's to
+    set). ``on_frame(spec, units)`` after each step, for progress."""
+    started = time.time()
+    result = _execute(spec, bench, on_frame)
+    return dataclasses.replace(result, started=started, finished=time.time())
+
+
+def _execute(spec: RunSpec, bench: Bench, on_frame: Optional[FrameCallback]) -> RunResult:
     step = (lambda n=1: on_frame(spec, n)) if on_frame is not None else (lambda n=1: None)
     start = time.perf_counter()
     if spec.measure == "reference":

@@ -152,7 +152,7 @@ def spec_for(choice, algorithm: Optional[str] = None, **runtime) -> VariantSpec:
     kind = kind_of(choice)
     if kind is None:
         raise RRCacheError("the original shader has no variant", "selection",
-                           hint="the original shader needs none; write its files with Profile.write_variant")
+                           hint="the original shader needs none; rrcache.choice.write writes its files")
     algorithm = algorithm or getattr(choice, "algorithm", None) or "three-pass"
     return kind.spec(tuple(getattr(choice, "parts", choice)), algorithm, **runtime)
 
@@ -173,14 +173,14 @@ class CompileCache:
 
     @staticmethod
     def key(work, spec: VariantSpec) -> tuple:
-        """(shader hash, its file and its vertex shader's, unroll limit, compiled spec): the hash
-        covers what is compiled, the paths what the variant names (its manifest, its messages);
-        a work without a hash is its own key."""
+        """(shader hash, its file and its vertex shader's, unroll limit, sum order, compiled spec):
+        the hash covers what is compiled, the paths what the variant names (its manifest, its
+        messages), the analysis settings the node ids; a work without a hash is its own key."""
         shader = getattr(work, "hash", None)
         if not shader:
             return ("object", id(work), spec.compiled())
         paths = (str(getattr(work.shader, "path", None)), str(getattr(getattr(work, "vertex", None), "path", None)))
-        return (shader, *paths, getattr(work, "max_unroll", None), spec.compiled())
+        return (shader, *paths, getattr(work, "max_unroll", None), getattr(work, "term_scores", ()), spec.compiled())
 
     def get(self, work, spec: VariantSpec):
         key = self.key(work, spec)

@@ -55,7 +55,12 @@ CREATE TABLE IF NOT EXISTS set_run (
         return " + ".join(p.describe() for p in parts)
 
     def cells(self, selection, profile=None, texts=False):
-        what = " + ".join((p.text or p.node) if texts else p.node for p in selection.parts)
+        if texts:
+            what = " + ".join(p.text or p.node for p in selection.parts)
+        elif profile is not None:  # ids with their expressions
+            what = " + ".join(f"{p.node}: {p.text or profile.node(p.node).text}" for p in selection.parts)
+        else:
+            what = " + ".join(p.node for p in selection.parts)
         return what, " + ".join(str(p.period) for p in selection.parts)
 
     def sentence(self, selection, profile) -> str:

@@ -30,7 +30,7 @@ from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.profiler.jobs import Meter, RunShapes
 from rrcache.profiler.plan import Plan
 from rrcache.profiler.train import timing_frame_indices
-from rrcache.profiles.choice import load_work
+from rrcache.choice import load_work
 from rrcache.runtime.spec import VariantSpec
 
 DEFAULT_PERIODS = (6, 14, 30)
@@ -127,6 +127,9 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
              progress: Optional[Callable] = None) -> AccuracyReport:
     """Measure ``nodes`` (default :func:`nodes_that_matter`) of ``profile`` at ``periods`` and
     compare with the models' predictions (see the module docstring)."""
+    from rrcache.profiles.inputs import check_inputs
+
+    check_inputs(profile)  # what profile.json names is the profiled shader, before anything reads it
     table = profile.table
     settings = profile.settings
     periods = [int(p) for p in periods]

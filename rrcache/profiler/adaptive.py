@@ -75,16 +75,19 @@ def sweep(executor, spec: VariantSpec, thresholds: Sequence[float], frames, time
     for threshold in thresholds:
         at = spec.with_runtime(threshold=float(threshold))
         label = f"{node} adaptive ≥{threshold:g}"
-        runs.append(RunSpec("compare", at, frames, size, window, ERROR_FORMAT, clock, ("adaptive", float(threshold)),
-                            f"{label} error"))
-        runs += [RunSpec("compare", at, timed, size, window, timing_format, clock, ("adaptive", float(threshold)),
-                         f"{label} timing [{r + 1}/{repeats}]") for r in range(max(1, int(repeats)))]
+        runs.append(RunSpec("compare", at, frames, size, window, ERROR_FORMAT, clock,
+                            ("adaptive", float(threshold), "error"), f"{label} error"))
+        runs += [RunSpec("compare", at, timed, size, window, timing_format, clock,
+                         ("adaptive", float(threshold), "timing", r), f"{label} timing [{r + 1}/{repeats}]")
+                 for r in range(max(1, int(repeats)))]
     results: dict = {}
-    for result in executor.run(runs):
-        results.setdefault(result.spec.key[1], []).append(result)
+    for result in executor.run(runs):  # in any order (an executor may finish them so)
+        results.setdefault(result.spec.key[1], {})[result.spec.key[2:]] = result
     points = []
     for threshold in thresholds:
-        exact, *timing = results[float(threshold)]
+        got = results[float(threshold)]
+        exact = got[("error",)]
+        timing = [got[("timing", r)] for r in range(max(1, int(repeats)))]
         ratio = statistics.median(r.ms / r.original_ms for r in timing)
         points.append(AdaptivePoint(node, int(period), float(threshold), int(spec.fast_period), exact.steady_error,
                                     exact.steady_psnr, float(ratio), float(exact.hit_rate),

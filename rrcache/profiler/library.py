@@ -17,7 +17,6 @@ process at a time writes a library folder (``library.lock``, as :mod:`rrcache.pr
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import time
 import traceback
@@ -47,10 +46,12 @@ def entry_settings(base: Optional[TrainingSettings], *overrides: dict, where: st
 
 
 def _sha256(path: str) -> Optional[str]:
-    try:
-        with open(path, "rb") as f:
-            return hashlib.sha256(f.read()).hexdigest()
-    except OSError:
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
+    try:  # by rrcache.files' rule: a FIFO or a sparse giant is no shader
+        return read_file(path, budget.source_bytes).sha256
+    except Refused:
         return None
 
 
@@ -99,9 +100,15 @@ def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings,
 def read_rows(folder) -> dict[str, dict]:
     """The rows of ``library.json`` in ``folder`` by name (none when it is missing or unreadable:
     every entry is then checked against its own profile folder)."""
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     path = Path(folder) / LIBRARY_JSON
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        try:
+            data = json.loads(read_file(path, budget.document_bytes).data.decode("utf-8"))
+        except Refused:
+            return {}
         return {row["name"]: row for row in data.get("rows", []) if isinstance(row, dict) and "name" in row}
     except (OSError, ValueError, AttributeError, TypeError, KeyError):
         return {}

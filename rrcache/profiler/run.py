@@ -20,10 +20,12 @@ from __future__ import annotations
 import os
 import sqlite3
 import time
+import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
 from rrcache import kinds
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
 from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.glsl.frontend import file_records
@@ -35,6 +37,7 @@ from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
 from rrcache.selection import Selection
+from rrcache.choice import write as choice_write
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -65,6 +68,25 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
+    # the run's warnings are kept in profile.json (the report shows them) and raised again at
+    # the end for the caller
+    raised: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
+                                include_dirs, wait, vertex, adaptive, caught)
+            finally:
+                raised = list(caught)
+    finally:
+        for w in raised:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return prof
+
+
+def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
+             vertex, adaptive, caught: list) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -110,6 +132,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
                                          window=result.plan.timing_window if result.plan is not None else None,
                                          store=store, executor=executor)
+            prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
             # how many variants this invocation compiled (each at most once: the compile cache)
             prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
@@ -298,25 +321,28 @@ def _verdict(ceiling) -> dict:
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
-    """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    out.mkdir(parents=True, exist_ok=True)
+    """The shader files of each selection, then (with ``plots``) the plots, the report's frames
+    (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
     kept = []
-    for sel in prof.selections:
-        folder = out / "optimized" / sel.label
-        if folder.exists():
-            for old in folder.iterdir():
-                if old.is_file():
-                    old.unlink()
-        prof.write_variant(sel, folder, work=work)
-        kept.append(sel.replace(files=str(folder.relative_to(out))))
+    # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
+    # refused, never followed, and the old files of a selection are removed only inside it
+    with OutputFolder(out) as root, root.folder("optimized") as optimized:
+        for sel in prof.selections:
+            with optimized.folder(sel.label) as folder:
+                folder.remove_files()
+                choice_write(prof, sel, folder, work=work)
+            kept.append(sel.replace(files=f"optimized/{sel.label}"))
+        if prof.verdict is not None:  # stopped before training: nothing to plot or report
+            with optimized.folder("original") as folder:
+                choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), folder)
+            plots = False
     prof.selections = kept
     prof.path = out
-    if prof.verdict is not None:  # stopped before training: nothing to plot or report
-        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
-        plots = False
     if plots:
+        from rrcache.profiler.frames import write_frames
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
         prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_report(prof, out, work=work)
+        write_frames(prof, out, work)
+        write_report(prof, out)

@@ -32,12 +32,16 @@ from pathlib import Path
 from typing import Iterable, Optional
 
 from rrcache import kinds
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, open_file
 from rrcache.selection import Selection, parts_from_json, parts_to_json
 
 SCHEMA_VERSION = 3
 #: the schema versions :func:`read_store` reads as they are
 READABLE = ("2", "3")
+#: the files SQLite keeps beside the store (write-ahead log, shared memory, rollback journal)
+_SIDE_FILES = ("-wal", "-shm", "-journal")
 #: the store's file name in a profile folder
 STORE_NAME = "profile.sqlite"
 
@@ -110,12 +114,14 @@ CREATE TABLE error_frame (
 -- timing_run / timing_frame: one node at one timing period over the L timing frames at the
 --   session's full resolution. Each timed frame follows one untimed warm-up frame (the one
 --   before it) and is timed right after the original on the same frame (original_ms), so that
---   machine noise touches both alike.
+--   machine noise touches both alike. host: the machine that timed it (NULL: the profiling
+--   process itself).
 CREATE TABLE timing_run (
     node TEXT NOT NULL,
     period INTEGER NOT NULL,
     wall_s REAL NOT NULL,
     run_id INTEGER NOT NULL REFERENCES run_log(id),
+    host TEXT,
     PRIMARY KEY (node, period)
 );
 CREATE TABLE timing_frame (
@@ -332,47 +338,55 @@ class ProfileStore:
         file raise :class:`RRCacheError` naming the file and the problem.
         """
         path = Path(path)
-        if fresh and path.exists():
-            backup = path.with_name(path.name + ".bak")
-            os.replace(path, backup)
-            for suffix in ("-wal", "-shm"):
-                side = path.with_name(path.name + suffix)
-                if side.exists():
-                    os.replace(side, backup.with_name(backup.name + suffix))
-        exists = path.exists() and path.stat().st_size > 0
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if exists:
-            conn = cls._connect_existing(path)
-            store = cls(path, conn)
+        # by rrcache.atomic's rule: the store and SQLite's side files must be regular files (a
+        # link named profile.sqlite is refused, not followed), reached through the folder's
+        # descriptor; --fresh renames only regular files
+        sides = [path.name + suffix for suffix in _SIDE_FILES]
+        with OutputFolder(path.parent) as folder:
+            folder.regular_or_missing(path.name, *sides, path.name + ".bak", *(s + ".bak" for s in sides))
+            if fresh and folder.exists(path.name):
+                backup = path.name + ".bak"
+                folder.rename(path.name, backup)
+                for side in sides:
+                    if folder.exists(side):
+                        folder.rename(side, side.replace(path.name, backup, 1))
+            exists = folder.exists(path.name) and os.stat(path.name, dir_fd=folder.fd).st_size > 0
+            pinned = folder.proc_path(path.name)
+            if exists:
+                conn = cls._connect_existing(path, pinned)
+                store = cls(path, conn)
+                try:
+                    if store._is_empty():
+                        # a run killed while it created the store (its one transaction never
+                        # committed) leaves an SQLite file with no tables: nothing to lose, start it
+                        store._create(key)
+                    else:
+                        store._check(key)
+                except BaseException:
+                    conn.close()
+                    raise
+                return store
             try:
-                if store._is_empty():
-                    # a run killed while it created the store (its one transaction never
-                    # committed) leaves an SQLite file with no tables: nothing to lose, start it
-                    store._create(key)
-                else:
-                    store._check(key)
-            except BaseException:
-                conn.close()
-                raise
-            return store
-        try:
-            conn = sqlite3.connect(str(path), isolation_level=None)
-        except sqlite3.Error as err:
-            raise _refuse(path, f"cannot create the profile store: {err}",
-                          "free disk space or make the folder writable, then run the same command again") from None
+                conn = sqlite3.connect(pinned, isolation_level=None)
+            except sqlite3.Error as err:
+                raise _refuse(path, f"cannot create the profile store: {err}",
+                              "free disk space or make the folder writable, then run the same command again") from None
         store = cls(path, conn)
         store._create(key)
         return store
 
     @staticmethod
-    def _connect_existing(path: Path) -> sqlite3.Connection:
-        with open(path, "rb") as f:
-            header = f.read(16)
+    def _connect_existing(path: Path, pinned: Optional[str] = None) -> sqlite3.Connection:
+        try:
+            with open_file(pinned or path, limit=None) as f:
+                header = os.pread(f.fd, 16, 0)
+        except Refused as err:
+            raise _refuse(path, f"the profile store {err.reason}", _FRESH_HINT) from None
         if header != b"SQLite format 3\x00":
             raise _refuse(path, "not a profile store (not an SQLite file)",
                           "it is damaged or another program's file; " + _FRESH_HINT)
         try:
-            conn = sqlite3.connect(str(path), isolation_level=None)
+            conn = sqlite3.connect(pinned or str(path), isolation_level=None)
             rows = conn.execute("PRAGMA integrity_check").fetchall()
         except sqlite3.DatabaseError as err:
             raise _refuse(path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
@@ -523,10 +537,12 @@ class ProfileStore:
         self._write([("INSERT OR REPLACE INTO reference_timing VALUES (?, ?, ?)", (int(f), float(ms), int(c)))
                      for f, ms, c in rows])
 
-    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float) -> None:
-        """One timing run and its frames, in one transaction."""
+    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float,
+                       host: Optional[str] = None) -> None:
+        """One timing run and its frames (``host``: the machine that timed it), in one transaction."""
         rid = self._rid()
-        statements = [("INSERT INTO timing_run VALUES (?, ?, ?, ?)", (node, int(period), float(wall_s), rid))]
+        statements = [("INSERT INTO timing_run(node, period, wall_s, run_id, host) VALUES (?, ?, ?, ?, ?)",
+                       (node, int(period), float(wall_s), rid, host))]
         statements += [("INSERT INTO timing_frame VALUES (?, ?, ?, ?, ?, ?, ?)",
                         (node, int(period), f.frame, f.hits, f.misses, f.ms, f.original_ms)) for f in frames]
         statements.append(("UPDATE run_log SET timing_runs_computed = timing_runs_computed + 1 WHERE id = ?", (rid,)))
@@ -675,7 +691,7 @@ class ProfileStore:
         else:
             self.add_timing_run(node, int(period), [TimingFrame(r.frame, _count(r.hits), _count(r.misses), float(r.ms),
                                                                 float(r.original_ms)) for r in rows],
-                                float(result.wall_s))
+                                float(result.wall_s), result.host)
 
     def has_node_run(self, measure: str, node: str, period: int) -> bool:
         return (self.has_error_run if measure == "error" else self.has_timing_run)(node, period)
@@ -839,10 +855,12 @@ def _migrate_1(conn: sqlite3.Connection) -> None:
 
 def _migrate_2(conn: sqlite3.Connection) -> None:
     """Schema 2 → 3 in one transaction: the kinds' tables made (``amortize_run`` from before the
-    slots history rebuilt with its ``history`` column, its rows ``blend``), and the set stage's
-    record moved from ``meta('sets')`` into ``set_run``."""
+    slots history rebuilt with its ``history`` column, its rows ``blend``), the set stage's
+    record moved from ``meta('sets')`` into ``set_run``, and ``timing_run`` given its ``host``."""
     conn.execute("BEGIN IMMEDIATE")
     try:
+        if "host" not in _columns(conn, "timing_run"):
+            conn.execute("ALTER TABLE timing_run ADD COLUMN host TEXT")
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
         if "amortize_run" in tables and "history" not in _columns(conn, "amortize_run"):
             conn.execute("ALTER TABLE amortize_run RENAME TO amortize_run_old")
@@ -914,7 +932,9 @@ def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     path = Path(path)
     if not path.exists():
         raise _refuse(path, "no profile store here", "run 'rrcache profile' first")
-    conn = ProfileStore._connect_existing(path)
+    with OutputFolder(path.parent, create=False) as folder:
+        folder.regular_or_missing(path.name, *(path.name + suffix for suffix in _SIDE_FILES))
+        conn = ProfileStore._connect_existing(path, folder.proc_path(path.name))
     store = ProfileStore(path, conn)
     try:
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}

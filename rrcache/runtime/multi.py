@@ -116,6 +116,9 @@ class MultiCacheRuntime(CacheRuntime):
 
     # ------------------------------------------------------------------ resources
 
+    def _cache_textures(self) -> list:
+        return [t for pair in self._payloads + self._invdepths for t in pair]
+
     def bytes_per_pixel(self) -> int:
         """Depth, colour, each node's two payloads and two inverse depths, and the read-back."""
         size = 4 if self.payload_dtype == "f4" else 2
@@ -156,6 +159,7 @@ class MultiCacheRuntime(CacheRuntime):
         self._resources = [self.depth, self.color, *[t for pair in self._payloads + self._invdepths for t in pair],
                            *self._cache_fbos, *self._clear_fbos, self._out_fbo, self._color_only_fbo,
                            *[f for pair in self._node_fbos for f in pair], *self._depth_only]
+        self._make_zero_fbos()
         if self.window is not None:
             from rrcache.gl.window import check_window
             try:

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD, DEFAULT_SPREAD
-from rrcache.runtime.cache import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH
+from rrcache.runtime.cache import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD, DEFAULT_REFRESH
 
 #: the fields the runtime takes (changing them needs no new compilation)
 RUNTIME_FIELDS = ("periods", "block", "refresh", "depth_epsilon", "threshold", "fast_period", "spread", "blend")
@@ -41,7 +41,7 @@ class VariantSpec:
     #: the cached nodes' ids, in the order of ``periods`` (empty for an amortized loop)
     nodes: tuple = ()
     algorithm: str = "three-pass"
-    filter: str = "bilinear"
+    filter: str = DEFAULT_FILTER
     payload: str = "f4"
     pack_depth: bool = False
     #: an amortized loop: its estimator id, m, history and phase

@@ -35,19 +35,12 @@ import numpy as np
 from rrcache.gl.context import get_context
 from rrcache.gl.formats import ERROR_FORMAT, color_dtype, texture_floats
 from rrcache.gl.limits import check_target_size, target_guard
-from rrcache.gl.program import build_program
+from rrcache.gl.program import build_program, fullscreen_vertex
 from rrcache.gl.resources import GLScope
 from rrcache.gl.uniforms import write_uniform
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import session_background
 from rrcache.compiler.vertex import vertex_for
-
-_FULLSCREEN_VERTEX = """#version 330 core
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, -1.0, 1.0);
-}
-"""
 
 _MASK_FRAGMENT = """#version 330 core
 uniform usampler2D rr_mask;
@@ -133,7 +126,7 @@ class SampleShader:
             self._depth = scope.own(ctx.depth_texture(size))
             self.fbo = scope.own(ctx.framebuffer([self._color], self._depth))
             self._mask = scope.own(ctx.texture(size, 1, dtype="u1"))
-        self._mask_program = scope.own(build_program(ctx, _FULLSCREEN_VERTEX, _MASK_FRAGMENT,
+        self._mask_program = scope.own(build_program(ctx, fullscreen_vertex(-1.0), _MASK_FRAGMENT,
                                                      fragment_name="<render cache sample mask>"))
         self._mask_program["rr_mask"].value = 0
         self._mask_vao = scope.own(ctx.vertex_array(self._mask_program, []))

@@ -1,5 +1,6 @@
 """A profile's choice at one level, exactly as the profile made it: the one place that turns a
-level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with.
+level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with. (It sits
+above the pipeline and the profile's data: the document, :mod:`rrcache.profiles`, compiles nothing.)
 
 The profile's ``optimized/eN`` folders, ``rrcache instance PROFILE --level eN``,
 ``rrcache render PROFILE --level eN``, ``rrcache select --out`` and the report's "what to do
@@ -65,9 +66,10 @@ def load_work(prof, include_dirs=()):
     """The profiled shader loaded again for the profile's session (its defines, include folders
     and vertex shader), checked to be the shader that was profiled; returns ``(work, session)``."""
     from rrcache.pipeline import load_for_session
-    from rrcache.session import load_session
+    from rrcache.profiles.inputs import load_session_of
 
-    session = load_session(prof.session)
+    # what profile.json names is the profiled shader and session, before anything parses them
+    session = load_session_of(prof)
     work = load_for_session(prof.shader, session, prof.defines, list(include_dirs) + list(prof.include_dirs),
                             vertex=prof.vertex)
     check_same_shader(prof, work)
@@ -115,19 +117,19 @@ def write(prof, sel: Selection, out_dir, work=None) -> list[str]:
     (recording the period and every run-time option); for the original shader only a
     ``manifest.json`` saying so. ``work``: the profiled shader already loaded (else it is loaded
     again and must still have the profiled hash)."""
-    from rrcache import atomic
+    from rrcache.atomic import OutputFolder
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    if not isinstance(out_dir, OutputFolder):  # by rrcache.atomic's rule, into the chosen folder
+        with OutputFolder(out_dir) as folder:
+            return write(prof, sel, folder, work)
     if not sel.parts:
-        path = out / "manifest.json"
-        atomic.write_text(str(path), json.dumps({"rrcache_selection": 1, "node": None, "shader": prof.shader,
-                                                 "note": original_note(prof, sel)}, indent=2) + "\n")
-        return [str(path)]
+        return [out_dir.write_text("manifest.json", json.dumps(
+            {"rrcache_selection": 1, "node": None, "shader": prof.shader, "note": original_note(prof, sel)},
+            indent=2) + "\n")]
     if work is None:
         work, _session = load_work(prof)
     variant, period = variant_of(prof, sel, work)
-    return variant.write(out, period=period, runtime=runtime_options(prof, sel))
+    return variant.write(out_dir, period=period, runtime=runtime_options(prof, sel))
 
 
 def describe_options(prof, sel: Selection) -> str:
