@@ -76,7 +76,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             warnings.simplefilter("always")
             try:
                 prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught)
+                                include_dirs, wait, vertex, adaptive, caught, cluster)
             finally:
                 raised = list(caught)
     finally:
@@ -86,7 +86,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
 
 def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list) -> Profile:
+             vertex, adaptive, caught: list, cluster=None) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
