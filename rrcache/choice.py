@@ -73,6 +73,7 @@ def load_work(prof, include_dirs=()):
     work = load_for_session(prof.shader, session, prof.defines, list(include_dirs) + list(prof.include_dirs),
                             vertex=prof.vertex)
     check_same_shader(prof, work)
+    work.filter = prof.filter  # the variants compile as the profile trained them
     return work, session
 
 

@@ -57,6 +57,9 @@ class ShaderWork:
     max_unroll: int = DEFAULT_MAX_ITERATIONS
     #: the measured order of sums the table was analysed with (``term_scores``; part of the key)
     term_scores: tuple = ()
+    #: the cache filter every variant of this work compiles with unless told otherwise (a
+    #: profile's: ``Profile.filter``, chosen by rrcache.profiler.filters)
+    filter: str = DEFAULT_FILTER
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -111,15 +114,16 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
     return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
-def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
+def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: Optional[str] = None,
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
     """The variant of ``work`` caching ``node_id`` (an id such as ``n42``; ``adaptive``: refreshed
-    by :mod:`rrcache.runtime.adaptive`'s rule), compiled once (:func:`rrcache.kinds.compile`)."""
-    spec = VariantSpec("adaptive" if adaptive else "cache", (node_id,), algorithm, filter, payload_dtype)
+    by :mod:`rrcache.runtime.adaptive`'s rule; ``filter``: the work's when not given), compiled
+    once (:func:`rrcache.kinds.compile`)."""
+    spec = VariantSpec("adaptive" if adaptive else "cache", (node_id,), algorithm, filter or work.filter, payload_dtype)
     return kinds.compile(work, spec)
 
 
-def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = DEFAULT_FILTER,
+def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: Optional[str] = None,
                       payload_dtype: str = "f4") -> Variant:
     """The variant of ``work`` caching every node of ``node_ids`` (two or more; one:
     :func:`variant_for`), each with its own payload and period
@@ -127,7 +131,7 @@ def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass",
     node_ids = list(node_ids)
     if len(node_ids) == 1:
         return variant_for(work, node_ids[0], algorithm, filter, payload_dtype)
-    return kinds.compile(work, VariantSpec("nodes", tuple(node_ids), algorithm, filter, payload_dtype))
+    return kinds.compile(work, VariantSpec("nodes", tuple(node_ids), algorithm, filter or work.filter, payload_dtype))
 
 
 def variant_for_selection(work: ShaderWork, selection: Selection, **runtime) -> tuple[Variant, object]:
@@ -136,7 +140,7 @@ def variant_for_selection(work: ShaderWork, selection: Selection, **runtime) -> 
     the refresh period it runs with (for several nodes, the list of periods in part order): the
     kind of choice (:mod:`rrcache.kinds`) says how it compiles. The variant's ``spec`` is the
     selection's, whole. The original shader (no part) has no variant: RRCacheError."""
-    spec = kinds.spec_for(selection, selection.algorithm or "three-pass", **runtime)
+    spec = kinds.spec_for(selection, selection.algorithm or "three-pass", work.filter, **runtime)
     period = spec.period
     return kinds.compile(work, spec), list(period) if isinstance(period, tuple) else period
 

@@ -93,7 +93,7 @@ def _overlap(a, b) -> bool:
 def test_a_profile_through_dask_equals_the_one_in_process(scene, cluster, in_process, tmp_path):
     shader, session = scene
     before = len(cluster.placements)
-    remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, cluster=cluster)
+    remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, executor=cluster)
     _same(in_process, remote)
     placed = cluster.placements[before:]
     assert {p.kind for p in placed} == {"error", "timing"} and len({p.pid for p in placed}) == 2
@@ -115,7 +115,7 @@ def test_a_worker_killed_mid_profile(scene, cluster, in_process, tmp_path):
     shader, session = scene
     cluster.client.wait_for_workers(2, timeout=60)
     with killing_a_busy_worker(cluster.client, matching="error") as victims:
-        remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, cluster=cluster)
+        remote = profile(shader, session, tmp_path / "p", SETTINGS, plots=False, executor=cluster)
     assert victims, "no worker was seen busy with an error run"
     _same(in_process, remote)
     cluster.client.wait_for_workers(2, timeout=60)

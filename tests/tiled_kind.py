@@ -68,20 +68,20 @@ CREATE TABLE IF NOT EXISTS tiled_run (
 );
 """
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
         (p,) = parts
         runtime.update(refresh="tiled", block=int(p.block))
-        return VariantSpec(self.name, (p.node,), algorithm, periods=(int(p.period),), **runtime)
+        return VariantSpec(self.name, (p.node,), algorithm, filter or "bilinear", periods=(int(p.period),), **runtime)
 
     def compile(self, work, spec: VariantSpec):
         from rrcache.compiler import instance
 
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter="bilinear") -> list:
         node, block = subject
         options = dict(settings.cache_options(), refresh="tiled", block=int(block))
-        return [(measure, VariantSpec(self.name, (node,), algorithm, periods=(p,), **options),
+        return [(measure, VariantSpec(self.name, (node,), algorithm, filter, periods=(p,), **options),
                  ("tiled", node, p, int(block))) for measure in ("error", "timing") for p in settings.periods]
 
     def collect(self, store, result) -> None:

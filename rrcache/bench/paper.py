@@ -165,6 +165,11 @@ class SceneResult:
     notes: list = field(default_factory=list)
     wall_s: float = 0.0
     figure: Optional[str] = None
+    #: the cache filter the profile chose (rrcache.profiler.filters) and what each candidate measured
+    filter: Optional[str] = None
+    filter_times: Optional[dict] = None
+    #: the medium selection's misses by cause (rrcache.bench.cache.MissRow as JSON)
+    misses: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         out = asdict(self)
@@ -462,6 +467,9 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         warnings.simplefilter("always")
         prof = profile(scene.shader, session_path, folder, training, progress=on_event, plots=settings.plots)
     result.notes += [f"profile: {w.message}" for w in caught]
+    work.filter = prof.filter  # the selections compile with the profile's filter
+    result.filter = prof.filter
+    result.filter_times = (prof.plan or {}).get("filter_times")
     counts = prof.counts or {}
     result.profile = str(folder)
     # the profiler's precomputation time: every invocation on its store added up (older
@@ -494,8 +502,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
     if not medium.choice.one_node:  # an amortized estimator, several nodes: the algorithms and limit are one node's
+        if medium.multi:  # the all-hit limit of the set (the algorithms and the misses are one node's)
+            _set_limit(prof, work, session, frames, medium, result, progress)
         result.notes.append(f"the {medium.label} selection is {medium.describe()} ({medium.choice.title}): the "
-                            "algorithms and the all-hit limit are measured for a single cached node only")
+                            "algorithms and the miss breakdown are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:
             result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
             originals += [r.original_ms for r in result.equal_time[1:]]
@@ -505,7 +515,9 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     _say(progress, f"algorithms and limit on {medium.node}")
     bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
+                            base_filter=prof.filter, limit_filter=prof.filter, misses=True,
                             progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
+    result.misses = [asdict(m) for m in bench.misses]
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
                                    r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]
     originals += [r.original_ms for r in result.algorithms]
@@ -522,6 +534,21 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     result.original_ms = float(statistics.median(originals)) if originals else _original_ms(work, session, frames)
     result.wall_s = time.time() - started
     return result
+
+
+def _set_limit(prof, work, session, frames, medium: Selection, result: "SceneResult", progress) -> None:
+    """The all-hit limit of a selection of several nodes: its variant with every node hitting."""
+    from rrcache.harness.limit import all_hit_limit, probe_frames
+    from rrcache.pipeline import variant_for_selection
+
+    _say(progress, f"limit of {medium.describe()}")
+    variant, periods = variant_for_selection(work, medium)
+    options = prof.settings.cache_options()
+    limit = all_hit_limit(variant, session, work.prepared, probe_frames(frames), None, period=periods,
+                          color_format=prof.settings.timing_format, **options)
+    result.limit_ms, result.limit_original_ms = limit.limit_ms, limit.original_median_ms
+    result.limit_speedup = limit.original_median_ms / limit.limit_ms
+    result.limit_algorithm = prof.algorithm
 
 
 def _original_ms(work, session, frames) -> float:

@@ -25,17 +25,18 @@ from rich.console import Console
 from rrcache.cli.options import (cluster_options, include_dirs_option, parse_defines, resolution_option as _resolution,
                                  vert_option)
 from rrcache.cli.progress import Reporter, quiet_option
-from rrcache.cli.tables import TextTable
 from rrcache.cluster import maybe_cluster
+from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK, UNRELIABLE_NOISE
 from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
-from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.document import algorithm_line, filter_line
 from rrcache.profiles.notices import ceiling_noise, run_warnings
 from rrcache.profiles.store import STORE_NAME
-from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_KINDS, TrainingSettings, parse_periods
+from rrcache.profiles.settings import (ALGORITHM_CHOICES, DEFAULT_PERIODS, FILTER_CHOICES, LEVEL_KINDS, TrainingSettings,
+                                      parse_periods)
 
 
 def _periods(ctx, param, value):
@@ -93,6 +94,9 @@ def _fmt(value, spec=".3g", none="–"):
               help="Refresh periods at which each node is timed (default: 2,8,50).")
 @click.option("--algorithm", type=click.Choice(ALGORITHM_CHOICES), default="auto", show_default=True,
               help="auto: time three-pass and two-pass on the first node and keep the faster.")
+@click.option("--filter", "filter_", type=click.Choice(FILTER_CHOICES), default="auto", show_default=True,
+              help="The cache's hit test and payload reconstruction: auto measures bilinear against plane on "
+                   "the first node and keeps plane where faster at about the same PSNR (docs/misses.md).")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
@@ -131,12 +135,12 @@ def _fmt(value, spec=".3g", none="–"):
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            algorithm, filter_, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
             wait, max_sets, defines, adaptive, clock, workers, scheduler, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
-    kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
+    kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
                   validate=not no_validate, validation_frames=validation_frames, levels=levels, clock=clock)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),
@@ -157,7 +161,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
                 with maybe_cluster(workers, scheduler, announce=reporter.line) as cluster:
                     prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
                                    vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive,
-                                   cluster=cluster)
+                                   executor=cluster)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
@@ -223,6 +227,7 @@ def _summary(prof, console: Console) -> None:
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {prof.pixels:,.0f} covered pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
+    console.print(f"filter: {filter_line(prof)}", highlight=False)
     for line in _estimator_lines(prof):
         console.print(line, highlight=False)
     ceiling = prof.measured_ceiling

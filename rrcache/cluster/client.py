@@ -58,10 +58,13 @@ class Cluster:
 
     def executor(self, work, session, on_frame=None):
         """The executor of one profile's runs (``work`` over ``session``) on this cluster:
-        :class:`rrcache.cluster.executor.DaskExecutor`."""
+        :class:`rrcache.cluster.executor.DaskExecutor`. The cluster itself is the executor
+        factory :func:`rrcache.profile` takes (``executor=cluster``)."""
         from rrcache.cluster.executor import DaskExecutor
 
         return DaskExecutor(self, work, session, on_frame)
+
+    __call__ = executor
 
     @property
     def capacity(self) -> int:

@@ -184,6 +184,18 @@ class DaskExecutor:
                                     "workers' logs; the runs already made are stored: run the command again "
                                     "to resume") from first.error
 
+    def record(self, capacity=None) -> dict:
+        """What profile.json keeps of the cluster (``Profile.cluster``): its workers and hosts,
+        what their ``capacity`` bought (:class:`rrcache.profiler.capacity.CapacityPlan`: the
+        training frames, the budget's factor) and, per host, the timed runs it made."""
+        cluster = self.runs.cluster
+        timed: dict = {}
+        for p in self.placements:
+            if p.kind == "timing":
+                timed.setdefault(p.host, []).append(p.label)
+        return {"workers": len(cluster.workers), "hosts": cluster.hosts, "dashboard": cluster.dashboard,
+                "capacity": capacity.to_json() if capacity is not None else None, "timing_hosts": timed}
+
     def close(self) -> None:
         if self.name is not None:
             self.runs.close(self.name)

@@ -145,16 +145,17 @@ def parts_from_json(data, where: str) -> tuple:
     return tuple(out)
 
 
-def spec_for(choice, algorithm: Optional[str] = None, **runtime) -> VariantSpec:
+def spec_for(choice, algorithm: Optional[str] = None, filter: Optional[str] = None, **runtime) -> VariantSpec:
     """The :class:`VariantSpec` of a selection (or of its parts) run with ``algorithm`` (default:
-    the selection's, else three-pass) and the runtime's fields ``runtime`` (``block``,
-    ``refresh``, ``depth_epsilon``). The original shader has none: RRCacheError."""
+    the selection's, else three-pass), the profile's cache ``filter`` (None: the default) and the
+    runtime's fields ``runtime`` (``block``, ``refresh``, ``depth_epsilon``). The original
+    shader has none: RRCacheError."""
     kind = kind_of(choice)
     if kind is None:
         raise RRCacheError("the original shader has no variant", "selection",
                            hint="the original shader needs none; rrcache.choice.write writes its files")
     algorithm = algorithm or getattr(choice, "algorithm", None) or "three-pass"
-    return kind.spec(tuple(getattr(choice, "parts", choice)), algorithm, **runtime)
+    return kind.spec(tuple(getattr(choice, "parts", choice)), algorithm, filter, **runtime)
 
 
 class CompileCache:

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
-from rrcache.kinds.base import Kind, only as _only
+from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -48,22 +49,14 @@ class AdaptiveNode:
     @classmethod
     def from_json(cls, data: dict, where: str) -> "AdaptiveNode":
         _only(data, ("kind", "node", "period", "threshold", "fast_period", "spread", "text"), where)
-        node = data.get("node")
-        if not isinstance(node, str) or not node:
-            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
-        for key in ("period", "fast_period"):
-            value = data.get(key, 4 if key == "fast_period" else None)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise RRCacheError("must be a whole number >= 1", f"{where}.{key}")
+        node = id_of(data, "node", where, "n42")
+        period, fast_period = whole(data, "period", where), whole(data, "fast_period", where, 4)
         for key in ("threshold", "spread"):
             value = data.get(key, 0.0 if key == "spread" else None)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise RRCacheError("must be a finite number >= 0", f"{where}.{key}")
-        text = data.get("text")
-        if text is not None and not isinstance(text, str):
-            raise RRCacheError("must be a string or null", f"{where}.text")
-        return cls(node, data["period"], float(data["threshold"]), data.get("fast_period", 4),
-                   float(data.get("spread", 0.0)), text)
+        return cls(node, period, float(data["threshold"]), fast_period, float(data.get("spread", 0.0)),
+                   text_of(data, where))
 
 
 class AdaptiveKind(Kind):
@@ -92,9 +85,10 @@ CREATE TABLE IF NOT EXISTS adaptive_point (
 );
 """
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
         (p,) = parts
-        return VariantSpec(self.name, (p.node,), algorithm, periods=(int(p.period),), threshold=float(p.threshold),
+        return VariantSpec(self.name, (p.node,), algorithm, filter or DEFAULT_FILTER, periods=(int(p.period),),
+                           threshold=float(p.threshold),
                            fast_period=int(p.fast_period), spread=float(p.spread), **runtime)
 
     def compile(self, work, spec: VariantSpec):
@@ -103,11 +97,11 @@ CREATE TABLE IF NOT EXISTS adaptive_point (
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
                         pack_depth=spec.pack_depth, adaptive=True)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=DEFAULT_FILTER) -> list:
         """``subject`` = (node, period, thresholds, fast_period): each threshold measured beside the
         original (``compare``)."""
         node, period, thresholds, fast_period = subject
-        base = VariantSpec(self.name, (node,), algorithm, periods=(int(period),), fast_period=int(fast_period),
+        base = VariantSpec(self.name, (node,), algorithm, filter, periods=(int(period),), fast_period=int(fast_period),
                            **settings.cache_options())
         return [("compare", base.with_runtime(threshold=float(t)), ("adaptive", node, int(period), float(t)))
                 for t in thresholds]

@@ -13,7 +13,7 @@ from typing import ClassVar, Optional
 
 from rrcache.compiler.slots import AMORTIZE_PAYLOADS
 from rrcache.errors import RRCacheError
-from rrcache.kinds.base import Kind, only as _only
+from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
 from rrcache.runtime.glsl import FILTERS
 from rrcache.runtime.spec import VariantSpec
 
@@ -58,12 +58,8 @@ class AmortizedLoop:
     @classmethod
     def from_json(cls, data: dict, where: str) -> "AmortizedLoop":
         _only(data, ("kind", "estimator", "samples", "blend", "history", "phase", "text", "filter", "payload"), where)
-        estimator = data.get("estimator")
-        if not isinstance(estimator, str) or not estimator:
-            raise RRCacheError("must be an estimator id (a string such as 'e1')", f"{where}.estimator")
-        samples = data.get("samples")
-        if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
-            raise RRCacheError("must be a whole number >= 1", f"{where}.samples")
+        estimator = id_of(data, "estimator", where, "e1")
+        samples = whole(data, "samples", where)
         blend = data.get("blend")
         if isinstance(blend, bool) or not isinstance(blend, (int, float)) or not 0.0 <= blend < 1.0:
             raise RRCacheError("must be a number in [0, 1)", f"{where}.blend")
@@ -72,9 +68,7 @@ class AmortizedLoop:
             raise RRCacheError("must be 'blend' or 'slots'", f"{where}.history")
         if phase not in ("frame", "pixel"):
             raise RRCacheError("must be 'frame' or 'pixel'", f"{where}.phase")
-        text = data.get("text")
-        if text is not None and not isinstance(text, str):
-            raise RRCacheError("must be a string or null", f"{where}.text")
+        text = text_of(data, where)
         filter_, payload = data.get("filter", "bilinear"), data.get("payload", "f4")
         if filter_ not in FILTERS:
             raise RRCacheError(f"must be one of {', '.join(FILTERS)}", f"{where}.filter")
@@ -112,7 +106,8 @@ CREATE TABLE IF NOT EXISTS amortize_run (
 );
 """
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
+        # (its part names its own filter: the profile's, a node cache's, does not apply)
         (p,) = parts
         return VariantSpec(self.name, (), algorithm, p.filter, p.payload, estimator=p.estimator,
                            samples=int(p.samples), history=p.history, phase=p.phase, blend=float(p.blend), **runtime)
@@ -124,7 +119,7 @@ CREATE TABLE IF NOT EXISTS amortize_run (
                                   phase=spec.phase, history=spec.history, filter=spec.filter,
                                   payload_dtype=spec.payload, vertex=work.vertex)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=None) -> list:
         """``subject`` = (estimator id, history, payload, [(m, [λ, ...]), ...], timed m list): the
         error runs at each (m, λ) and the timing runs at each timed m."""
         estimator, history, payload, errors, timed = subject
@@ -137,7 +132,24 @@ CREATE TABLE IF NOT EXISTS amortize_run (
         return out
 
     def collect(self, store, result) -> None:
-        store.add_amortize_result(result)
+        """An estimator's error run (one row of ``amortize_run``: the means over the frames after the
+        first) or timing run (a row per timed frame), keyed ``("amortize", estimator, history, m, λ)``."""
+        _, estimator, history, m, lam = result.spec.key
+        rows = result.frames
+        if result.spec.measure == "error":
+            steady = rows[1:]
+            errs = [r.error for r in steady] or [0.0]
+            psnrs = [r.psnr for r in steady] or [100.0]
+            hits, misses = sum(r.hits or 0 for r in steady), sum(r.misses or 0 for r in steady)
+            rate = hits / (hits + misses) if hits + misses else 0.0
+            store.add_amortize_rows([(estimator, history, "error", int(m), float(lam), -1,
+                                      float(sum(errs) / len(errs)), float(sum(psnrs) / len(psnrs)), rate, hits,
+                                      misses, 0.0, 0.0, float(result.wall_s))])
+        else:
+            wall = float(result.wall_s) / max(1, len(rows))
+            store.add_amortize_rows([(estimator, history, "timing", int(m), 0.0, int(r.frame), 0.0, 0.0, 0.0,
+                                      int(r.hits or 0), int(r.misses or 0), float(r.ms), float(r.original_ms), wall)
+                                     for r in rows])
 
     def cells(self, selection, profile=None, texts=False):
         p = selection.parts[0]

@@ -15,6 +15,7 @@ import html
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -25,9 +26,29 @@ def only(data: dict, keys: tuple, where: str) -> None:
         raise RRCacheError(f"unknown key {unknown[0]!r} (known: {', '.join(keys)})", where)
 
 
-def node_part_key(part) -> tuple:
-    """The identity of a node part without its text (what equality compares)."""
-    return part.key()
+def text_of(data: dict, where: str) -> Optional[str]:
+    """A part's ``text`` (None when absent); RRCacheError unless a string or null."""
+    text = data.get("text")
+    if text is not None and not isinstance(text, str):
+        raise RRCacheError("must be a string or null", f"{where}.text")
+    return text
+
+
+def whole(data: dict, key: str, where: str, default=None) -> int:
+    """A part's whole number ``key`` ≥ 1 (``default`` when absent); RRCacheError otherwise."""
+    value = data.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise RRCacheError("must be a whole number >= 1", f"{where}.{key}")
+    return value
+
+
+def id_of(data: dict, key: str, where: str, example: str) -> str:
+    """A part's id ``key`` (a non-empty string such as ``example``); RRCacheError otherwise."""
+    value = data.get(key)
+    if not isinstance(value, str) or not value:
+        raise RRCacheError(f"must be {'an' if key[0] in 'aeiou' else 'a'} {key} id (a string such as '{example}')",
+                           f"{where}.{key}")
+    return value
 
 
 class Kind:
@@ -58,9 +79,10 @@ class Kind:
         exactly one part of :attr:`part`."""
         return self.part is not None and len(parts) == 1 and isinstance(parts[0], self.part)
 
-    def spec(self, parts: tuple, algorithm: str, **runtime) -> VariantSpec:
-        """The variant spec of ``parts`` run with ``algorithm``, with the runtime's fields
-        ``runtime`` (``block``, ``refresh``, ``depth_epsilon``)."""
+    def spec(self, parts: tuple, algorithm: str, filter: Optional[str] = None, **runtime) -> VariantSpec:
+        """The variant spec of ``parts`` run with ``algorithm``, the profile's cache ``filter`` where
+        the kind caches nodes with it (None: the default; an amortized loop's part names its own),
+        and the runtime's fields ``runtime`` (``block``, ``refresh``, ``depth_epsilon``)."""
         raise NotImplementedError
 
     def compile(self, work, spec: VariantSpec):
@@ -69,9 +91,10 @@ class Kind:
         raise NotImplementedError
 
     # ---------------------------------------------------------------- training and the store
-    def training(self, subject, settings, algorithm: str) -> list[tuple[str, VariantSpec, tuple]]:
+    def training(self, subject, settings, algorithm: str, filter: str = DEFAULT_FILTER) -> list:
         """The runs training ``subject`` with ``settings`` (a
-        :class:`~rrcache.profiles.settings.TrainingSettings`) and ``algorithm`` plans:
+        :class:`~rrcache.profiles.settings.TrainingSettings`), ``algorithm`` and the profile's cache
+        ``filter`` plans:
         ``(measure, spec, key)`` each (``measure`` of :data:`rrcache.runs.MEASURES`; ``key``
         what the collector files the result under). Kinds without training return []."""
         return []

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from rrcache.kinds.base import Kind
 from rrcache.kinds.single import CachedNode
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -34,8 +35,8 @@ CREATE TABLE IF NOT EXISTS set_run (
     def claims(self, parts) -> bool:
         return len(parts) >= 2 and all(isinstance(p, CachedNode) for p in parts)
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
-        return VariantSpec(self.name, tuple(p.node for p in parts), algorithm,
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
+        return VariantSpec(self.name, tuple(p.node for p in parts), algorithm, filter or DEFAULT_FILTER,
                            periods=tuple(int(p.period) for p in parts), **runtime)
 
     def compile(self, work, spec: VariantSpec):
@@ -43,10 +44,10 @@ CREATE TABLE IF NOT EXISTS set_run (
 
         return instance_nodes(work.table, list(spec.nodes), spec.algorithm, spec.filter, spec.payload, work.vertex)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=DEFAULT_FILTER) -> list:
         """``subject``: (node ids, periods) of one set: an error run and a timing run."""
         nodes, periods = subject
-        spec = VariantSpec(self.name, tuple(nodes), algorithm, periods=tuple(periods),
+        spec = VariantSpec(self.name, tuple(nodes), algorithm, filter, periods=tuple(periods),
                            **settings.cache_options())
         key = ("set", tuple(nodes), tuple(int(p) for p in periods))
         return [("error", spec, key), ("timing", spec, key)]

@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
-from rrcache.kinds.base import Kind, only as _only
+from rrcache.kinds.base import Kind, id_of, only as _only, text_of, whole
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.runtime.spec import VariantSpec
 
 
@@ -36,16 +37,7 @@ class CachedNode:
     @classmethod
     def from_json(cls, data: dict, where: str) -> "CachedNode":
         _only(data, ("kind", "node", "period", "text"), where)
-        node = data.get("node")
-        if not isinstance(node, str) or not node:
-            raise RRCacheError("must be a node id (a string such as 'n42')", f"{where}.node")
-        period = data.get("period")
-        if isinstance(period, bool) or not isinstance(period, int) or period < 1:
-            raise RRCacheError("must be a whole number >= 1", f"{where}.period")
-        text = data.get("text")
-        if text is not None and not isinstance(text, str):
-            raise RRCacheError("must be a string or null", f"{where}.text")
-        return cls(node, period, text)
+        return cls(id_of(data, "node", where, "n42"), whole(data, "period", where), text_of(data, where))
 
 
 class CacheKind(Kind):
@@ -54,9 +46,9 @@ class CacheKind(Kind):
     title = "one cached node"
     one_node = True
 
-    def spec(self, parts, algorithm, **runtime) -> VariantSpec:
+    def spec(self, parts, algorithm, filter=None, **runtime) -> VariantSpec:
         (p,) = parts
-        return VariantSpec(self.name, (p.node,), algorithm, periods=(int(p.period),), **runtime)
+        return VariantSpec(self.name, (p.node,), algorithm, filter or DEFAULT_FILTER, periods=(int(p.period),), **runtime)
 
     def compile(self, work, spec: VariantSpec):
         from rrcache.compiler import instance
@@ -64,9 +56,9 @@ class CacheKind(Kind):
         return instance(work.table, spec.nodes[0], spec.algorithm, spec.filter, spec.payload, work.vertex,
                         pack_depth=spec.pack_depth)
 
-    def training(self, subject, settings, algorithm) -> list:
+    def training(self, subject, settings, algorithm, filter=DEFAULT_FILTER) -> list:
         """A node (``subject``, its id) at each training period (error) and timing period (timing)."""
-        base = VariantSpec(self.name, (subject,), algorithm, **settings.cache_options())
+        base = VariantSpec(self.name, (subject,), algorithm, filter, **settings.cache_options())
         return ([("error", base.with_runtime(periods=(p,)), ("node", subject, p)) for p in settings.periods]
                 + [("timing", base.with_runtime(periods=(p,)), ("node", subject, p)) for p in settings.timing_periods])
 

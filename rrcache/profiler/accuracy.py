@@ -158,7 +158,8 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
     for nid in nodes:  # each node's held-out periods: error runs, then timing runs (one variant serves all)
         runs += [shapes.run(measure, spec.with_runtime(periods=(p,)), ("node", nid, p), f"{nid} Δn={p}")
                  for measure in ("error", "timing") for p in periods
-                 for spec in [VariantSpec(kind.name, (nid,), profile.algorithm, **settings.cache_options())]]
+                 for spec in [VariantSpec(kind.name, (nid,), profile.algorithm, profile.filter,
+                                          **settings.cache_options())]]
     with Bench(work, session) as bench:
         results = list(LocalExecutor(bench, on_frame=meter.on_frame()).run(runs))
     measured = {}

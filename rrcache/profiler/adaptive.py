@@ -148,7 +148,7 @@ def extend(prof, work, session, settings, thresholds: Sequence[float], fast_peri
                 if todo:
                     if executor is None:
                         executor = LocalExecutor(Bench(work, session))
-                    spec = VariantSpec("adaptive", (part.node,), algorithm, periods=(int(part.period),),
+                    spec = VariantSpec("adaptive", (part.node,), algorithm, work.filter, periods=(int(part.period),),
                                        fast_period=int(fast_period), **settings.cache_options())
                     start = time.perf_counter()
                     new = sweep(executor, spec, todo, frames, window=window, timing_format=settings.timing_format,

@@ -45,6 +45,7 @@ class FrameShots:
 
             work = load_for_session(profile.shader, self.session, profile.defines,
                                     getattr(profile, "include_dirs", ()), vertex=profile.vertex)
+            work.filter = getattr(profile, "filter", work.filter)
         self.work = work
         self.size = image_size(self.session.resolution, max_width)
         self._originals: dict = {}

@@ -164,7 +164,8 @@ def profile_library(entries: list[LibraryEntry], out_dir, settings: Optional[Tra
                     say(f"{tag}: profiling {entry.shader} over {entry.session} ({why}"
                         f"{'; starting over' if restart and not fresh else ''})")
                     prof = profile(entry.shader, entry.session, folder, chosen, entry.defines, progress, fresh=restart,
-                                   plots=plots, include_dirs=entry.include_dirs, vertex=entry.vertex, cluster=cluster)
+                                   plots=plots, include_dirs=entry.include_dirs, vertex=entry.vertex,
+                                   executor=cluster)
                     wall = prof.precompute_s if prof.precompute_s is not None else time.perf_counter() - started
                 report = folder / "report.html"
                 row = profile_row(prof, entry.name, entry.name, f"{entry.name}/report.html" if report.exists() else None,

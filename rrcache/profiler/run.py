@@ -52,7 +52,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None, cluster=None) -> Profile:
+            vertex=None, adaptive=None, executor=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -62,9 +62,14 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`). ``cluster`` (:func:`rrcache.cluster.maybe_cluster`)
-    makes the runs on a Dask cluster instead of in this process, and its workers buy a larger
-    default plan (:mod:`rrcache.profiler.capacity`), recorded in ``Profile.cluster``.
+    same level (:mod:`rrcache.profiler.adaptive`). ``executor``: a callable ``(work, session) ->
+    executor`` making what runs the training's :class:`~rrcache.runs.RunSpec` s (its
+    ``run(specs, on_frame=None)`` yields a :class:`~rrcache.runs.RunResult` per spec, in any order;
+    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`). A
+    factory with a ``capacity`` (runs made at once: a Dask cluster's workers,
+    :class:`rrcache.cluster.client.Cluster`) buys a larger default plan
+    (:mod:`rrcache.profiler.capacity`); an executor with a ``record(capacity)`` has it kept in
+    ``Profile.cluster``.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -75,8 +80,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught, cluster)
+                prof = _profile(shader_path, session_path, out_dir, settings, caught, defines=defines,
+                                progress=progress, fresh=fresh, plots=plots, include_dirs=include_dirs, wait=wait,
+                                vertex=vertex, adaptive=adaptive, executor=executor)
             finally:
                 raised = list(caught)
     finally:
@@ -85,8 +91,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     return prof
 
 
-def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list, cluster=None) -> Profile:
+def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defines, progress, fresh, plots,
+             include_dirs, wait, vertex, adaptive, executor) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -95,10 +101,12 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
     settings = settings or TrainingSettings()
     capacity = None
-    if cluster is not None:  # more workers: more frames and more nodes (rrcache.profiler.capacity)
+    if executor is not None and getattr(executor, "capacity", None):
+        # an executor that makes several runs at once buys a larger default plan: more training
+        # frames and more nodes (rrcache.profiler.capacity)
         from rrcache.profiler.capacity import scaled
 
-        settings, capacity = scaled(settings, session, cluster.capacity)
+        settings, capacity = scaled(settings, session, int(executor.capacity))
     resolved = settings.resolved(session)
     from rrcache.profiler.amortize import estimator_table
 
@@ -115,7 +123,7 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
         # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
         # the original's reference frames rendered once
         compiled = sum(kinds.compile_counts().values())
-        executor = cluster.executor(work, session) if cluster is not None else LocalExecutor(Bench(work, session))
+        executor = executor(work, session) if executor is not None else LocalExecutor(Bench(work, session))
         try:
             store.begin_run()
             result = train(work, session, resolved, store, progress, executor=executor)
@@ -138,8 +146,8 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
             prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
-            if cluster is not None:
-                prof.cluster = _cluster_record(cluster, capacity, executor.placements)
+            if hasattr(executor, "record"):  # where the runs were made (a Dask cluster's workers)
+                prof.cluster = executor.record(capacity)
             prof.write(out)
         except KeyboardInterrupt:
             _end_quietly(store, "interrupted")
@@ -153,18 +161,6 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
     finally:
         lock.release()
     return prof
-
-
-def _cluster_record(cluster, capacity, placements) -> dict:
-    """What profile.json says of the cluster a profile's runs were made on: the workers and
-    hosts, what their capacity bought (training frames, budget factor), and where this
-    invocation's timed runs ran (host → the runs' labels)."""
-    timed = {}
-    for p in placements:
-        if p.kind == "timing":
-            timed.setdefault(p.host, []).append(p.label)
-    return {"workers": len(cluster.workers), "hosts": cluster.hosts, "dashboard": cluster.dashboard,
-            "capacity": capacity.to_json() if capacity is not None else None, "timing_hosts": timed}
 
 
 def _end_quietly(store, status: str) -> None:
@@ -224,6 +220,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
+        filter=(plan.filter if plan is not None and plan.filter else "bilinear"),
         nodes=nodes, defines=dict(work.defines), include_dirs=list(work.include_dirs), plan=plan.to_json() if plan is not None else None,
         untrained=list(result.untrained), budget_stopped=result.budget_stopped,
         mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,

@@ -198,7 +198,7 @@ def train_set(prof, settings, session, option: SetOption, executor, meter: Meter
     label = option.describe()
     runs = [shapes.run(measure, spec, key, f"{label} {measure}")
             for measure, spec, key in kinds.get("nodes").training((option.nodes, option.periods), settings,
-                                                                  prof.algorithm)]
+                                                                  prof.algorithm, prof.filter)]
     meter.grow(sum(r.cost for r in runs))
     errors, psnrs, hits, counted, ratios = [], [], np.zeros(len(option.periods)), 0, []
     for result in executor.run(runs, on_frame=meter.on_frame("sets")):

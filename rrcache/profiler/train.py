@@ -56,6 +56,8 @@ from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork
 from rrcache.model.ceiling import Ceiling
 from rrcache.profiler.ceiling import measure_ceiling
+from rrcache.profiler.filters import choose_filter
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                     shader_inputs, signature)
 from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
@@ -296,6 +298,16 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 plan.algorithm = settings.fixed_algorithm
             store.set_plan(plan.to_json())
         algorithm = plan.algorithm
+        if plan.filter is None:
+            if settings.filter == "auto" and order.nodes and len(timing) > 0:
+                plan.filter, plan.filter_times = choose_filter(settings, order.nodes[0].id, algorithm, shapes,
+                                                               executor, meter)
+            else:
+                plan.filter = DEFAULT_FILTER if settings.filter == "auto" else settings.filter
+            store.set_plan(plan.to_json())
+        # every variant compiled for this profile from here on (training, validation, the sets,
+        # the selections' files) uses the profile's filter
+        work.filter = plan.filter
 
         if need_refs:  # the original over the training frames in the error window, once for every run
             for result in executor.run([shapes.run("reference", None, ("reference",), "reference frames")],
@@ -305,7 +317,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         # runtime's) and its timing runs; a started node is finished, none started past the budget
         kind = kinds.get("cache")
         groups = [Group(nid, [shapes.run(measure, spec, key, f"{nid} Δn={key[2]}")
-                              for measure, spec, key in kind.training(nid, settings, algorithm)])
+                              for measure, spec, key in kind.training(nid, settings, algorithm, work.filter)])
                   for nid in ids]
         runs = RunPlan(groups, done=lambda r: store.has_node_run(r.measure, r.key[1], r.key[2]),
                        budget=settings.budget_s, spent=store.spent_s,
@@ -317,7 +329,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         trained = [i for i in ids if _node_complete(store, i, settings)]
         if trained and need_overhead and timing:
             # the cached pipeline's frame time with almost nothing covered
-            spec = VariantSpec("cache", (trained[0],), algorithm, periods=(settings.timing_periods[-1],),
+            spec = VariantSpec("cache", (trained[0],), algorithm, work.filter, periods=(settings.timing_periods[-1],),
                                **settings.cache_options())
             overhead = RunSpec("overhead", spec, tuple(timing), OVERHEAD_SIZE, None, fmt, settings.clock,
                                ("overhead", trained[0]), f"{trained[0]} at {OVERHEAD_SIZE[0]}×{OVERHEAD_SIZE[1]}")

@@ -36,10 +36,11 @@ from rrcache.errors import RRCacheError
 from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH,
-                             REFRESH_MODES)
+                             FILTERS, REFRESH_MODES)
 
 #: the cache algorithms a profile may use; ``auto`` measures which is faster on this machine
 ALGORITHM_CHOICES = ("auto",) + tuple(ALGORITHMS)
+FILTER_CHOICES = ("auto",) + tuple(FILTERS)
 #: what ``auto`` stands for when nothing was measured (no node to time)
 DEFAULT_ALGORITHM = "three-pass"
 
@@ -114,6 +115,10 @@ class TrainingSettings:
       ``wall`` (the default; wall time around ``ctx.finish()``) or ``gl-timer`` (GL timer
       queries, for real GPUs). Keyed (another clock measures other times), except at its
       default, so stores trained before the clock was recorded keep their key.
+    - ``filter``: the cache's hit test and payload reconstruction; ``auto`` (the default)
+      measures ``bilinear`` against ``plane`` on the first node to train and keeps ``plane``
+      where it was faster at about the same PSNR (:mod:`rrcache.profiler.filters`; the choice is
+      kept in the plan).
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -137,6 +142,9 @@ class TrainingSettings:
     max_sets: int = 3
     #: the frame clock of the timed runs (rrcache.harness.timing.CLOCKS)
     clock: str = DEFAULT_CLOCK
+    #: the cache's hit test and payload reconstruction: ``auto`` measures ``bilinear`` against
+    #: ``plane`` on the first node (rrcache.profiler.filters), or one of rrcache.runtime.glsl.FILTERS
+    filter: str = "auto"
 
     def cache_options(self) -> dict:
         """The cache's run-time parameters besides the period, as the keyword arguments of
@@ -197,6 +205,8 @@ class TrainingSettings:
             raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
         if self.clock not in CLOCKS:
             raise _fail("clock", f"unknown frame clock {self.clock!r}", f"one of {', '.join(sorted(CLOCKS))}")
+        if self.filter not in FILTER_CHOICES:
+            raise _fail("filter", f"unknown filter {self.filter!r}", f"one of {', '.join(FILTER_CHOICES)}")
         if self.timing_format not in COLOR_FORMATS:
             raise _fail("timing_format", f"unknown colour format {self.timing_format!r}",
                         f"one of {', '.join(COLOR_FORMATS)}")
@@ -268,6 +278,8 @@ class TrainingSettings:
         data = {k: v for k, v in self.to_json().items() if k not in UNKEYED}
         if data.get("clock") == DEFAULT_CLOCK:  # as stores written before the clock was a setting
             del data["clock"]
+        if data.get("filter") == "auto":  # the default keys as before it existed: older stores resume
+            del data["filter"]
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def key_hash(self) -> str:

@@ -97,6 +97,12 @@ def _textures(session, names) -> tuple[dict, int]:
             if data.ndim == 3:
                 data = data[..., None]
             _, h, w, c = data.shape
+        if c < 4:  # RGBA everywhere: WebGL2 makes mipmaps of every RGBA format (not of RGB8, RGB32F ...);
+            # the missing channels read as GL reads them from a narrower texture: 0, 0, alpha 1
+            pad = np.zeros(data.shape[:-1] + (4 - c,), np.float32)
+            pad[..., -1] = 1.0
+            data = np.concatenate([np.asarray(data, np.float32), pad], axis=-1)
+            c = 4
         fmt, stored = _texture_format(data)
         total += stored.nbytes
         out[name] = {"kind": kind, "width": int(w), "height": int(h), "channels": int(c), "format": fmt,
