@@ -155,8 +155,8 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
             prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
-            if hasattr(executor, "record"):  # where the runs were made (a Dask cluster's workers)
-                prof.cluster = executor.record(capacity)
+            if hasattr(runner, "record"):  # where the runs were made (a Dask cluster's workers)
+                prof.cluster = runner.record(capacity)
             prof.write(out)
         except KeyboardInterrupt:
             _end_quietly(store, "interrupted")
