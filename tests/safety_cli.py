@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import json
 import os
+import sqlite3
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -79,3 +82,81 @@ def tree(folder: Path) -> dict:
             st = path.lstat()
             out[str(path)] = (st.st_size, st.st_mtime_ns)
     return out
+
+
+#: ``python -c`` of :func:`rrcache_traced`: rrcache's command line with an audit hook that logs
+#: every path the process opens through Python (``open()``, ``os.open``: every file rrcache
+#: reads or writes goes through them; C libraries get ``/proc/self/fd/N``)
+_TRACED = """
+import os, sys
+log = open(os.environ["RRCACHE_TEST_OPENS"], "a", encoding="utf-8", errors="replace")
+def hook(event, args):
+    if event == "open" and args and isinstance(args[0], (str, bytes)):
+        log.write(os.fsdecode(args[0]).replace("\\n", " ") + "\\n")
+        log.flush()
+sys.addaudithook(hook)
+from rrcache.cli import main
+main(sys.argv[1:])
+"""
+
+
+#: a small launcher between the test and the traced command: the kernel starts a child's peak
+#: memory count from its parent's resident size at the fork, so the command is forked from this
+#: fresh interpreter (tens of MiB), not from the test process, and its own peak is what is measured
+_LAUNCH = """
+import os, sys
+usage_file, argv = sys.argv[1], sys.argv[2:]
+pid = os.fork()
+if pid == 0:
+    os.execv(sys.executable, [sys.executable, *argv])
+_, status, usage = os.wait4(pid, 0)
+with open(usage_file, "w") as f:
+    f.write(str(usage.ru_maxrss))
+sys.exit(os.waitstatus_to_exitcode(status) % 256)
+"""
+
+
+def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
+    """``rrcache ARGS`` in ``cwd``, traced: (exit code, stdout, the non-empty stderr lines, the
+    command's peak resident memory in MiB (its own ``wait4`` rusage, forked from a small
+    launcher), every path it opened). A run past ``timeout`` seconds is killed (a hang guard,
+    not a timing)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="rrcache-traced-") as tmp:
+        names = {k: os.path.join(tmp, k) for k in ("out", "err", "opens", "usage")}
+        open(names["opens"], "w").close()
+        with open(names["out"], "w") as out, open(names["err"], "w") as err:
+            proc = subprocess.run([sys.executable, "-c", _LAUNCH, names["usage"], "-c", _TRACED, *map(str, args)],
+                                  cwd=cwd, stdin=stdin, env={**env(), "RRCACHE_TEST_OPENS": names["opens"]},
+                                  stdout=out, stderr=err, timeout=timeout)
+        read = lambda k: open(names[k], encoding="utf-8", errors="replace").read()  # noqa: E731
+        lines = [line for line in read("err").splitlines() if line.strip()]
+        return proc.returncode, read("out"), lines, int(read("usage")) / 1024, read("opens").splitlines()
+
+
+@pytest.fixture(scope="module")
+def made_profile(tmp_path_factory):
+    """A folder with ``scene.frag``, ``scene.json`` and ``p/``, their small profile (every
+    selection the original at this size: seconds), made once per test module for its tests to
+    copy."""
+    folder = tmp_path_factory.mktemp("made")
+    write_case(folder)
+    code, _, lines = rrcache(folder, "profile", "scene.frag", "scene.json", "--out", "p", *QUICK_PROFILE)
+    assert code == 0, lines
+    return folder
+
+
+def stored_error_runs(path) -> int:
+    """The error runs the store at ``path`` holds now, read without waiting on its writer (0 while
+    it is missing, being created or locked for a moment)."""
+    if not Path(path).exists():
+        return 0
+    try:
+        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=0.2)
+        try:
+            return int(conn.execute("SELECT COUNT(*) FROM error_run").fetchone()[0])
+        finally:
+            conn.close()
+    except sqlite3.Error:
+        return 0

@@ -238,3 +238,22 @@ def test_the_scene_table_shows_several_nodes_and_an_estimator():
     text = scene_markdown(scene)
     assert "| e2 | 0.0036 | `noise(p) + albedo * light` | 50 + 4 | 3.10× |" in text
     assert "| e1 | 0.0005 | `e1 m=4 λ=0.6 slots/frame u8: for (int i = 0; i < 16; i++)` | – | 2.20× |" in text
+
+
+def test_paper_size_measures_the_shipped_selections_again(quick_run):
+    """python -m rrcache.bench.paper_size: the bench's cached selections measured again over the
+    scene's session beside the original, each row beside the bench's figures."""
+    from rrcache.bench import paper_size
+
+    doc, folder, _, _ = quick_run
+    scene = doc["scenes"][0]
+    cached = [s for s in scene["selections"] if s["parts"]]
+    result = paper_size.run(folder / "out", scenes=("noise",), labels=("e1", "e2", "e3", "e4"), frames=4,
+                            progress=lambda *_: None)
+    assert [r.label for r in result.rows] == [s["label"] for s in cached]
+    for row, sel in zip(result.rows, cached):
+        assert row.frames == 4 and row.speedup > 0 and 0 <= row.hit_rate <= 1 and 0 < row.psnr <= 100
+        assert row.bench_speedup == pytest.approx(sel["measured_speedup"])
+        assert (row.limit_speedup is not None) == (row.label == scene["medium"])
+    assert result.markdown().count("| noise |") == 2 * len(cached)
+    assert paper_size.main([str(folder / "nowhere")]) == 2

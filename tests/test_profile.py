@@ -27,6 +27,7 @@ from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings, load_profile, read_store, select
 from rrcache.profiles.document import algorithm_line
 from rrcache.selection import CachedNode, Selection
+from rrcache.choice import write as choice_write
 
 from scene_files import SETTINGS, write_scene
 
@@ -103,7 +104,7 @@ def test_auto_algorithm_keeps_the_faster_variant(trained):
     # this tiny scene's selections are all the original (its variants cost more than it), so
     # write a trained node's variant the way selections are written
     node = prof.trained_nodes[0].id
-    prof.write_variant(Selection((CachedNode(node, 13),)), folder / "chosen")
+    choice_write(prof, Selection((CachedNode(node, 13),)), folder / "chosen")
     manifest = json.loads((folder / "chosen" / "manifest.json").read_text())
     assert manifest["algorithm"] == prof.algorithm and manifest["period"] == 13  # what it runs with
     assert manifest["runtime"] == {"block": 4, "refresh": "random", "depth_epsilon": 1e-3}
@@ -351,3 +352,21 @@ def test_store_matches_profile_json(trained):
         assert store.run_log()[-1]["status"] == "done"
         errs = {r.period: r.mean_error for r in store.error_runs(prof.nodes[0].id)}
     assert [errs[p] for p in (2, 4, 8)] == prof.nodes[0].errors
+
+
+def test_the_cache_filter_is_measured_and_kept(trained):
+    """``filter="auto"`` (the default): bilinear and plane measured on the first node, side by
+    side with the original (time) and in the error window (PSNR); the choice follows the rule
+    of rrcache.profiler.filters.pick and is the profile's, recorded in its plan."""
+    from rrcache.profiler.filters import pick
+
+    prof, events, _ = trained
+    times = prof.plan["filter_times"]
+    assert set(times) == {"bilinear", "plane"}
+    for measured in times.values():
+        assert 0 < measured["time"] < 100 and 0 < measured["psnr"] <= 100 and measured["period"] in (2, 4, 8)
+    assert prof.filter == prof.plan["filter"] == pick(times)
+    assert any(e.stage == "filter" for e in events)
+    # a resumed profile keeps the choice without measuring again
+    reread = load_profile(prof.path)
+    assert reread.filter == prof.filter

@@ -178,7 +178,7 @@ def test_a_pair_is_trained_kept_and_validated(tiny, gl_ctx, monkeypatch):
     assert 0.5 * max(e_a, e_b) <= option.trained_error <= 1.10 * (e_a + e_b), (option.trained_error, e_a, e_b)
     assert option.trained_ms > 0 and option.trained_psnr > 20 and option.trained_s > 0
     # kept: a second stage reads it back without rendering
-    monkeypatch.setattr(stage, "_Runner", lambda *a, **k: (_ for _ in ()).throw(AssertionError("rendered again")))
+    monkeypatch.setattr(stage, "train_set", lambda *a, **k: (_ for _ in ()).throw(AssertionError("rendered again")))
     again = SetOption([albedo, wave.id], [8, 4])
     store = ProfileStore.open(store_path, key)
     try:

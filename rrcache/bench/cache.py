@@ -171,7 +171,8 @@ class CacheBench:
         lines.append(f"Limit (every pixel hits): {self.limit_ms:.1f} ms against {self.limit_original_ms:.1f} ms, "
                      f"{100 * self.limit_fraction:.0f}% of the original: at most {self.limit_speedup:.2f}×.")
         same = [r.speedup for r in self.periods + self.algorithms + self.blocks + self.filters
-                if (r.algorithm, r.period, r.block, r.filter) == ("three-pass", self.compare_period, 4, DEFAULT_FILTER)]
+                if (r.algorithm, r.period, r.block) == ("three-pass", self.compare_period, 4)
+                and r.filter == (self.periods[0].filter if self.periods else DEFAULT_FILTER)]
         if self.no_refresh is not None and same:
             r, achieved = self.no_refresh, statistics.median(same)
             lines += ["", f"Where the time between the limit and Δn={self.compare_period} goes (three-pass, k=4): "
@@ -191,40 +192,43 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         progress: Optional[Callable[[str, int, int], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
         limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT, vertex: Optional[str] = None,
         include_dirs=(), filters=(), misses: bool = False, limit_filter: str = DEFAULT_FILTER,
-        algorithms=("three-pass", "two-pass", "one-pass")) -> CacheBench:
+        algorithms=("three-pass", "two-pass", "one-pass"), base_filter: str = DEFAULT_FILTER,
+        term_scores=None) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
     ``limit_algorithm`` and ``limit_filter``; every render draws into a ``color_format`` colour
-    target (the errors are then those of that format). ``algorithms``: those compared at the
+    target (the errors are then those of that format). ``base_filter``: the filter of every row
+    but the filters' own (a profile's); ``term_scores``: a profile's measured order of sums (its node
+    ids refer to it). ``algorithms``: those compared at the
     compared period (the ones the node allows). ``filters``: the filters timed at the
     compared period; ``misses``: each of them (bilinear when none) measured again with the misses
     sorted by cause. ``progress(message, done, total)`` after each step. ``vertex``: the user's
     vertex shader (None: the session's, else generated)."""
     step = {"done": 0}
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex, term_scores=term_scores)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution
     bench = CacheBench(shader_path, session_path, node_id, entry.text, tuple(size), len(indices),
                        compare_period=compare_period, color_format=color_format)
 
-    plan = [("periods", f"Δn={period}", "three-pass", period, 4, period, DEFAULT_FILTER) for period in periods]
+    plan = [("periods", f"Δn={period}", "three-pass", period, 4, period, base_filter) for period in periods]
     # only the algorithms the node table allows for this node (one-pass cannot cache a value
     # that needs screen-space derivatives)
-    plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period, DEFAULT_FILTER)
+    plan += [("algorithms", algorithm, algorithm, compare_period, 4, compare_period, base_filter)
              for algorithm in algorithms
              if algorithm in getattr(entry, "algorithms", ("three-pass", "two-pass", "one-pass"))]
-    plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period, DEFAULT_FILTER)
+    plan += [("blocks", f"k={block}", "three-pass", compare_period, block, compare_period, base_filter)
              for block in blocks]
     if periods:
-        plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH, DEFAULT_FILTER))
+        plan.append(("no_refresh", "no refresh", "three-pass", compare_period, 4, NO_REFRESH, base_filter))
     plan += [("filters", filter_, "three-pass", compare_period, 4, compare_period, filter_) for filter_ in filters]
     variants = {}
     for _group, _label, algorithm, period, _block, _run, filter_ in plan:
         if (algorithm, filter_) not in variants:
             variants[(algorithm, filter_)] = variant_for(work, node_id, algorithm, filter=filter_)
-    miss_filters = list(filters or (DEFAULT_FILTER,)) if misses else []
+    miss_filters = list(filters or (base_filter,)) if misses else []
     total = len(plan) * repeats + len(miss_filters) + 1
 
     def say(message):  # after each step: the reporter counts finished work

@@ -46,6 +46,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from rrcache import atomic
 from rrcache.bench.scenes import Scene, scaled_session
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json as _finite
@@ -164,6 +165,11 @@ class SceneResult:
     notes: list = field(default_factory=list)
     wall_s: float = 0.0
     figure: Optional[str] = None
+    #: the cache filter the profile chose (rrcache.profiler.filters) and what each candidate measured
+    filter: Optional[str] = None
+    filter_times: Optional[dict] = None
+    #: the medium selection's misses by cause (rrcache.bench.cache.MissRow as JSON)
+    misses: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         out = asdict(self)
@@ -369,8 +375,9 @@ def render_cache_row(work, session, frames, search, target, settings, progress, 
     found = tune_samples(work.prepared, session, search, target, base, rel_tol=settings.tolerance,
                          max_steps=settings.max_steps, progress=step)
     final = compare(work.prepared, session, frames, replace(base, samples=found.value), on_frame=on_frame)
-    row = MethodRow(RENDER_CACHE, f"{found.value:.2%} of the pixels per frame ({final.budget} pixels, "
-                                  f"{base.block}×{base.block} blocks, {base.points_per_pixel:g} points per pixel)",
+    chosen = replace(base, samples=found.value)
+    row = MethodRow(RENDER_CACHE, f"{chosen.describe().split(': ', 1)[1]} ({final.budget} pixels), a cache of "
+                                  f"{base.points_per_pixel:g}× the pixels",
                     final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
                     final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                     [list(s) for s in found.steps])
@@ -461,6 +468,11 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         warnings.simplefilter("always")
         prof = profile(scene.shader, session_path, folder, training, progress=on_event, plots=settings.plots)
     result.notes += [f"profile: {w.message}" for w in caught]
+    if prof.term_scores:  # the profile measured the order of its sums: its node ids refer to it
+        work = load_for_session(scene.shader, session, term_scores=prof.term_scores)
+    work.filter = prof.filter  # the selections compile with the profile's filter
+    result.filter = prof.filter
+    result.filter_times = (prof.plan or {}).get("filter_times")
     counts = prof.counts or {}
     result.profile = str(folder)
     # the profiler's precomputation time: every invocation on its store added up (older
@@ -492,11 +504,11 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     if medium.label != MEDIUM:
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
-    if medium.kind != "cache":  # an amortized estimator or several nodes: the algorithms and limit are one node's
-        what = ("amortized sampling" if medium.kind == "amortize" else "several cached nodes" if medium.multi
-                else f"a selection of kind {medium.kind}")
-        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({what}): the "
-                            "algorithms and the all-hit limit are measured for a single cached node only")
+    if not medium.choice.one_node:  # an amortized estimator, several nodes: the algorithms and limit are one node's
+        if medium.multi:  # the all-hit limit of the set (the algorithms and the misses are one node's)
+            _set_limit(prof, work, session, frames, medium, result, progress)
+        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({medium.choice.title}): the "
+                            "algorithms and the miss breakdown are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:
             result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
             originals += [r.original_ms for r in result.equal_time[1:]]
@@ -506,7 +518,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     _say(progress, f"algorithms and limit on {medium.node}")
     bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
+                            base_filter=prof.filter, limit_filter=prof.filter, misses=True,
+                            term_scores=prof.term_scores,
                             progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
+    result.misses = [asdict(m) for m in bench.misses]
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
                                    r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]
     originals += [r.original_ms for r in result.algorithms]
@@ -523,6 +538,21 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     result.original_ms = float(statistics.median(originals)) if originals else _original_ms(work, session, frames)
     result.wall_s = time.time() - started
     return result
+
+
+def _set_limit(prof, work, session, frames, medium: Selection, result: "SceneResult", progress) -> None:
+    """The all-hit limit of a selection of several nodes: its variant with every node hitting."""
+    from rrcache.harness.limit import all_hit_limit, probe_frames
+    from rrcache.pipeline import variant_for_selection
+
+    _say(progress, f"limit of {medium.describe()}")
+    variant, periods = variant_for_selection(work, medium)
+    options = prof.settings.cache_options()
+    limit = all_hit_limit(variant, session, work.prepared, probe_frames(frames), None, period=periods,
+                          color_format=prof.settings.timing_format, **options)
+    result.limit_ms, result.limit_original_ms = limit.limit_ms, limit.original_median_ms
+    result.limit_speedup = limit.original_median_ms / limit.limit_ms
+    result.limit_algorithm = prof.algorithm
 
 
 def _original_ms(work, session, frames) -> float:
@@ -571,6 +601,4 @@ def run(scenes: list, settings: BenchSettings = FULL, out="rrcache-bench", progr
 
 
 def _write(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    atomic.write_text(path, text)

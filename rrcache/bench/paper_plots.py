@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rrcache.report.agg import agg_pyplot
+from rrcache.report.agg import agg_pyplot, save_figure
 
 
 def _x(speedup):
@@ -64,7 +64,7 @@ def write_scene_plot(scene, out) -> str:
         ax.grid(alpha=0.3)
         fig.tight_layout()
         path = Path(out) / f"{scene.name}-error-time.png"
-        fig.savefig(path)
+        save_figure(fig, path)
     finally:
         plt.close(fig)
     return str(path)

@@ -12,11 +12,13 @@ import importlib
 import math
 import os
 import sys
+import traceback
 
 import click
 
 from rrcache import watchdog
-from rrcache.budgets import budget, reset_budget
+from rrcache.cli import interrupt
+from rrcache.budgets import MAX_READ_BYTES, budget, reset_budget
 from rrcache.errors import RRCacheError, printable
 
 # subcommand name -> module in rrcache.cli (each module defines a click command named `command`)
@@ -56,16 +58,24 @@ class _LazyGroup(click.Group):
               help=f"Refuse expressions nested deeper (default {budget.expression_depth:,}).")
 @click.option("--max-texture-pixels", type=click.IntRange(min=1), default=None, metavar="N",
               help=f"Refuse textures of more pixels, read from the header (default {budget.image_pixels:,}).")
-@click.option("--max-source-bytes", type=click.IntRange(min=1), default=None, metavar="N",
+@click.option("--max-source-bytes", type=click.IntRange(min=1, max=MAX_READ_BYTES), default=None, metavar="N",
               help=f"Refuse shaders whose sources (with includes) are larger (default {budget.source_bytes:,}).")
+@click.option("--max-document-bytes", type=click.IntRange(min=1, max=MAX_READ_BYTES), default=None, metavar="N",
+              help=f"Refuse larger session files and profile.json (default {budget.document_bytes:,}).")
+@click.option("--max-asset-bytes", type=click.IntRange(min=1, max=MAX_READ_BYTES), default=None, metavar="N",
+              help=f"Refuse larger mesh and texture files, measured before reading (default {budget.asset_bytes:,}).")
+@click.option("--max-session-values", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Refuse sessions of more JSON values, keyframes mostly (default {budget.session_values:,}).")
+@click.option("--max-session-objects", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Refuse sessions of more objects (default {budget.session_objects:,}).")
 @click.option("--frame-timeout", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
               help="Stop with an error when one frame takes longer than S seconds (what is done is kept).")
 @click.option("--allow-outside-paths", is_flag=True,
               help="Let sessions name meshes, textures and include folders outside their own folder tree.")
 @click.version_option(package_name="rrcache")
 @click.pass_context
-def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, frame_timeout,
-        allow_outside_paths):
+def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, max_document_bytes,
+        max_asset_bytes, max_session_values, max_session_objects, frame_timeout, allow_outside_paths):
     """rrcache: speed up expensive pixel shaders with a reverse reprojection cache."""
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
@@ -76,8 +86,11 @@ def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_byt
         budget.expression_depth = max_depth
     if max_texture_pixels is not None:
         budget.image_pixels = max_texture_pixels
-    if max_source_bytes is not None:
-        budget.source_bytes = max_source_bytes
+    for name, value in (("source_bytes", max_source_bytes), ("document_bytes", max_document_bytes),
+                        ("asset_bytes", max_asset_bytes), ("session_values", max_session_values),
+                        ("session_objects", max_session_objects)):
+        if value is not None:
+            setattr(budget, name, value)
     budget.allow_outside_paths = allow_outside_paths
     if frame_timeout is not None and not math.isfinite(frame_timeout):
         raise click.BadParameter("must be a finite number of seconds", param_hint="--frame-timeout")
@@ -100,11 +113,31 @@ def _environment_error(err: OSError) -> None:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
     hint = {errno.ENOSPC: "free disk space and run the command again",
+            errno.EBADF: "run it with its output open (a closing '>&-' leaves it none), or redirect it to a file",
             errno.EROFS: "write to a folder on a writable file system (--out)",
             errno.EACCES: "choose a folder you can write to (--out)",
             errno.EPIPE: "the reader of the output went away"}.get(err.errno, "check the path and the disk")
     click.echo(f"rrcache: error: {printable(str(where))}: {printable(err.strerror or str(err))} (hint: {hint})", err=True)
     sys.exit(2)
+
+
+class _ClosedOutput:
+    """``sys.stdout`` when the process started without descriptor 1: the first write is an
+    ``OSError`` the command line reports in one line (exit 2) after the work is done and saved."""
+
+    encoding = "utf-8"
+
+    def write(self, text):
+        raise OSError(errno.EBADF, "standard output is closed", "output")
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return False
+
+    def fileno(self):
+        raise OSError(errno.EBADF, "standard output is closed", "output")
 
 
 _ARGV = None  # the arguments main() was given (for the frame watchdog's child process)
@@ -115,12 +148,15 @@ def main(argv=None):
     global _ARGV
     _ARGV = list(argv) if argv is not None else None
     debug = "--debug" in (argv if argv is not None else sys.argv[1:])
+    interrupt.install()
+    if sys.stdout is None:  # started with its standard output closed ('>&-')
+        sys.stdout = _ClosedOutput()
     try:
         cli.main(args=argv, prog_name="rrcache", standalone_mode=False)
         sys.stdout.flush()  # a full or closed output fails here, while we can still say so
     except RRCacheError as err:
-        if debug:
-            raise
+        if debug:  # the traceback, then the same line and the same exit code as without --debug
+            traceback.print_exc()
         click.echo(f"rrcache: error: {printable(str(err))}", err=True)
         sys.exit(2)
     except click.exceptions.Abort:
@@ -138,13 +174,13 @@ def main(argv=None):
         click.echo(f"rrcache: error: {printable(err.format_message())}{hint}", err=True)
         sys.exit(err.exit_code)
     except KeyboardInterrupt:
-        click.echo("rrcache: interrupted", err=True)
-        sys.exit(130)
+        click.echo(f"rrcache: {interrupt.word()}", err=True)
+        sys.exit(interrupt.exit_code())
     except SystemExit:
         raise
     except OSError as err:  # the machine's side: a full disk, a read-only folder, a closed pipe
         if debug:
-            raise
+            traceback.print_exc()
         _environment_error(err)
     except Exception as err:  # an internal error: say so plainly, traceback only with --debug
         if debug:

@@ -43,55 +43,25 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
     prof = load_profile(profile_path)
     prof.include_dirs = list(include_dirs) + prof.include_dirs
     choice = prof.select(max_error) if max_error is not None else prof.select_psnr(min_psnr)
-    written = prof.write_variant(choice, out_dir) if out_dir else []
+    written = choice_write(prof, choice, out_dir) if out_dir else []
     level = f"error {max_error:g}" if max_error is not None else f"PSNR ≥ {min_psnr:g} dB"
     if as_json:
-        if choice.kind == "amortize":  # amortized sampling: the estimator, m and λ
-            part = choice.parts[0]
-            data = {"node": None, "period": None, "kind": "amortize", "estimator": part.estimator,
-                    "samples": part.samples, "of": prof.estimator(part.estimator).samples, "blend": part.blend,
-                    "history": part.history, "phase": part.phase, "filter": part.filter, "payload": part.payload,
-                    "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
-                    "predicted_speedup": float(choice.predicted_speedup),
-                    "predicted_speedup_range": list(choice.predicted_speedup_range),
-                    "predicted_psnr": choice.predicted_psnr,
-                    "predicted_psnr_uncertainty": choice.predicted_psnr_uncertainty,
-                    "exact": choice.exact, "visible_artifacts": choice.visible_artifacts}
-            click.echo(json.dumps(finite_json(data)))
-            return
-        if choice.multi:  # several nodes: "n12+n40" and one period each
-            data = {"node": "+".join(choice.nodes), "period": list(choice.periods), "nodes": list(choice.nodes),
-                    "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
-                    "predicted_speedup": float(choice.predicted_speedup)}
-            click.echo(json.dumps(finite_json(data)))
-            return
-        data = {"node": choice.node, "period": None if choice.period is None else int(choice.period),
-                "predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
-                "predicted_speedup": float(choice.predicted_speedup),
-                "predicted_speedup_range": list(choice.predicted_speedup_range),
-                "predicted_psnr": choice.predicted_psnr, "predicted_psnr_uncertainty": choice.predicted_psnr_uncertainty,
-                "exact": choice.exact, "visible_artifacts": choice.visible_artifacts}
-        click.echo(json.dumps(finite_json(data)))
+        figures = {"predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
+                   "predicted_speedup": float(choice.predicted_speedup),
+                   "predicted_speedup_range": list(choice.predicted_speedup_range),
+                   "predicted_psnr": choice.predicted_psnr,
+                   "predicted_psnr_uncertainty": choice.predicted_psnr_uncertainty,
+                   "exact": choice.exact, "visible_artifacts": choice.visible_artifacts}
+        # what is chosen, as its kind of choice says it (rrcache.kinds); the original: node null
+        what = choice.choice.summary(choice, prof) if choice.parts else {"node": None, "period": None}
+        click.echo(json.dumps(finite_json({**what, **figures})))
         return
-    if choice.kind == "amortize":
-        part = choice.parts[0]
-        click.echo(f"amortize {part.estimator} ({part.text}): {part.samples} of "
-                   f"{prof.estimator(part.estimator).samples} terms per frame, {_history(part)}, λ = {part.blend:g}: "
-                   f"predicted "
-                   f"error {choice.predicted_error:.4g}, PSNR {psnr_text(choice.predicted_psnr)} ± "
-                   f"{choice.predicted_psnr_uncertainty or 0:.1f} dB, {choice.predicted_ms:.3f} ms per frame, "
-                   f"{choice.predicted_speedup:.2f}× the original")
-    elif choice.multi:
-        texts = "; ".join(prof.node(n).text for n in choice.nodes)
-        click.echo(f"cache {choice.describe()} ({texts}): predicted error {choice.predicted_error:.4g}, "
-                   f"{choice.predicted_ms:.3f} ms per frame, {choice.predicted_speedup:.2f}× the original")
-    elif choice.node is None:
+    if not choice.parts:
         reason = prof.verdict["answer"] if prof.verdict is not None else f"nothing is predicted faster within {level}"
         click.echo(f"the original shader: {reason} ({choice.predicted_ms:.3f} ms per frame)")
     else:
-        text = prof.node(choice.node).text
         lo, hi = choice.predicted_speedup_range or (choice.predicted_speedup, choice.predicted_speedup)
-        click.echo(f"cache {choice.node} ({text}) every Δn = {int(choice.period)} frames: predicted error "
+        click.echo(f"{choice.choice.sentence(choice, prof)}: predicted error "
                    f"{choice.predicted_error:.4g}, PSNR {psnr_text(choice.predicted_psnr)} ± "
                    f"{choice.predicted_psnr_uncertainty or 0:.1f} dB, {choice.predicted_ms:.3f} ms per frame, "
                    f"{choice.predicted_speedup:.2f}× ({lo:.2f}–{hi:.2f}) the original")
@@ -101,9 +71,5 @@ def command(profile_path, max_error, min_psnr, as_json, out_dir, include_dirs):
         click.echo(f"wrote {len(written)} files to {out_dir}")
 
 
-def _history(part) -> str:
-    """How the amortized choice keeps its history, in words."""
-    if part.history == "slots":
-        return ("slots history (the N/m subset sums kept apart, each blended with its own"
-                + (", in 8 bits by the terms' range)" if part.payload == "u8" else ")"))
-    return "blend history (one running estimate)"
+from rrcache.kinds.amortize import history_words as _history  # noqa: E402,F401 (the words, the kind's)
+from rrcache.choice import write as choice_write

@@ -23,7 +23,7 @@ from rrcache.glsl import ast as A
 from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.builtins import NON_FRAGMENT_VARIABLES
 from rrcache.glsl.parser import parse_preprocessed
-from rrcache.glsl.preprocessor import preprocess
+from rrcache.glsl.preprocessor import preprocess, read_source
 from rrcache.glsl.semantic import SemanticInfo, check
 from rrcache.glsl.types import Type
 
@@ -125,7 +125,7 @@ def parse_shader(source: str, filename: str = "<string>",
     _reject_multiple_outputs(frag_data, info)
     path = None if filename.startswith("<") else filename
     files = list(pp.files) or ([filename] if path else [])
-    digests = file_digests(source, files, filename)
+    digests = file_digests(source, files, filename, pp.file_hashes)
     return Shader(
         path=path, source=source, unit=unit, info=info, version=info.version,
         profile=unit.profile or ("es" if info.es else None),
@@ -179,39 +179,16 @@ def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
     Type('vec3')
     """
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as f:
-            data = f.read(budget.source_bytes + 1)
-    except OSError as e:
-        raise GLSLError(f"cannot read shader file '{path}': {e.strerror or e}", None,
-                        "check the path" if isinstance(e, FileNotFoundError) else None) from None
-    if len(data) > budget.source_bytes:
-        raise GLSLError(f"the shader file is larger than {budget.source_bytes:,} bytes, the analysis budget",
-                        SourceLoc(path, 1, 1), "raise it with 'rrcache --max-source-bytes N ...'")
-    try:
-        source = data.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        line = data.count(b"\n", 0, e.start) + 1
-        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
-        raise GLSLError("the shader file is not valid UTF-8", SourceLoc(path, line, col),
-                        "save the shader as UTF-8") from None
+    source, _ = read_source(path)
     return parse_shader(source, path, defines, include_dirs)
 
 
-def file_digests(source: str, files: list[str], filename: str) -> list[str]:
+def file_digests(source: str, files: list[str], filename: str, read: Mapping[str, str]) -> list[str]:
     """The sha256 of each file's content, ``files`` order: the main file's from ``source`` (the
-    text that was parsed), the included ones as read from disk now."""
-    out = []
-    for path in files or [filename]:
-        if path == filename:
-            out.append(hashlib.sha256(source.encode("utf-8")).hexdigest())
-            continue
-        try:
-            with open(path, "rb") as f:
-                out.append(hashlib.sha256(f.read()).hexdigest())
-        except OSError:
-            out.append("<unreadable>")
-    return out
+    text that was parsed), the included ones' from what the preprocessor read (``read``:
+    :attr:`~rrcache.glsl.preprocessor.Preprocessed.file_hashes`); no file is opened again."""
+    return [hashlib.sha256(source.encode("utf-8")).hexdigest() if path == filename else read[path]
+            for path in files or [filename]]
 
 
 def _hash(digests: list[str], defines: Mapping[str, object]) -> str:

@@ -80,11 +80,16 @@ def read_manifest(path) -> tuple[list[LibraryEntry], dict]:
     docstring)."""
     path = Path(path)
     where = str(path)
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise RRCacheError("no such manifest", where, hint="give a JSON or TOML file listing shaders and sessions") from None
-    except (OSError, UnicodeDecodeError) as err:
+        text = read_file(path, budget.document_bytes).data.decode("utf-8")
+    except Refused as err:
+        if err.kind == "missing":
+            raise RRCacheError("no such manifest", where, hint="give a JSON or TOML file listing shaders and sessions") from None
+        raise RRCacheError(f"cannot read the manifest: it {err.reason}", where, hint="give a UTF-8 JSON or TOML file") from None
+    except UnicodeDecodeError as err:
         raise RRCacheError(f"cannot read the manifest ({err})", where, hint="give a UTF-8 JSON or TOML file") from None
     if path.suffix.lower() == ".toml":
         data = _toml(text, where)

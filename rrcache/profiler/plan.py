@@ -69,19 +69,26 @@ class Plan:
     algorithm_times: Optional[dict] = None
     #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON), once measured
     ceiling: Optional[dict] = None
+    #: the cache filter of the profile (``auto`` settings: :mod:`rrcache.profiler.filters`) and
+    #: what each candidate measured; None in plans made before the choice existed (bilinear)
+    filter: Optional[str] = None
+    filter_times: Optional[dict] = None
 
     def to_json(self) -> dict:
         return {"error_window": list(self.error_window) if self.error_window else None,
                 "timing_window": list(self.timing_window) if self.timing_window else None,
                 "original_ms": self.original_ms, "algorithm": self.algorithm,
-                "algorithm_times": self.algorithm_times, "ceiling": self.ceiling}
+                "algorithm_times": self.algorithm_times, "ceiling": self.ceiling,
+                "filter": self.filter, "filter_times": self.filter_times}
 
     @classmethod
     def from_json(cls, data: dict) -> "Plan":
         ew, tw = data.get("error_window"), data.get("timing_window")
         return cls(tuple(int(v) for v in ew) if ew else None, tuple(int(v) for v in tw) if tw else None,
                    float(data.get("original_ms", float("nan"))), data.get("algorithm"),
-                   data.get("algorithm_times"), data.get("ceiling"))
+                   data.get("algorithm_times"), data.get("ceiling"),
+                   # a plan that chose its algorithm before the filter existed trained bilinear
+                   data.get("filter", "bilinear" if data.get("algorithm") else None), data.get("filter_times"))
 
 
 def fraction_for(original_ms: float, target_ms: float, cap: float, floor: float = MIN_FRACTION) -> float:

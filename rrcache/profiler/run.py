@@ -24,7 +24,10 @@ import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache import kinds
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -34,6 +37,7 @@ from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
 from rrcache.selection import Selection
+from rrcache.choice import write as choice_write
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -48,7 +52,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None) -> Profile:
+            vertex=None, adaptive=None, executor=None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -58,7 +62,14 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`).
+    same level (:mod:`rrcache.profiler.adaptive`). ``executor``: a callable ``(work, session) ->
+    executor`` making what runs the training's :class:`~rrcache.runs.RunSpec` s (its
+    ``run(specs, on_frame=None)`` yields a :class:`~rrcache.runs.RunResult` per spec, in any order;
+    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`). A
+    factory with a ``capacity`` (runs made at once: a Dask cluster's workers,
+    :class:`rrcache.cluster.client.Cluster`) buys a larger default plan
+    (:mod:`rrcache.profiler.capacity`); an executor with a ``record(capacity)`` has it kept in
+    ``Profile.cluster``.
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -69,8 +80,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught)
+                prof = _profile(shader_path, session_path, out_dir, settings, caught, defines=defines,
+                                progress=progress, fresh=fresh, plots=plots, include_dirs=include_dirs, wait=wait,
+                                vertex=vertex, adaptive=adaptive, executor=executor)
             finally:
                 raised = list(caught)
     finally:
@@ -79,15 +91,23 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     return prof
 
 
-def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list) -> Profile:
+def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defines, progress, fresh, plots,
+             include_dirs, wait, vertex, adaptive, executor) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
 
     session = load_session(session_path)
     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
-    resolved = (settings or TrainingSettings()).resolved(session)
+    settings = settings or TrainingSettings()
+    capacity = None
+    if executor is not None and getattr(executor, "capacity", None):
+        # an executor that makes several runs at once buys a larger default plan: more training
+        # frames and more nodes (rrcache.profiler.capacity)
+        from rrcache.profiler.capacity import scaled
+
+        settings, capacity = scaled(settings, session, int(executor.capacity))
+    resolved = settings.resolved(session)
     from rrcache.profiler.amortize import estimator_table
 
     estimator_table(work)  # a malformed '#pragma rrcache estimator': said before anything is trained
@@ -100,24 +120,43 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
     try:
         store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
         started = time.time()
+        compiled = sum(kinds.compile_counts().values())
+        make_executor, runner = executor, None
         try:
             store.begin_run()
-            result = train(work, session, resolved, store, progress)
+            if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
+                from rrcache.profiler.terms import scores_for
+
+                scores = scores_for(work, session, store, progress)
+                if scores:
+                    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
+                                            term_scores=scores)
+            # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+            # the original's reference frames rendered once
+            runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
+            result = train(work, session, resolved, store, progress, executor=runner)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
-            prof.sets = _sets(prof, work, session, resolved, store, progress)
+            prof.term_scores = dict(work.term_scores)
+            prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress)
+            prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
+            runner.close()  # validation renders side by side with its own renderers
             prof.selections = _selections(prof, work, session, resolved, result, store, progress)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
-                                         window=result.plan.timing_window if result.plan is not None else None)
+                                         window=result.plan.timing_window if result.plan is not None else None,
+                                         store=store, executor=runner)
             prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
+            # how many variants this invocation compiled (each at most once: the compile cache)
+            prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
+            if hasattr(runner, "record"):  # where the runs were made (a Dask cluster's workers)
+                prof.cluster = runner.record(capacity)
             prof.write(out)
         except KeyboardInterrupt:
             _end_quietly(store, "interrupted")
@@ -125,6 +164,9 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
         except BaseException:
             _end_quietly(store, "failed")
             raise
+        finally:
+            if runner is not None:
+                runner.close()
         store.close()
     finally:
         lock.release()
@@ -188,6 +230,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
+        filter=(plan.filter if plan is not None and plan.filter else "bilinear"),
         nodes=nodes, defines=dict(work.defines), include_dirs=list(work.include_dirs), plan=plan.to_json() if plan is not None else None,
         untrained=list(result.untrained), budget_stopped=result.budget_stopped,
         mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,
@@ -202,12 +245,12 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     return prof
 
 
-def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+def _sets(prof: Profile, work, session, settings, store, progress, executor=None) -> list:
     """The sets of several cached nodes predicted to improve the front, the few picked trained
     (:mod:`rrcache.profiler.sets`)."""
     from rrcache.profiler.sets import train_sets
 
-    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets, executor=executor)
 
 
 def _psnr_offset(store, settings, result: TrainingResult) -> float:
@@ -285,25 +328,28 @@ def _verdict(ceiling) -> dict:
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
-    """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    out.mkdir(parents=True, exist_ok=True)
+    """The shader files of each selection, then (with ``plots``) the plots, the report's frames
+    (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
     kept = []
-    for sel in prof.selections:
-        folder = out / "optimized" / sel.label
-        if folder.exists():
-            for old in folder.iterdir():
-                if old.is_file():
-                    old.unlink()
-        prof.write_variant(sel, folder, work=work)
-        kept.append(sel.replace(files=str(folder.relative_to(out))))
+    # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
+    # refused, never followed, and the old files of a selection are removed only inside it
+    with OutputFolder(out) as root, root.folder("optimized") as optimized:
+        for sel in prof.selections:
+            with optimized.folder(sel.label) as folder:
+                folder.remove_files()
+                choice_write(prof, sel, folder, work=work)
+            kept.append(sel.replace(files=f"optimized/{sel.label}"))
+        if prof.verdict is not None:  # stopped before training: nothing to plot or report
+            with optimized.folder("original") as folder:
+                choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), folder)
+            plots = False
     prof.selections = kept
     prof.path = out
-    if prof.verdict is not None:  # stopped before training: nothing to plot or report
-        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
-        plots = False
     if plots:
+        from rrcache.profiler.frames import write_frames
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
         prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_report(prof, out, work=work)
+        write_frames(prof, out, work)
+        write_report(prof, out)

@@ -186,8 +186,10 @@ class Chromium:
             params.update(captureBeyondViewport=True,
                           clip={"x": 0, "y": 0, "width": size["width"], "height": size["height"], "scale": 1})
         data = base64.b64decode(self.send("Page.captureScreenshot", **params)["data"])
+        from rrcache.atomic import write_bytes
+
         path = Path(path)
-        path.write_bytes(data)
+        write_bytes(path, data)
         return path
 
     def errors(self) -> list[str]:

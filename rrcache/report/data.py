@@ -14,12 +14,15 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Optional
 
 import numpy as np
 
-from rrcache.errors import RRCacheError
+
+def _plot_label(sel) -> dict:
+    """The chart's ``node`` and ``period`` of a selection (its kind's; the original: none)."""
+    node, period = sel.choice.plot_label(sel) if sel.parts else (None, None)
+    return {"node": node, "period": period}
 
 
 def _num(value) -> Optional[float]:
@@ -54,10 +57,7 @@ def chart_data(prof) -> dict:
             if point[1] < best:
                 front.append(point)
                 best = point[1]
-    selections = [{"label": s.label, "node": "+".join(s.nodes) if s.multi else (s.describe() if s.kind == "amortize"
-                                                                              else s.node),
-                   "period": list(s.periods) if s.multi else (None if s.kind == "amortize" else s.period),
-                   "what": s.describe(),
+    selections = [{"label": s.label, **_plot_label(s), "what": s.describe(),
                    "ms": _num(s.predicted_ms), "error": _num(s.predicted_error)} for s in prof.selections]
     # the amortized estimators' options (estimator, m, λ) on the same axes
     amortized = [[float(o.predicted_ms), float(o.predicted_error), o.describe()] for o in options]
@@ -107,12 +107,9 @@ def node_details(prof, node_id: str) -> dict:
 
 def read_source(prof) -> list[str]:
     """The profiled shader's lines (RRCacheError naming the file when it cannot be read)."""
-    path = Path(prof.shader)
-    try:
-        return path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as err:
-        raise RRCacheError(f"cannot read the profiled shader ({err.strerror})", str(path),
-                           hint="the profile names the shader by its absolute path; put it back there") from None
+    from rrcache.profiles.inputs import shader_source
+
+    return shader_source(prof).splitlines()
 
 
 def source_lines(prof) -> list[dict]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import html
 import json
+import os
 from pathlib import Path
 from typing import Optional
 
@@ -54,10 +55,13 @@ def read_manifest(prof, sel) -> Optional[dict]:
     """The level's ``manifest.json`` as the profile wrote it, or None (not written, or moved)."""
     if not sel.files or prof.path is None:
         return None
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     path = Path(prof.path) / sel.files / "manifest.json"
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    try:  # by rrcache.files' rule, inside the profile's folder (profile.json names the folder)
+        return json.loads(read_file(path, budget.document_bytes, [os.path.realpath(prof.path)]).data)
+    except (Refused, ValueError):
         return None
 
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rrcache.report.agg import agg_pyplot
+from rrcache.report.agg import agg_pyplot, save_figure
 
 PERIODS = np.arange(1, 51)
 
@@ -126,7 +126,7 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
     fig.tight_layout()
     paths = [str(Path(out_dir) / "tradeoff.png"), str(Path(out_dir) / "tradeoff.svg")]
     for path in paths:
-        fig.savefig(path)
+        save_figure(fig, path)
     plt.close(fig)
     return paths
 
@@ -149,7 +149,7 @@ def plot_hitrate(prof, out_dir) -> list[str]:
     ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
     path = str(Path(out_dir) / "hitrate.png")
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return [path]
 
@@ -163,8 +163,9 @@ def plot_validation(prof, out_dir) -> list[str]:
     fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4), dpi=110)
     for ax, pred, meas, name in ((a, "predicted_error", "measured_error", "mean RGB L2 error"),
                                  (b, "predicted_ms", "measured_ms", "ms per frame")):
-        xs = [getattr(s, pred) for s in rows]
-        ys = [getattr(s, meas) for s in rows]
+        pairs = [(getattr(s, pred), getattr(s, meas)) for s in rows
+                 if getattr(s, pred) is not None and getattr(s, meas) is not None]
+        xs, ys = [p[0] for p in pairs], [p[1] for p in pairs]
         top = max(xs + ys + [1e-9]) * 1.15
         ax.plot([0, top], [0, top], "--", color="gray", lw=1)
         ax.plot(xs, ys, "o", color="tab:red")
@@ -179,7 +180,7 @@ def plot_validation(prof, out_dir) -> list[str]:
     b.set_title("time: model against render")
     fig.tight_layout()
     path = str(Path(out_dir) / "validation.png")
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return [path]
 

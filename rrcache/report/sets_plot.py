@@ -59,7 +59,7 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
     original, a validation's against its own): the single-node front, the front with the trained
     sets, the sets (predicted, and trained joined to their prediction, numbered as listed under
     the panel) and the validated selections."""
-    from rrcache.report.agg import agg_pyplot
+    from rrcache.report.agg import agg_pyplot, save_figure
 
     plt = agg_pyplot()
     profiles = list(profiles)
@@ -88,7 +88,7 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
         for sel in prof.selections:
             if sel.measured_speedup and sel.parts:
                 x = 1.0 / float(sel.measured_speedup)
-                ax.plot([x], [sel.measured_error], "*" if sel.multi else "s", color="crimson", ms=9, mfc="none")
+                ax.plot([x], [sel.measured_error], sel.choice.marker if sel.parts else "s", color="crimson", ms=9, mfc="none")
                 ax.annotate(sel.label, (x, sel.measured_error), textcoords="offset points", xytext=(-14, 4),
                             fontsize=7, color="crimson")
         ax.plot([], [], "D", color="darkorange", label="set: predicted (hollow) → trained (filled)")
@@ -104,6 +104,6 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
         text = "\n".join(f"{i + 1}: {o.describe()}" for i, o in enumerate(listed))
         ax.text(0.0, -0.13, text, transform=ax.transAxes, fontsize=7, va="top", color="darkorange")
     fig.tight_layout()
-    fig.savefig(str(path))
+    save_figure(fig, path)
     plt.close(fig)
     return [str(path)]
