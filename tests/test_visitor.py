@@ -200,3 +200,18 @@ def test_no_pass_switches_on_three_node_classes_by_hand():
     tool = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(tool)
     assert tool.count(ROOT, min_classes=3) == {}, "write the pass as a rrcache.glsl.visitor.NodeVisitor"
+
+
+@pytest.mark.parametrize("body,kinds,expected", [
+    ("switch (k) { case 0: break; } for (;;) { continue; }", ("break", "continue"), False),
+    ("switch (k) { case 0: continue; }", ("break", "continue"), True),
+    ("for (;;) { if (x) return; }", ("break", "return"), True),
+    ("if (x) discard;", ("break",), False),
+    ("if (x) discard;", ("discard",), True),
+    ("while (true) break; if (y) { break; }", ("break",), True),
+])
+def test_one_account_of_what_jumps_out_of_a_loop(body, kinds, expected):
+    from rrcache.analysis.loops import jumps
+
+    loop = parse_source(f"#version 330\nvoid main() {{ for (;;) {{ {body} }} }}").decls[0].body.stmts[0]
+    assert jumps(loop.body, *kinds) is expected

@@ -79,6 +79,7 @@ from rrcache.glsl.rewrite import (
 )
 from rrcache.glsl.defuse import definitions, out_qualifiers, param_qualifier
 from rrcache.glsl.visitor import NodeVisitor
+from rrcache.analysis.loops import jumps
 
 __all__ = ["inline_calls", "inline_unit"]
 
@@ -178,24 +179,13 @@ class _Returns(NodeVisitor):
     visit_While = visit_DoWhile = visit_Switch = visit_For
 
 
-class _Continues(NodeVisitor):
-    """Whether a loop body holds a ``continue`` of that loop."""
-
-    def visit_Continue(self, s) -> bool:
-        return True
-
-    def visit_For(self, s) -> bool:
-        return False
-
-    visit_While = visit_DoWhile = visit_For
-
-    def generic_visit(self, s) -> bool:
-        return any(self.visit(c) for c in _stmt_children(s))
-
-
 _returns_in_loops = _Returns(in_loops=True).visit
 _has_return = _Returns(in_loops=False).visit
-_has_continue = _Continues().visit
+
+
+def _has_continue(body) -> bool:
+    """A ``continue`` that belongs to the loop whose body is ``body``."""
+    return jumps(body, "continue")
 
 
 class _ConvertReturns(NodeVisitor):

@@ -35,7 +35,7 @@ import numpy as np
 from rrcache.glsl import ast as A
 from rrcache.glsl.visitor import NodeVisitor
 
-__all__ = ["COMPARE", "Constants", "CountedLoop", "counted_loop", "body_exits", "exits_early",
+__all__ = ["COMPARE", "Constants", "CountedLoop", "counted_loop", "body_exits", "exits_early", "jumps",
            "scalar", "global_scalars"]
 
 #: the comparisons a counted loop's condition may make, evaluated in the index's type
@@ -277,26 +277,51 @@ def _step(s, name: str, constants, base: str):
     return None if got is None else got[1]
 
 
-class _Exits(NodeVisitor):
-    """Whether a loop body has a ``break``/``continue`` of its own loop."""
+class _Jumps(NodeVisitor):
+    """Whether the statements of a loop body jump, by one of ``kinds`` (``break``, ``continue``,
+    ``return``, ``discard``), out of that loop or to its next iteration: an inner loop's
+    ``break`` and ``continue`` and a ``switch``'s ``break`` do not; ``return`` and ``discard``
+    do from anywhere. Visiting takes (statement, inside an inner loop, inside a switch)."""
 
-    def generic_visit(self, node) -> bool:
+    def __init__(self, *kinds: str):
+        self.kinds = frozenset(kinds)
+
+    def generic_visit(self, s, nested: bool = False, in_switch: bool = False) -> bool:
         return False
 
-    def visit_Break(self, s) -> bool:
-        return True
+    def visit_Break(self, s, nested: bool = False, in_switch: bool = False) -> bool:
+        return "break" in self.kinds and not nested and not in_switch
 
-    visit_Continue = visit_Break
+    def visit_Continue(self, s, nested: bool = False, in_switch: bool = False) -> bool:
+        return "continue" in self.kinds and not nested
 
-    def visit_Compound(self, s: A.Compound) -> bool:
-        return any(self.visit(x) for x in s.stmts)
+    def visit_Return(self, s, nested: bool = False, in_switch: bool = False) -> bool:
+        return "return" in self.kinds
 
-    def visit_If(self, s: A.If) -> bool:
-        return self.visit(s.then) or (s.else_ is not None and self.visit(s.else_))
+    def visit_Discard(self, s, nested: bool = False, in_switch: bool = False) -> bool:
+        return "discard" in self.kinds
 
-    def visit_Switch(self, s: A.Switch) -> bool:
-        # a ``break`` leaves the switch; a ``continue`` the loop
-        return any(isinstance(n, A.Continue) for n in A.walk(s.body, decl_types=False))
+    def visit_Compound(self, s: A.Compound, nested: bool = False, in_switch: bool = False) -> bool:
+        return any(self.visit(x, nested, in_switch) for x in s.stmts)
+
+    def visit_If(self, s: A.If, nested: bool = False, in_switch: bool = False) -> bool:
+        return self.visit(s.then, nested, in_switch) or (
+            s.else_ is not None and self.visit(s.else_, nested, in_switch))
+
+    def visit_For(self, s, nested: bool = False, in_switch: bool = False) -> bool:
+        return self.visit(s.body, True, in_switch)
+
+    visit_While = visit_DoWhile = visit_For
+
+    def visit_Switch(self, s: A.Switch, nested: bool = False, in_switch: bool = False) -> bool:
+        return self.visit(s.body, nested, True)
+
+
+def jumps(body: A.Stmt, *kinds: str) -> bool:
+    """Whether the loop body ``body`` jumps out of its loop, or to the loop's next iteration, by
+    one of ``kinds`` (``"break"``, ``"continue"``, ``"return"``, ``"discard"``; see
+    :class:`_Jumps`)."""
+    return _Jumps(*kinds).visit(body)
 
 
 def body_exits(body: A.Stmt) -> bool:
@@ -308,31 +333,7 @@ def body_exits(body: A.Stmt) -> bool:
     >>> body_exits(loop.body), body_exits(loop.body.stmts[0].body)
     (False, True)
     """
-    return _Exits().visit(body)
-
-
-class _EarlyExit(NodeVisitor):
-    """Whether a loop body can end the loop before its last iteration."""
-
-    def generic_visit(self, node) -> bool:
-        return False
-
-    def visit_Break(self, s) -> bool:
-        return True
-
-    visit_Return = visit_Discard = visit_Break
-
-    def visit_Compound(self, s: A.Compound) -> bool:
-        return any(self.visit(x) for x in s.stmts)
-
-    def visit_If(self, s: A.If) -> bool:
-        return self.visit(s.then) or (s.else_ is not None and self.visit(s.else_))
-
-    def visit_For(self, s) -> bool:
-        # an inner loop's ``break`` ends only that loop; a ``return`` or ``discard`` ends all
-        return any(n.__class__ in (A.Return, A.Discard) for n in A.walk(s.body, decl_types=False))
-
-    visit_While = visit_DoWhile = visit_Switch = visit_For
+    return jumps(body, "break", "continue")
 
 
 def exits_early(body: A.Stmt) -> bool:
@@ -344,4 +345,4 @@ def exits_early(body: A.Stmt) -> bool:
     >>> exits_early(loop.body), exits_early(loop.body.stmts[0].body)
     (True, True)
     """
-    return _EarlyExit().visit(body)
+    return jumps(body, "break", "return", "discard")
