@@ -95,6 +95,29 @@ def test_timing_runs_time_each_frame_beside_the_original(gl_ctx, bench):
     assert len(compared.frames) == 3 and compared.ms > 0 and compared.original_ms > 0
 
 
+def test_a_compare_run_measures_flip_and_the_temporal_error_as_validation_does(gl_ctx, bench):
+    """A compare run asked for FLIP on some frames and the temporal error gives what
+    rrcache.harness.perceptual computes on the same renders by hand (validation's figures); the
+    errors and hits are the harness's compare's; other runs cannot ask for them."""
+    from rrcache.harness.cached import compare
+    from rrcache.harness.perceptual import FrameQuality
+
+    spec = VariantSpec("cache", (_node(bench),), "two-pass", periods=(3,))
+    frames = (0, 1, 2, 3, 4)
+    run = execute(RunSpec("compare", spec, frames, SIZE, flip_frames=(1, 4), temporal=True), bench)
+    quality = FrameQuality((1, 4))
+    by_hand = compare(compile_spec(bench.work, spec), bench.session, bench.work.prepared, frames, spec,
+                      resolution=SIZE, on_frame=lambda row, got, ref: quality.add(row.index, got.image, ref.image))
+    assert [r.error for r in run.frames] == [float(f.mean_error) for f in by_hand.frames]
+    assert [(r.hits, r.misses) for r in run.frames] == [(f.hits, f.misses) for f in by_hand.frames]
+    assert len(run.flips) == 2 and list(run.flips) == pytest.approx(quality.flips)
+    assert run.temporal_psnr == pytest.approx(quality.temporal_psnr)
+    plain = execute(RunSpec("compare", spec, frames, SIZE), bench)
+    assert plain.flips == () and plain.temporal_psnr is None
+    with pytest.raises(ValueError, match="compare runs"):
+        RunSpec("error", spec, frames, SIZE, flip_frames=(1,))
+
+
 def test_specs_and_results_are_plain_records(gl_ctx, bench):
     """Pickled and back they are equal (what a distributed executor ships), and a timing run says
     it is one (a distributed executor keeps those alone on a host)."""

@@ -129,8 +129,9 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
             prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
-            runner.close()  # validation renders side by side with its own renderers
-            prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+            if hasattr(runner, "release"):  # the training's reference frames are not needed again
+                runner.release()
+            prof.selections = _selections(prof, work, session, resolved, result, store, progress, runner)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
@@ -265,9 +266,11 @@ def _psnr_offset(store, settings, result: TrainingResult) -> float:
     return coverage_offset_db(train_covered, train_area, check_covered, check_area)
 
 
-def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
+def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress,
+                executor=None) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
-    (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
+    (:mod:`rrcache.profiler.validate`, its renders run by ``executor``), else predicted only;
+    none without a trained node."""
     if not result.trained:
         return []
     choices = prof.threshold_selections()
@@ -277,13 +280,13 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
 
     validator = Validator(work, session, settings, store, progress,
                           window=result.plan.timing_window if result.plan is not None else None,
-                          candidates=prof.front_candidates)
+                          candidates=prof.front_candidates, executor=executor)
     measured = validator.run(choices)
     if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
-                               result.plan.timing_window if result.plan is not None else None)
+                               result.plan.timing_window if result.plan is not None else None, executor)
     prof.calibration = calibration_record(validator)
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
