@@ -152,3 +152,38 @@ def test_a_worker_loads_its_bench_from_a_work_source(tmp_path):
         here = execute(spec, bench)
     assert [r.error for r in there.frames] == [r.error for r in here.frames]
     assert [(r.hits, r.misses) for r in there.frames] == [(r.hits, r.misses) for r in here.frames]
+
+
+def test_validation_measures_through_the_executor_it_is_given(gl_ctx, bench, tmp_path):
+    """Validation's renders are compare runs of the executor given (the profile's): one error run
+    with FLIP and the temporal error over the validation frames, three timed repeats; the
+    measured selection holds what they measured."""
+    from rrcache.profiler.validate import REPEATS, validate
+    from rrcache.profiles import TrainingSettings
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.selection import CachedNode, Selection
+
+    made = []
+
+    class Recording(LocalExecutor):
+        def run(self, specs, on_frame=None):
+            specs = list(specs)
+            made.extend(specs)
+            return super().run(specs, on_frame)
+
+    node = _node(bench)
+    settings = TrainingSettings(periods=(2, 4), resolution=SIZE, validation_frames=5).resolved(bench.session)
+    choice = Selection((CachedNode(node, 4),), 0.01, 1.0, 2.0, label="e1", max_error=0.02, algorithm="two-pass")
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    executor = Recording(bench)
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        [row] = validate(bench.work, bench.session, settings, store, [choice], fallback=False, executor=executor)
+    assert [s.measure for s in made] == ["compare"] * (1 + REPEATS)
+    error = made[0]
+    assert error.temporal and error.flip_frames and error.frames == tuple(range(5))
+    assert error.resolution == tuple(bench.session.resolution) and error.variant.periods == (4,)
+    assert all(s.color_format == settings.timing_format and not s.flip_frames for s in made[1:])
+    assert row.parts == choice.parts and row.frames == 5 and row.measured_flip is not None
+    assert len(row.speedups) == REPEATS and row.measured_temporal_psnr is not None
+    # the executor given stays open (it is the profile's): it still runs
+    assert next(executor.run([RunSpec("compare", error.variant, (0, 1), SIZE)])).frames

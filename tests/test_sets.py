@@ -226,7 +226,10 @@ def test_a_pair_is_trained_kept_and_validated(tiny, gl_ctx, monkeypatch):
     if stood.multi:
         assert stood.measured_error > 0 and not slower_beyond_noise(stood.speedups)
     else:
-        assert "slower than the original in every repeat" in stood.fallback and albedo in stood.fallback
+        # refused for its speed (rrcache.model.levels.speed_miss: slower in every repeat, or below
+        # the gain worth having when a noisy repeat reached 1.0x on this shared machine)
+        assert albedo in stood.fallback and ("slower than the original" in stood.fallback
+                                             or "below the gain worth having" in stood.fallback)
     with read_store(store_path) as store:
         assert any(v.multi for v in store.validations())
     if stood.multi:
