@@ -354,16 +354,20 @@ def test_store_matches_profile_json(trained):
 
 
 def test_the_cache_filter_is_measured_and_kept(trained):
-    """``filter="auto"`` (the default): bilinear and plane measured on the first node, side by
-    side with the original (time) and in the error window (PSNR); the choice follows the rule
-    of rrcache.profiler.filters.pick and is the profile's, recorded in its plan."""
+    """``filter="auto"`` (the default): bilinear and plane measured on the first node at the
+    shortest, middle and longest training periods, side by side with the original (time) and in
+    the error window (error); the choice follows the equal-time rule of
+    rrcache.profiler.filters.pick and is the profile's, recorded in its plan."""
     from rrcache.profiler.filters import pick
 
     prof, events, _ = trained
     times = prof.plan["filter_times"]
     assert set(times) == {"bilinear", "plane"}
-    for measured in times.values():
-        assert 0 < measured["time"] < 100 and 0 < measured["psnr"] <= 100 and measured["period"] in (2, 4, 8)
+    for points in times.values():
+        assert [q["period"] for q in points] == [2, 4, 8]
+        for q in points:
+            assert 0 < q["time"] < 100 and 0 < q["psnr"] <= 100 and q["error"] >= 0
+        assert points[0]["error"] <= points[-1]["error"]   # longer periods: staler values
     assert prof.filter == prof.plan["filter"] == pick(times)
     assert any(e.stage == "filter" for e in events)
     # a resumed profile keeps the choice without measuring again

@@ -379,7 +379,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             if settings.filter == "auto" and order.nodes and len(timing) > 0:
                 meter.grow(filter_steps(settings, timing))
                 plan.filter, plan.filter_times = choose_filter(work, session, settings, order.nodes[0].id, algorithm,
-                                                               timed_original, timing, plan, meter, _timing_run)
+                                                               timed_original, timing, plan, meter, _timing_run,
+                                                               _error_run)
             else:
                 plan.filter = DEFAULT_FILTER if settings.filter == "auto" else settings.filter
             store.set_plan(plan.to_json())
