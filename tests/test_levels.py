@@ -167,3 +167,37 @@ def test_flip_and_the_temporal_error_on_real_frames(trained, tmp_path, gl_ctx):
     assert lagging.measured_temporal_psnr is not None and lagging.measured_temporal_psnr < 100.0
     assert lagging.measured_psnr_uncertainty is not None and lagging.measured_psnr_uncertainty >= 0.0
     assert exact.exact and exact.measured_flip == 0.0 and exact.measured_temporal_psnr is None
+
+
+def test_a_screen_space_shader_is_answered_with_its_files(tmp_path):
+    """Every input gets an answer (issue 29 item 7): a shader whose every value is a function of
+    gl_FragCoord (The Book of Shaders' clouds) exits 0 with "keep the original" and why, and
+    writes profile.json, report.html and the original's manifest; select answers the original."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from test_cli_profile import _env as _cli_env
+
+    def _env():  # this checkout's rrcache in the child
+        return dict(_cli_env(), PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+
+    shader = Path(__file__).parent / "data" / "shaders" / "clouds_fragcoord.frag"
+    _, session = write_scene(tmp_path)
+    out = tmp_path / "clouds.rrprofile"
+    run = subprocess.run([sys.executable, "-m", "rrcache", "profile", str(shader), str(session), "--out", str(out),
+                          "--quiet"], capture_output=True, text=True, env=_env(), timeout=300)
+    assert run.returncode == 0, run.stderr
+    answer = "keep the original shader: every value it computes per pixel depends on the screen position"
+    assert answer in run.stdout and "why:" in run.stdout and "gl_FragCoord" in run.stdout
+    data = json.loads((out / "profile.json").read_text())
+    assert data["verdict"]["choice"] == "original" and data["verdict"]["answer"].startswith(answer)
+    assert "screen" in data["verdict"]["reason"] and data["selections"] == []
+    report = (out / "report.html").read_text()
+    assert answer in report and "what would change it" in report
+    assert json.loads((out / "optimized" / "original" / "manifest.json").read_text())["node"] is None
+    chosen = subprocess.run([sys.executable, "-m", "rrcache", "select", str(out), "--min-psnr", "40", "--json"],
+                            capture_output=True, text=True, env=_env(), timeout=120)
+    assert chosen.returncode == 0, chosen.stderr
+    assert json.loads(chosen.stdout)["node"] is None

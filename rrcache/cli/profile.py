@@ -81,7 +81,8 @@ def _fmt(value, spec=".3g", none="–"):
               help="Share of the frame the error runs render at full resolution (default: chosen from the "
                    "original's cost, at most 0.25; 1: the whole frame).")
 @click.option("--frames", type=click.IntRange(min=2), default=None,
-              help="Train the error on the first N frames (default: 64, or all of a shorter session).")
+              help="Train the error on N frames, spread over the session in segments (default: 150, all of a "
+                   "shorter session).")
 @click.option("--periods", callback=_periods, default=None, metavar="LIST",
               help=f"Training refresh periods (default: {','.join(map(str, DEFAULT_PERIODS))}).")
 @click.option("--timing-frames", type=click.IntRange(min=1), default=None,
@@ -219,6 +220,11 @@ def _summary(prof, console: Console) -> None:
                   f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
+    if prof.plan:
+        from rrcache.profiler.plan import Plan
+
+        console.print(Plan.from_json(prof.plan).describe(prof.settings.resolution, prof.settings.frames),
+                      highlight=False)
     for line in _estimator_lines(prof):
         console.print(line, highlight=False)
     ceiling = prof.measured_ceiling

@@ -146,7 +146,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
     work, session = load_work(profile)
     plan = Plan.from_json(profile.plan or {})
     full = tuple(int(v) for v in session.resolution)
-    train_frames = list(range(settings.frames))
+    train_frames = plan.error_frames(settings.frames)  # the profile's error frames (rrcache.profiler.plan)
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     meter = _Meter(progress, len(train_frames) * (1 + len(nodes) * len(periods)) + 3 * len(timing) * len(nodes) * len(periods))
     report = AccuracyReport(periods, nodes, chosen_by=chosen_by)

@@ -45,6 +45,7 @@ from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
 from rrcache.compiler.amortize import HISTORIES
 from rrcache.model.amortize import TRAIN_BLENDS, fit_amortized_time, fit_error, training_samples
+from rrcache.profiler.plan import restart, run_order
 from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn, timed_beside, timing_frame_indices
 from rrcache.profiles import amortize as data
 from rrcache.profiles.amortize import EstimatorProfile, HistoryRuns
@@ -119,7 +120,8 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             r.note = "not trained: the profile stopped before training (see its verdict)"
         return records
     algorithm = plan.algorithm
-    frames = list(range(settings.frames))
+    # the nodes' error frames (rrcache.profiler.plan), so that the options compare with theirs
+    frames = plan.error_frames(settings.frames)
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     full = tuple(int(v) for v in session.resolution)
     state = {"done": 0, "total": 0}
@@ -236,18 +238,22 @@ def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, r
             for lam in todo:
                 start = clock()
                 cached.runtime.blend = float(lam)
-                cached.reset()
                 errs, psnrs, hits, misses = [], [], 0, 0
-                for i, ref in enumerate(refs):
-                    got = cached.render_frame(ref.index)
-                    _settled(cached, payload)
-                    step(f"{_label(est, m, history, payload)} λ={lam:g}")
-                    if i == 0:
-                        continue  # the first frame has no cache
-                    errs.append(float(mean_l2(got.image, ref.image, ref.mask)[0]))
-                    psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
-                    hits += int(got.hits or 0)
-                    misses += int(got.misses or 0)
+                by_index = {r.index: r for r in refs}
+                # segments of the error frames, each warmed up by the largest training period
+                for segment in run_order(list(by_index), max(settings.periods)):
+                    restart(cached, segment[0][0])
+                    for index, compared in segment:
+                        got = cached.render_frame(index)
+                        _settled(cached, payload)
+                        step(f"{_label(est, m, history, payload)} λ={lam:g}")
+                        if not compared or index == 0:
+                            continue  # a warm-up frame, or frame 0 (it has no cache)
+                        ref = by_index[index]
+                        errs.append(float(mean_l2(got.image, ref.image, ref.mask)[0]))
+                        psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
+                        hits += int(got.hits or 0)
+                        misses += int(got.misses or 0)
                 errs = errs or [0.0]
                 psnrs = psnrs or [PSNR_CAP]
                 rate = hits / (hits + misses) if hits + misses else 0.0

@@ -82,8 +82,11 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         started = time.time()
         try:
             store.begin_run()
-            result = train(work, session, resolved, store, progress)
-            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+            if work.table.nodes:
+                result, verdict = train(work, session, resolved, store, progress), None
+            else:  # nothing a cache can hold: the answer is the original, why, and its frame time
+                result, verdict = _original_only(work, session, resolved), no_node_verdict(work)
+            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out, verdict)
             prof.sets = _sets(prof, work, session, resolved, store, progress)
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
@@ -132,9 +135,10 @@ def _add_times(prof: Profile, store, run_wall_s: float) -> None:
 
 
 def _assemble(work, session, shader_path, session_path, settings, result: TrainingResult, store,
-              out: Path) -> Profile:
+              out: Path, verdict: Optional[dict] = None) -> Profile:
     """The profile of a training result, before its selections (read back from its own
-    document, so that what the run goes on with is what a reader gets)."""
+    document, so that what the run goes on with is what a reader gets); ``verdict``: the answer
+    when nothing was trained for a reason other than the ceiling's."""
     by_id = {n.id: n for n in work.table.nodes}
     nodes = []
     for nid in result.order:
@@ -173,7 +177,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         hit_fit=_fit_json(hit), overhead_ms=result.overhead_ms, original_ms=result.original_ms,
         pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts),
         ceiling=result.ceiling.to_json() if result.ceiling is not None else None,
-        verdict=_verdict(result.ceiling) if result.stopped else None,
+        verdict=verdict if verdict is not None else (_verdict(result.ceiling) if result.stopped else None),
         timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE,
         psnr_offset_db=_psnr_offset(store, settings, result))
     prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
@@ -263,6 +267,60 @@ def _verdict(ceiling) -> dict:
             "reason": ceiling.reason(), "changes": ceiling.changes()}
 
 
+def _original_only(work, session, settings) -> TrainingResult:
+    """The training result of a shader with nothing to train: the original's frame time (the
+    median over the timing frames at full resolution) and covered pixels, nothing else."""
+    import statistics
+
+    from rrcache.harness.renderer import Renderer
+    from rrcache.profiler.train import timing_frame_indices
+
+    full = tuple(int(v) for v in session.resolution)
+    with Renderer(work.prepared, session, full, color_format=settings.timing_format) as renderer:
+        frames = [renderer.render_frame(i) for i in timing_frame_indices(session.frames, settings.timing_frames)]
+    result = TrainingResult(order=[], trained=[], untrained=[], stopped=True)
+    if frames:
+        result.original_ms = float(statistics.median(f.ms for f in frames))
+        result.pixels = float(statistics.mean(f.covered_pixels for f in frames))
+    return result
+
+
+def no_node_verdict(work) -> dict:
+    """The answer for a shader with no value a cache can hold (``work.table.nodes`` empty): keep
+    the original, why (the analysis's reasons, counted) and what would change it. A shader whose
+    every per-pixel value depends on the screen position (a Book of Shaders sketch of
+    ``gl_FragCoord``) is said to be one.
+
+    >>> from types import SimpleNamespace as NS
+    >>> table = NS(nodes=[], excluded=[NS(reason="screen")] * 3 + [NS(reason="uniform")], shader=None)
+    >>> no_node_verdict(NS(table=table))["answer"]
+    'keep the original shader: every value it computes per pixel depends on the screen position (gl_FragCoord), which a surface cache cannot hold'
+    """
+    from collections import Counter
+
+    counts = Counter(x.reason for x in work.table.excluded)
+    per_pixel = {r: n for r, n in counts.items() if r not in ("uniform", "type", "duplicate")}
+    listed = ", ".join(f"{n} {r}" for r, n in counts.most_common())
+    if per_pixel and set(per_pixel) <= {"screen", "derivative"} and counts.get("screen"):
+        answer = ("keep the original shader: every value it computes per pixel depends on the screen position "
+                  "(gl_FragCoord), which a surface cache cannot hold")
+        reason = (f"a reverse reprojection cache keeps values of surface points and fetches them where the surface "
+                  f"was last frame; every value this shader computes per pixel is a function of the pixel's "
+                  f"position on the screen, so none of them belongs to a surface (the analysis left out {listed})")
+    elif counts:
+        answer = "keep the original shader: none of the values it computes can be cached"
+        reason = f"the analysis left every value out ({listed}; 'rrcache nodes SHADER --all' says why for each)"
+    else:
+        answer = "keep the original shader: it computes no value a cache could hold"
+        reason = "its colour comes from inputs and constants alone"
+    return {"choice": "original", "ceiling": None, "min_gain": None, "answer": answer, "reason": reason,
+            "changes": ["compute the costly values from surface inputs (v_position, v_objectPosition, v_texcoord, "
+                        "v_normal) rather than gl_FragCoord: a reprojection cache follows surfaces as they move",
+                        "a screen-space effect is better served by rendering it at a lower resolution or caching it "
+                        "in a screen-space texture of your own",
+                        "'rrcache nodes SHADER --all' lists every value left out and the reason"]}
+
+
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
     out.mkdir(parents=True, exist_ok=True)
@@ -277,12 +335,13 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         kept.append(sel.replace(files=str(folder.relative_to(out))))
     prof.selections = kept
     prof.path = out
-    if prof.verdict is not None:  # stopped before training: nothing to plot or report
+    answered = prof.verdict is not None  # stopped before training: nothing to plot, the answer to report
+    if answered:
         prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
-        plots = False
     if plots:
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
-        prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
+        if not answered:
+            prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
         write_report(prof, out, work=work)

@@ -36,6 +36,7 @@ import numpy as np
 from rrcache.errors import RRCacheError
 from rrcache.model.sets import DEFAULT_MAX_SETS, TRAIN_MARGIN, SetOption, pick, search
 from rrcache.profiler.train import PSNR_CAP, ProgressEvent
+from rrcache.profiler.plan import restart, run_order
 
 #: the share of the training budget the set stage may spend even when the nodes spent it all
 SET_SHARE = 0.15
@@ -210,8 +211,10 @@ class _Runner:
         self.timing_window = self.plan.timing_window if self.plan is not None else None
         self.full = tuple(int(v) for v in session.resolution)
         self.timing = timing_frame_indices(session.frames, settings.timing_frames)
+        # the nodes' error frames (rrcache.profiler.plan), so that a set's error compares with theirs
+        frames = self.plan.error_frames(settings.frames) if self.plan is not None else range(settings.frames)
         with Renderer(work.prepared, session, settings.resolution, window=self.error_window) as renderer:
-            self.refs = [renderer.render_frame(i) for i in range(settings.frames)]
+            self.refs = [renderer.render_frame(i) for i in frames]
         self.original = Renderer(work.prepared, session, self.full, window=self.timing_window,
                                  color_format=settings.timing_format)
 
@@ -231,18 +234,25 @@ class _Runner:
         errors, psnrs, hits, counted = [], [], np.zeros(len(periods)), 0
         with CachedRenderer(variant, self.session, self.work.prepared, self.settings.resolution, period=periods,
                             window=self.error_window, **self.settings.cache_options()) as cached:
-            cached.reset()
-            for k, ref in enumerate(self.refs):
-                got = cached.render_frame(ref.index)
-                err, _ = mean_l2(got.image, ref.image, ref.mask)
-                if k > 0:  # the first frame has no cache
-                    errors.append(float(err))
-                    psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
-                    rates = _node_hits(cached, got)
-                    if rates is not None:
-                        hits += rates
-                        counted += 1
-                self._step(f"{label} error", k + 1, total)
+            by_index, k = {r.index: r for r in self.refs}, 0
+            # segments of the error frames, each warmed up by the set's longest period (run_order)
+            for segment in run_order(list(by_index), max(periods)):
+                restart(cached, segment[0][0])
+                for index, compared in segment:
+                    got = cached.render_frame(index)
+                    if not compared:
+                        continue
+                    ref = by_index[index]
+                    err, _ = mean_l2(got.image, ref.image, ref.mask)
+                    if index > 0:  # frame 0 has no cache
+                        errors.append(float(err))
+                        psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
+                        rates = _node_hits(cached, got)
+                        if rates is not None:
+                            hits += rates
+                            counted += 1
+                    k += 1
+                    self._step(f"{label} error", k, total)
         ratios = []
         with CachedRenderer(variant, self.session, self.work.prepared, self.full, period=periods,
                             window=self.timing_window, color_format=self.settings.timing_format,

@@ -5,10 +5,12 @@ holds, and fits the models from what is stored:
 
 0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profiler.order`
    (too-cheap nodes skipped, the rest diversity first). The original is timed at full resolution
-   on the timing frames, and from that time the windows of :mod:`rrcache.profiler.plan` are
-   chosen (once; kept in the store). With ``algorithm="auto"`` the three-pass and two-pass
-   variants of the first node are timed beside the original (:func:`choose_algorithm`) and the
-   faster serves the whole profile (kept in the plan too).
+   on the timing frames, and the windows and error frames of :mod:`rrcache.profiler.plan` are
+   chosen (once; kept in the store). With ``algorithm="auto"`` the ceiling's per-algorithm
+   limits decide which algorithm serves the whole profile when they differ beyond their noise;
+   else the three-pass and two-pass variants of the first node are timed beside the original
+   (:func:`choose_algorithm`) and the faster serves when the difference exceeds its noise, else
+   the higher ceiling (kept in the plan too, with the reason).
 1. **Reference frames.** The original shader over the training frames inside the error window
    (full pixel density), rendered once and kept in memory for the run.
 2. **Error runs.** Per node one :class:`~rrcache.harness.cached.CachedRenderer` inside the same
@@ -58,9 +60,8 @@ from rrcache.model.ceiling import Ceiling
 from rrcache.profiler.ceiling import measure_ceiling
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                     shader_inputs, signature)
-from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
-                                   coverage_map,
-                                   fraction_for, place_window)
+from rrcache.profiler.plan import (Plan, algorithm_by_ceiling, algorithm_by_timing, make_plan as _make_plan,
+                                   rendered_frames, restart, run_order)
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
 
@@ -160,19 +161,11 @@ def training_order(work: ShaderWork, session, settings: TrainingSettings) -> Tra
     return TrainingOrder(diversity_order(keep, signatures), skipped, signatures)
 
 
-def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames: list[int]) -> Plan:
-    """Choose the error and timing windows (:mod:`rrcache.profiler.plan`) for a shader whose
-    full frame costs ``original_ms``, placed over the coverage of ``frames``."""
-    full = tuple(int(v) for v in session.resolution)
-    at_full = tuple(settings.resolution) == full
-    error_fraction = settings.error_window if settings.error_window is not None else \
-        fraction_for(original_ms, ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION)
-    timing_fraction = 1.0 if original_ms <= TIMING_TARGET_MS else fraction_for(original_ms, TIMING_TARGET_MS, 1.0)
-    need = (at_full and error_fraction < 1.0) or timing_fraction < 1.0
-    coverage = coverage_map(work.prepared, session, frames[::max(1, len(frames) // 16)], Renderer) if need else None
-    error_window = place_window(coverage, full, error_fraction) if at_full and error_fraction < 1.0 else None
-    timing_window = place_window(coverage, full, timing_fraction) if timing_fraction < 1.0 else None
-    return Plan(error_window, timing_window, float(original_ms))
+def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames=None) -> Plan:
+    """Choose the error and timing windows and the error frames (:func:`rrcache.profiler.plan.make_plan`:
+    sized from the original's CPU time, which load moves little) for a shader whose full frame
+    measured ``original_ms``. ``frames`` is ignored (the plan chooses the error frames)."""
+    return _make_plan(work, session, settings, original_ms, Renderer)
 
 
 def timing_frame_indices(session_frames: int, count: int) -> list[int]:
@@ -191,17 +184,27 @@ def timing_frame_indices(session_frames: int, count: int) -> list[int]:
 
 
 def _error_run(cached: CachedRenderer, node_id: str, period: int, refs: list, meter: _Meter) -> tuple[ErrorRun, list]:
+    """One error run of ``node_id`` at ``period`` over the frames of ``refs`` (the original's
+    reference frames): each segment of consecutive frames from an empty cache, after the warm-up
+    frames that give the cache at its first frame what a run from frame 0 holds there
+    (:func:`rrcache.profiler.plan.run_order`). The run's figures are over the compared frames
+    but frame 0 (which has no cache)."""
     start = time.perf_counter()
     cached.period = period
-    cached.reset()
+    by_index = {r.index: r for r in refs}
     frames: list[ErrorFrame] = []
-    for ref in refs:
-        got = cached.render_frame(ref.index)
-        err, left_out = mean_l2(got.image, ref.image, ref.mask)
-        frames.append(ErrorFrame(ref.index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP),
-                                 int(got.hits), int(got.misses), int(got.covered_pixels), int(left_out)))
-        meter.step("error", f"{node_id} Δn={period}")
-    steady = frames[1:] or frames
+    for segment in run_order([r.index for r in refs], period):
+        restart(cached, segment[0][0])
+        for index, compared in segment:
+            got = cached.render_frame(index)
+            meter.step("error", f"{node_id} Δn={period}")
+            if not compared:
+                continue
+            ref = by_index[index]
+            err, left_out = mean_l2(got.image, ref.image, ref.mask)
+            frames.append(ErrorFrame(ref.index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP),
+                                     int(got.hits), int(got.misses), int(got.covered_pixels), int(left_out)))
+    steady = [f for f in frames if f.frame != 0] or frames
     hits, misses = sum(f.hits for f in steady), sum(f.misses for f in steady)
     run = ErrorRun(node_id, int(period), float(np.mean([f.mean_error for f in steady])),
                    float(np.mean([f.psnr for f in steady])), hits / (hits + misses) if hits + misses else 0.0,
@@ -235,23 +238,27 @@ AUTO_CANDIDATES = ("three-pass", "two-pass")
 
 
 def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node_id: str, original: Renderer,
-                     timing: list[int], window, meter: _Meter) -> tuple[str, dict]:
+                     timing: list[int], window, meter: _Meter) -> tuple[str, dict, dict]:
     """Time the :data:`AUTO_CANDIDATES` variants of ``node_id`` on the timing frames at the
     middle timing period, each frame beside the original as the timing runs are, and return the
-    faster and each one's median time as a fraction of the original's. The three-pass
+    faster median, each one's median time as a fraction of the original's, and each one's
+    per-frame fractions (whether their difference exceeds its noise is
+    :func:`rrcache.profiler.plan.algorithm_by_timing`'s to say; profiles decide from the
+    ceiling's limits first, :func:`rrcache.profiler.plan.algorithm_by_ceiling`). The three-pass
     algorithm is the paper's choice for GPUs, where a pass over the geometry is cheap and
     multiple render targets are not; on llvmpipe the geometry is set up on one thread, and the
     two-pass variant, one pass over the geometry fewer, measured 8-10% faster on Marble."""
     period = settings.timing_periods[len(settings.timing_periods) // 2]
     full = tuple(int(v) for v in session.resolution)
-    fractions = {}
+    fractions, ratios = {}, {}
     for algorithm in AUTO_CANDIDATES:
         variant = variant_for(work, node_id, algorithm)
         with CachedRenderer(variant, session, work.prepared, full, period=period, window=window,
                             color_format=settings.timing_format, **settings.cache_options()) as cached:
             frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
-        fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
-    return min(fractions, key=fractions.get), fractions
+        ratios[algorithm] = [f.ms / f.original_ms for f in frames if f.original_ms > 0]
+        fractions[algorithm] = float(statistics.median(ratios[algorithm]))
+    return min(fractions, key=fractions.get), fractions, ratios
 
 
 def _node_complete(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
@@ -281,7 +288,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                            hint="'rrcache nodes SHADER' says why in its algorithms column; profile with "
                                 "--algorithm auto, three-pass or two-pass")
     ids = [n.id for n in order.nodes]
-    train_frames = list(range(settings.frames))
+    train_frames: list[int] = []  # the plan's error frames, once the plan is known
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     full = tuple(int(v) for v in session.resolution)
 
@@ -297,7 +304,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
 
     def training_total() -> int:
         return ((len(train_frames) if need_refs else 0)
-                + sum(len(v) * len(train_frames) for v in todo_error.values())
+                + sum(rendered_frames(train_frames, p) for v in todo_error.values() for p in v)
                 + sum(len(v) * 3 * len(timing) for v in todo_timing.values())
                 + (len(timing) if need_overhead else 0))
 
@@ -321,11 +328,11 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
             store.add_reference_timing(rows)
         stored_plan = store.plan()
         if stored_plan is None:
-            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()),
-                             train_frames)
+            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()))
             store.set_plan(plan.to_json())
         else:
             plan = Plan.from_json(stored_plan)
+        train_frames[:] = plan.error_frames(settings.frames)
         if plan.timing_window is not None:
             original.release()
             original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt)
@@ -360,9 +367,17 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         meter.grow(training_total())
         if plan.algorithm is None:
             if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
-                meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
-                plan.algorithm, plan.algorithm_times = choose_algorithm(
-                    work, session, settings, order.nodes[0].id, timed_original, timing, plan.timing_window, meter)
+                # the ceiling's per-algorithm limits decide when they differ beyond their noise;
+                # else a timing of the first node, when its difference exceeds its noise
+                chosen, why = algorithm_by_ceiling(ceiling.algorithms if ceiling is not None else {},
+                                                   ceiling.noise if ceiling is not None else 0.0)
+                if chosen is None:
+                    meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
+                    _, plan.algorithm_times, ratios = choose_algorithm(
+                        work, session, settings, order.nodes[0].id, timed_original, timing, plan.timing_window, meter)
+                    chosen, why = algorithm_by_timing(ratios, ceiling.algorithm if ceiling is not None
+                                                      else settings.fixed_algorithm)
+                plan.algorithm, plan.algorithm_reason = chosen, why
             else:
                 plan.algorithm = settings.fixed_algorithm
             store.set_plan(plan.to_json())
@@ -382,7 +397,8 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 continue
             if not _node_started(store, nid, settings) and store.spent_s() >= settings.budget_s:
                 budget_stopped = True
-                meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
+                meter.shrink(sum(rendered_frames(train_frames, p) for p in todo_error[nid])
+                             + len(todo_timing[nid]) * 3 * len(timing))
                 continue
             # one compiled variant serves every period: the period is the runtime's (set per run)
             variant = variant_for(work, nid, algorithm)

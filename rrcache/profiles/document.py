@@ -403,8 +403,28 @@ class Profile:
         spread = 0.0
         if node.frame_spreads and len(node.frame_spreads) == len(node.periods) and period is not None:
             j = min(range(len(node.periods)), key=lambda k: abs(node.periods[k] - period))
-            spread = float(node.frame_spreads[j])
+            # the error's drift over the session moves the prediction only through the frames the
+            # error runs did not cover
+            spread = float(node.frame_spreads[j]) * self.uncovered_share()
         return self._loo[node.id], spread
+
+    def uncovered_share(self) -> float:
+        """The share of the validation frames the error runs did not cover (``plan``'s
+        ``error_segments``; a plan without them trained on the first ``settings.frames``).
+
+        >>> p = Profile("s", "t", "", "", TrainingSettings(frames=64, validation_frames=150), "two-pass", [])
+        >>> round(p.uncovered_share(), 3)
+        0.573
+        """
+        total = self.settings.validation_frames
+        if not total:
+            return 0.0
+        segments = (self.plan or {}).get("error_segments")
+        if segments:
+            covered = {i for start, n in segments for i in range(int(start), int(start) + int(n))}
+        else:
+            covered = set(range(int(self.settings.frames or 0)))
+        return 1.0 - len(covered & set(range(int(total)))) / float(total)
 
     def front_candidates(self, choice: Selection) -> list[Selection]:
         """The options that could stand in for ``choice`` at its level when it measures slower
@@ -752,8 +772,12 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
 
 # ---------------------------------------------------------------------- reading
 def algorithm_line(prof: Profile) -> str:
-    """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
-    0.377, three-pass 0.41 of the original's time)'."""
+    """The profile's algorithm, and with ``auto`` how it was decided: 'two-pass (auto, from the
+    ceiling: two-pass 1.47× against three-pass 0.85× ...)', or what a timing measured
+    ('two-pass (auto: two-pass 0.377, three-pass 0.41 of the original's time)')."""
+    reason = (prof.plan or {}).get("algorithm_reason")
+    if prof.settings.algorithm == "auto" and reason:
+        return f"{prof.algorithm} (auto, from {reason})"
     times = prof.algorithm_times or {}
     if prof.settings.algorithm != "auto" or not times:
         return prof.algorithm
