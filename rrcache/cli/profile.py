@@ -120,12 +120,15 @@ def _fmt(value, spec=".3g", none="–"):
               help="After validation, measure each selection's node with adaptive refresh at these "
                    "thresholds (e.g. 0.005,0.01,0.02) and keep it where faster at the same level "
                    "(docs/adaptive.md).")
+@click.option("--max-flip", type=click.FloatRange(min=0, min_open=True), default=None, metavar="F",
+              help="Add a level 'flip': the fastest choice measured at mean FLIP <= F against the original "
+                   "(docs/levels.md).")
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
             algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, max_sets, defines, adaptive, quiet, vert, include_dirs):
+            wait, max_sets, defines, adaptive, max_flip, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -148,7 +151,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
             warnings.simplefilter("always")
             try:
                 prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
-                               vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive)
+                               vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive,
+                               max_flip=max_flip)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

@@ -47,7 +47,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None) -> Profile:
+            vertex=None, adaptive=None, max_flip: Optional[float] = None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -57,7 +57,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`).
+    same level (:mod:`rrcache.profiler.adaptive`). ``max_flip``: a fifth level, ``flip``, of mean
+    FLIP at most this (:func:`rrcache.profiler.validate.flip_level`; docs/levels.md).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -91,7 +92,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             # amortized sampling: the estimators' models, on the same front as the nodes
             from rrcache.profiler.amortize import train_estimators
             prof.estimators = train_estimators(work, session, resolved, store, result, progress)
-            prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+            prof.selections = _selections(prof, work, session, resolved, result, store, progress, max_flip)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
@@ -219,7 +220,8 @@ def _psnr_offset(store, settings, result: TrainingResult) -> float:
     return coverage_offset_db(train_covered, train_area, check_covered, check_area)
 
 
-def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
+def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress,
+                max_flip: Optional[float] = None) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
     (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
     if not result.trained:
@@ -233,12 +235,19 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
                           window=result.plan.timing_window if result.plan is not None else None,
                           candidates=prof.front_candidates)
     measured = validator.run(choices)
+    if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first
+        from rrcache.profiler.validate import flip_level
+
+        flip = flip_level(prof, validator, float(max_flip))
+        store.add_validation(flip)
+        measured.append(flip)
     if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
                                result.plan.timing_window if result.plan is not None else None)
     prof.calibration = calibration_record(validator)
+    prof.measured = [s.replace(files=None) for s in validator.measured.values()]
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured

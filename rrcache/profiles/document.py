@@ -176,6 +176,10 @@ class Profile:
     #: predictions' error on them, ``raw`` and ``calibrated`` (as each was predicted when it was
     #: measured): ``{"n", "mean", "worst"}`` of |predicted − measured| dB. Empty before validation.
     calibration: dict = field(default_factory=dict)
+    #: every choice validation measured, shipped or refused at a level, with its measured figures
+    #: (``rrcache select`` and the explorer answer from these where they can:
+    #: :mod:`rrcache.profiles.measured`)
+    measured: list[Selection] = field(default_factory=list)
     #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
     #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
     #: was measured faster at the level
