@@ -11,6 +11,14 @@ limit and the way to raise it.
   (``--max-ast-nodes``), and :data:`budget.expression_depth`, the deepest expression nesting the
   recursive passes accept (:mod:`rrcache.deep` gives them the stack for it).
 * :data:`budget.source_bytes`: the size of a shader file and of everything it includes.
+* :data:`budget.document_bytes`: the size of a session file or a ``profile.json``
+  (``--max-document-bytes``); :data:`budget.asset_bytes`: of one mesh or texture file
+  (``--max-asset-bytes``). Every file is measured on its open descriptor before a byte is read
+  (:mod:`rrcache.files`): a sparse 100 GB file is refused at once.
+* :data:`budget.session_values` and :data:`budget.session_objects`: a session's JSON values
+  (keyframes are most of them) and objects (``--max-session-values``,
+  ``--max-session-objects``), counted before the schema validates anything: a schema-valid
+  session of 10⁶ keyframes or 10⁵ objects is refused at once instead of loading for minutes.
 
 The command line's global options (``rrcache --max-ast-nodes N ...``) set :data:`budget`.
 """
@@ -21,6 +29,8 @@ from dataclasses import dataclass
 
 from rrcache.errors import RRCacheError
 
+#: the largest any byte budget may be raised to (a file is read into memory whole: 16 GiB)
+MAX_READ_BYTES = 16 * 1024 ** 3
 #: the largest refresh period Δn a user may ask for (2^20 frames: over 4 hours at 60 fps)
 MAX_PERIOD = 2 ** 20
 #: the largest the runtime's signed 32-bit phase uniforms hold with room for frame arithmetic
@@ -36,6 +46,10 @@ class Budget:
     analysis_nodes: int = 1_000_000    # ~2 GB of analysis (a 100k-term chain: 200k nodes, 400 MB)
     expression_depth: int = 125_000   # a 100,000-term chain nests ~100,010 deep
     source_bytes: int = 16 * 1024 * 1024
+    document_bytes: int = 16 * 1024 * 1024
+    session_values: int = 250_000      # JSON values: ~25,000 camera keyframes
+    session_objects: int = 2_000
+    asset_bytes: int = 1024 * 1024 * 1024
     #: not a size: whether session paths may leave the session's folder tree (the opt-out)
     allow_outside_paths: bool = False
 

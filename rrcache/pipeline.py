@@ -34,7 +34,9 @@ from rrcache.compiler import Variant, instance, instance_nodes
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
 from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.selection import AdaptiveNode, AmortizedLoop, CachedNode, Selection
+from rrcache.session.changes import per_frame_uniforms
 
 
 @dataclass
@@ -49,6 +51,9 @@ class ShaderWork:
     vertex: object = None
     #: the command line's include folders (absolute; the session's own are in the session)
     include_dirs: tuple = ()
+    #: the cache filter every variant of this work compiles with unless told otherwise (a
+    #: profile's: ``Profile.filter``, chosen by rrcache.profiler.filters)
+    filter: str = DEFAULT_FILTER
 
     @cached_property
     def prepared(self) -> PreparedShader:
@@ -72,17 +77,22 @@ class ShaderWork:
 
 
 def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, str]] = None,
-                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None) -> ShaderWork:
+                     include_dirs=(), max_unroll: int = DEFAULT_MAX_ITERATIONS, vertex=None,
+                     term_scores=None) -> ShaderWork:
     """Load and analyse ``shader_path`` (loops of at most ``max_unroll`` iterations unrolled);
     with a ``session`` its meshes' attributes set the ``MODEL_VERTEX_*`` defines (``defines``
     win over them). Includes are looked up next to the including file, then in ``include_dirs``
     (``-I``), then in the session's ``"include_dirs"``. ``vertex`` is the path of the user's
-    vertex shader (None: the session's ``"vertex"``, else a generated one)."""
+    vertex shader (None: the session's ``"vertex"``, else a generated one). ``term_scores``: the
+    measured order of sums whose weights do not fold (:mod:`rrcache.profiler.terms`; node ids
+    then refer to the program ordered by them)."""
     dirs = all_include_dirs(include_dirs, session)
     shader, all_defines = load_for_meshes(shader_path, session, defines, dirs)
     user = load_user_vertex(vertex, session, all_defines, dirs)
-    return ShaderWork(shader, cacheable_nodes(shader, max_iterations=max_unroll), all_defines, user,
-                      tuple(os.path.abspath(d) for d in include_dirs or ()))
+    # what changes between the session's frames: the terms of a sum that read it go last
+    moving = sorted(per_frame_uniforms(session)) if session is not None else ()
+    table = cacheable_nodes(shader, max_iterations=max_unroll, moving=moving, scores=term_scores or None)
+    return ShaderWork(shader, table, all_defines, user, tuple(os.path.abspath(d) for d in include_dirs or ()))
 
 
 def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
@@ -90,14 +100,16 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
     return tuple(include_dirs or ()) + tuple(getattr(session, "include_dirs", ()) or ())
 
 
-def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: str = "bilinear",
+def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: Optional[str] = None,
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
     """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``;
-    ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule)."""
-    return instance(work.table, node_id, algorithm, filter, payload_dtype, work.vertex, adaptive=adaptive)
+    ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule; ``filter``: the work's
+    when not given)."""
+    return instance(work.table, node_id, algorithm, filter or work.filter, payload_dtype, work.vertex,
+                    adaptive=adaptive)
 
 
-def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: str = "bilinear",
+def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: Optional[str] = None,
                       payload_dtype: str = "f4") -> Variant:
     """Compile the variant of ``work`` caching every node of ``node_ids`` (two or more; one:
     :func:`variant_for`), each with its own payload and period
@@ -105,7 +117,7 @@ def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass",
     node_ids = list(node_ids)
     if len(node_ids) == 1:
         return variant_for(work, node_ids[0], algorithm, filter, payload_dtype)
-    return instance_nodes(work.table, node_ids, algorithm, filter, payload_dtype, work.vertex)
+    return instance_nodes(work.table, node_ids, algorithm, filter or work.filter, payload_dtype, work.vertex)
 
 
 def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:

@@ -139,7 +139,7 @@ class AmortizedLoop:
 
 
 #: the cache's reconstruction filters (their GLSL: rrcache.runtime.glsl), named by selections
-FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge")
+FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge", "plane")
 
 #: the payload formats of an amortized choice: 32- or 16-bit floats, or ``u8`` (the slots in 8 bits
 #: by the range of the estimator's terms, rrcache.compiler.payload_encoding)

@@ -79,3 +79,45 @@ def tree(folder: Path) -> dict:
             st = path.lstat()
             out[str(path)] = (st.st_size, st.st_mtime_ns)
     return out
+
+
+#: ``python -c`` of :func:`rrcache_traced`: rrcache's command line with an audit hook that logs
+#: every path the process opens through Python (``open()``, ``os.open``: every file rrcache
+#: reads or writes goes through them; C libraries get ``/proc/self/fd/N``)
+_TRACED = """
+import os, sys
+log = open(os.environ["RRCACHE_TEST_OPENS"], "a", encoding="utf-8", errors="replace")
+def hook(event, args):
+    if event == "open" and args and isinstance(args[0], (str, bytes)):
+        log.write(os.fsdecode(args[0]).replace("\\n", " ") + "\\n")
+        log.flush()
+sys.addaudithook(hook)
+from rrcache.cli import main
+main(sys.argv[1:])
+"""
+
+
+def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
+    """``rrcache ARGS`` in ``cwd``, traced: (exit code, stdout, the non-empty stderr lines, the
+    child's peak resident memory in MiB (its own ``wait4`` rusage), every path it opened).
+    A run past ``timeout`` seconds is killed (a hang guard, not a timing)."""
+    import tempfile
+    import threading
+
+    with tempfile.TemporaryDirectory(prefix="rrcache-traced-") as tmp:
+        names = {k: os.path.join(tmp, k) for k in ("out", "err", "opens")}
+        open(names["opens"], "w").close()
+        with open(names["out"], "w") as out, open(names["err"], "w") as err:
+            proc = subprocess.Popen([sys.executable, "-c", _TRACED, *map(str, args)], cwd=cwd, stdin=stdin,
+                                    env={**env(), "RRCACHE_TEST_OPENS": names["opens"]}, stdout=out, stderr=err)
+        timer = threading.Timer(timeout, proc.kill)
+        timer.start()
+        try:
+            _, status, usage = os.wait4(proc.pid, 0)
+        finally:
+            timer.cancel()
+        proc.returncode = code = os.waitstatus_to_exitcode(status)
+        assert code != -9, f"killed after {timeout} s: {args}"
+        read = lambda k: open(names[k], encoding="utf-8", errors="replace").read()  # noqa: E731
+        lines = [line for line in read("err").splitlines() if line.strip()]
+        return code, read("out"), lines, usage.ru_maxrss / 1024, read("opens").splitlines()

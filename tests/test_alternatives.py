@@ -23,7 +23,7 @@ from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import load_for_session
 from rrcache.session import load_session
 
-from test_profile import write_scene
+from scene_files import write_scene
 
 
 @pytest.fixture(scope="module")

@@ -28,20 +28,10 @@ from rrcache.errors import RRCacheError
 from rrcache.selection import CachedNode, Selection
 from rrcache.session import load_session
 
-SHADER = """#version 330
-in vec4 v_position;
-in vec3 v_normal;
-in vec3 v_objectPosition;
-uniform vec3 u_light;
-uniform float u_scale;
-uniform int u_octaves;
-out vec4 fragColor;
+from scene_files import WAVE, fragment, moving_camera, session_doc
+from scene_files import write_scene as write_files
 
-float wave(vec3 p, float f) {
-    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
-}
-
-void main() {
+SHADER = fragment("""void main() {
     vec3 p = v_objectPosition * u_scale;
     float n = 0.5;
     float amp = 0.25;
@@ -53,17 +43,10 @@ void main() {
     float diffuse = max(dot(nrm, l), 0.0);
     fragColor = vec4(albedo * (0.2 + 0.8 * diffuse), 1.0);
 }
-"""
+""", WAVE, uniforms=("int u_octaves",))
 
-SESSION = {
-    "rrcache_session": 1, "resolution": [64, 48], "frames": 16, "fps": 30,
-    "camera": {"fov": 45, "near": 0.1, "far": 50, "keyframes": [
-        {"frame": 0, "eye": [0, 0.4, 2.4], "target": [0, 0, 0], "up": [0, 1, 0]},
-        {"frame": 15, "eye": [0.8, 0.5, 2.2], "target": [0, 0, 0], "up": [0, 1, 0]}]},
-    "light": {"color": [1, 1, 1], "orbit": {"center": [0, 0, 0], "radius": 4, "height": 3, "degrees_per_frame": 3}},
-    "objects": [{"procedural": {"type": "icosphere", "radius": 1.0, "subdivisions": 3}}],
-    "uniforms": {"u_scale": 3.0, "u_octaves": 100},
-}
+SESSION = session_doc(frames=16, camera=moving_camera(16, (0, 0.4, 2.4), (0.8, 0.5, 2.2)),
+                      uniforms={"u_scale": 3.0, "u_octaves": 100})
 
 SCENE_KEYS = {"name", "cacheable_nodes", "precompute_s", "original_ms", "limit_speedup", "selections"}
 #: a bench selection is the profile's Selection record (rrcache.selection), measured again
@@ -72,11 +55,7 @@ SELECTION_KEYS = {"label", "max_error", "parts", "algorithm", "predicted_speedup
 
 
 def write_scene(folder, name="noise"):
-    folder.mkdir(parents=True, exist_ok=True)
-    shader, session = folder / f"{name}.frag", folder / f"{name}.json"
-    shader.write_text(SHADER)
-    session.write_text(json.dumps(SESSION))
-    return shader, session
+    return write_files(folder, SHADER, SESSION, f"{name}.frag", f"{name}.json")
 
 
 def rrcache(*args, timeout=240):
@@ -146,6 +125,7 @@ def test_json_shape(quick_run):
         if scene["equal_time"]:
             methods = [r["method"] for r in scene["equal_time"]]
             assert methods[0] == "reprojection cache (ours)" and "dynamic resolution" in methods
+            assert paper.RENDER_CACHE in methods or any("render cache" in n for n in scene["notes"])
             for row in scene["equal_time"]:
                 assert row["speedup"] > 0 and row["mean_error"] >= 0 and 0 < row["psnr"] <= 100
         else:
@@ -258,3 +238,22 @@ def test_the_scene_table_shows_several_nodes_and_an_estimator():
     text = scene_markdown(scene)
     assert "| e2 | 0.0036 | `noise(p) + albedo * light` | 50 + 4 | 3.10× |" in text
     assert "| e1 | 0.0005 | `e1 m=4 λ=0.6 slots/frame u8: for (int i = 0; i < 16; i++)` | – | 2.20× |" in text
+
+
+def test_paper_size_measures_the_shipped_selections_again(quick_run):
+    """python -m rrcache.bench.paper_size: the bench's cached selections measured again over the
+    scene's session beside the original, each row beside the bench's figures."""
+    from rrcache.bench import paper_size
+
+    doc, folder, _, _ = quick_run
+    scene = doc["scenes"][0]
+    cached = [s for s in scene["selections"] if s["parts"]]
+    result = paper_size.run(folder / "out", scenes=("noise",), labels=("e1", "e2", "e3", "e4"), frames=4,
+                            progress=lambda *_: None)
+    assert [r.label for r in result.rows] == [s["label"] for s in cached]
+    for row, sel in zip(result.rows, cached):
+        assert row.frames == 4 and row.speedup > 0 and 0 <= row.hit_rate <= 1 and 0 < row.psnr <= 100
+        assert row.bench_speedup == pytest.approx(sel["measured_speedup"])
+        assert (row.limit_speedup is not None) == (row.label == scene["medium"])
+    assert result.markdown().count("| noise |") == 2 * len(cached)
+    assert paper_size.main([str(folder / "nowhere")]) == 2

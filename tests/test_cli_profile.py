@@ -20,7 +20,7 @@ import time
 
 import pytest
 
-from test_profile import CLI_SETTINGS, write_scene
+from scene_files import CLI_SETTINGS, write_scene
 
 from rrcache.profiles import read_store
 

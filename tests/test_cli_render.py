@@ -213,8 +213,16 @@ def test_bench_cache_measures_every_configuration(files, capsys):
         assert row["ms_per_frame"] > 0 and row["original_ms_per_frame"] > 0
     assert doc["no_refresh"]["hit_rate"] >= doc["periods"][0]["hit_rate"]
     assert doc["limit_speedup"] > 0 and doc["limit_ms"] > 0
-    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1 and "limit: every pixel hits" in captured.err
+    assert [r["filter"] for r in doc["filters"]] == ["bilinear", "edge", "plane"]
+    assert captured.err.count("[2/2]") == 1 + 3 + 3 + 1 + 3 and "limit: every pixel hits" in captured.err
     assert doc["color_format"] == "rgba8"
+    # each filter's misses sorted by cause: they add up to the missing pixels of its run
+    assert [m["filter"] for m in doc["misses"]] == ["bilinear", "edge", "plane"]
+    for m in doc["misses"]:
+        missing = sum(m["pixels"].values())
+        assert m["covered"] > 0 and abs(missing / m["covered"] - (1 - m["hit_rate"])) < 1e-9
+        assert 0 < sum(m["blocks"].values()) <= m["covered_blocks"]
+        assert m["pixels"]["refresh"] > 0   # Δn = 2 refreshes half the blocks
 
 
 def test_bench_cache_breakdown(files, capsys):

@@ -128,11 +128,39 @@ def test_a_run_that_always_kills_its_worker_is_reported(cluster):
 
 
 def test_the_default_path_imports_no_dask(tmp_path):
+    """A whole in-process profile (and the commands' modules) without a Dask module loaded."""
+    from scene_files import write_scene
+
+    shader, session = write_scene(tmp_path / "scene")
     code = ("import sys, rrcache\n"
-            "from rrcache.profiler import profile\n"
-            "from rrcache.cli import main\n"
-            "import rrcache.cli.profile, rrcache.cli.profile_library, rrcache.profiler.library\n"
+            "import rrcache.cli, rrcache.cli.profile, rrcache.cli.profile_library, rrcache.profiler.library\n"
+            "from rrcache.profiles import TrainingSettings\n"
+            f"p = rrcache.profile({str(shader)!r}, {str(session)!r}, {str(tmp_path / 'out')!r}, "
+            "TrainingSettings(periods=(2, 4), resolution=(32, 24), timing_frames=2, timing_periods=(2,), "
+            "min_gain=0.0, budget_s=1.0, max_sets=0, validate=False), plots=False)\n"
+            "assert p.trained_nodes\n"
             "bad = sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed'))\n"
             "assert not bad, bad\n")
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    env = dict(os.environ, LP_NUM_THREADS="1")
+    env.pop("RRCACHE_SCHEDULER", None)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_a_scheduler_and_workers_started_apart(tmp_path, monkeypatch):
+    from farm import local_farm
+
+    from rrcache.cluster.client import SCHEDULER_ENV, connect
+    from rrcache.cluster.executor import DaskRuns
+
+    with local_farm(tmp_path / "farm", env={"RRCACHE_HOST_LOCK": str(tmp_path / "host.lock")}) as address:
+        monkeypatch.setenv(SCHEDULER_ENV, address)
+        said = []
+        with connect(announce=said.append) as c:
+            c.client.wait_for_workers(2, timeout=60)
+            runs = DaskRuns(c)
+            name = runs.open("sleepy", cluster_runs.Sleepy())
+            done = list(runs.map(name, [(0.2, "error"), (0.2, "timing"), (0.2, "error")]))
+            runs.close()
+        assert f"scheduler {address}" in said[0]
+    assert len(done) == 3 and all(p.result["pixel"] == [64, 128, 191, 255] for _, p in done)

@@ -3,7 +3,8 @@
 For every ``tests/corpus/*.glsl`` (with the session of the same name, else
 ``default_session.json``):
 
-1. every analysis pass runs on it in order (inlining, unrolling, compound-assignment expansion)
+1. every analysis pass runs on it in order (inlining, unrolling, compound-assignment expansion,
+   sum reordering)
    and the program each one returns type-checks: a pass that rejects its own rewrite fails here,
    naming the pass;
 2. the node table is built, and the variants of at most ``COSTLIEST + SAMPLED`` listed nodes (the
@@ -27,6 +28,7 @@ import numpy as np
 import pytest
 
 from rrcache.analysis.compound import expand_unit
+from rrcache.analysis.sums import reorder_sums
 from rrcache.analysis.inline import inline_unit
 from rrcache.analysis.unroll import unroll_unit
 from rrcache.compiler import ALGORITHMS
@@ -38,6 +40,7 @@ from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
+from rrcache.session.changes import per_frame_uniforms
 
 CORPUS = Path(__file__).parent / "corpus"
 SHADERS = sorted(CORPUS.glob("*.glsl"))
@@ -80,9 +83,11 @@ def test_every_analysis_pass_keeps_the_program_valid(shader):
     work = load_for_session(shader, session_of(shader))
     unit, info = work.shader.unit, work.shader.info
     # inline_unit works on a copy; the later passes work in place on what it returned
+    moving = per_frame_uniforms(session_of(shader))
     for name, run in (("inlining", inline_unit),
                       ("unrolling", lambda u: unroll_unit(u, info)),
-                      ("compound-assignment expansion", expand_unit)):
+                      ("compound-assignment expansion", expand_unit),
+                      ("sum reordering", lambda u: (reorder_sums(u, moving), u)[1])):
         unit = run(unit)
         try:
             check(unit, str(shader))

@@ -18,7 +18,7 @@ import math
 import numpy as np
 import pytest
 
-from test_profile import SESSION
+from scene_files import SESSION
 
 from rrcache.errors import RRCacheError, SessionError, UnsupportedShaderError
 from rrcache.harness.cached import compare

@@ -25,14 +25,14 @@ ROOT = Path(rrcache.__file__).resolve().parent
 #: every package (or top-level module) of rrcache, lowest layer first: a module may import from
 #: its own package and from lower layers only (the same table is in docs/architecture.md)
 LAYERS = [
-    {"errors", "jsonable"},
+    {"errors", "jsonable", "files"},
     {"budgets", "deep", "atomic", "stdio", "watchdog"},
     {"selection", "glsl", "session", "gl"},
     {"analysis", "runtime", "model"},
     {"harness"},
     {"compiler"},
     {"pipeline"},
-    {"alternatives", "profiles", "cluster"},
+    {"alternatives", "profiles", "cluster", "webgl"},
     {"report"},
     {"profiler"},
     {"bench"},

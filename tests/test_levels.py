@@ -20,7 +20,7 @@ import pytest
 from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings
 from rrcache.selection import CachedNode, Selection
-from test_profile import SETTINGS, write_scene
+from scene_files import SETTINGS, write_scene
 
 LEVEL = 40.0
 

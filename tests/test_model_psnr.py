@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from test_profile import SETTINGS, write_scene
+from scene_files import SETTINGS, write_scene
 
 from rrcache.model import ErrorFit, HitRateFit, ModelTable, PerfFit
 from rrcache.model.psnr import PSNR_CAP, fit_psnr, psnr_grid, psnr_text, select_min_psnr

@@ -28,56 +28,10 @@ from rrcache.profiles import TrainingSettings, load_profile, read_store, select
 from rrcache.profiles.document import algorithm_line
 from rrcache.selection import CachedNode, Selection
 
-SHADER = """#version 330
-in vec4 v_position;
-in vec3 v_normal;
-in vec3 v_objectPosition;
-uniform vec3 u_light;
-uniform float u_scale;
-out vec4 fragColor;
-
-float wave(vec3 p, float f) {
-    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
-}
-
-void main() {
-    vec3 p = v_objectPosition * u_scale;
-    float n = 0.5 + 0.25 * wave(p, 1.0) + 0.125 * wave(p, 2.1) + 0.0625 * wave(p, 4.3);
-    vec3 albedo = mix(vec3(0.9, 0.8, 0.6), vec3(0.3, 0.2, 0.1), n);
-    vec3 nrm = normalize(v_normal);
-    vec3 l = normalize(u_light - v_position.xyz);
-    float diffuse = max(dot(nrm, l), 0.0);
-    fragColor = vec4(albedo * (0.2 + 0.8 * diffuse), 1.0);
-}
-"""
-
-SESSION = {
-    "rrcache_session": 1, "resolution": [64, 48], "frames": 12, "fps": 30,
-    "camera": {"fov": 45, "near": 0.1, "far": 50, "keyframes": [
-        {"frame": 0, "eye": [0, 0.5, 3.2], "target": [0, 0, 0], "up": [0, 1, 0]},
-        {"frame": 11, "eye": [1.2, 0.6, 2.9], "target": [0, 0, 0], "up": [0, 1, 0]}]},
-    "light": {"color": [1, 1, 1], "orbit": {"center": [0, 0, 0], "radius": 4, "height": 3, "degrees_per_frame": 3}},
-    "objects": [{"procedural": {"type": "icosphere", "radius": 1.0, "subdivisions": 3}}],
-    "uniforms": {"u_scale": 3.0},
-}
-
-#: the settings of every test profile: training at 32×24, six timing frames; nothing cached beats
-#: the original on this tiny scene, so the ceiling must not stop the training (min_gain 0)
-SETTINGS = dict(periods=(2, 4, 8), resolution=(32, 24), timing_frames=6, timing_periods=(2, 8), min_gain=0.0)
-CLI_SETTINGS = ["--periods", "2,4,8", "--resolution", "32x24", "--timing-frames", "6", "--timing-periods", "2,8",
-                "--min-gain", "0"]
+from scene_files import SETTINGS, write_scene
 
 NODE_KEYS = {"id", "type", "line", "column", "text", "call_chain", "cost", "trained", "alpha", "lam",
              "error_quality", "error_r2", "t_hit", "t_miss", "perf_quality"}
-
-
-def write_scene(folder):
-    """The test shader and session in ``folder``; returns their paths."""
-    folder.mkdir(parents=True, exist_ok=True)
-    shader, session = folder / "noise.frag", folder / "orbit.json"
-    shader.write_text(SHADER)
-    session.write_text(json.dumps(SESSION))
-    return shader, session
 
 
 @pytest.fixture(scope="module")
@@ -406,3 +360,21 @@ def test_store_matches_profile_json(trained):
         assert store.run_log()[-1]["status"] == "done"
         errs = {r.period: r.mean_error for r in store.error_runs(prof.nodes[0].id)}
     assert [errs[p] for p in (2, 4, 8)] == prof.nodes[0].errors
+
+
+def test_the_cache_filter_is_measured_and_kept(trained):
+    """``filter="auto"`` (the default): bilinear and plane measured on the first node, side by
+    side with the original (time) and in the error window (PSNR); the choice follows the rule
+    of rrcache.profiler.filters.pick and is the profile's, recorded in its plan."""
+    from rrcache.profiler.filters import pick
+
+    prof, events, _ = trained
+    times = prof.plan["filter_times"]
+    assert set(times) == {"bilinear", "plane"}
+    for measured in times.values():
+        assert 0 < measured["time"] < 100 and 0 < measured["psnr"] <= 100 and measured["period"] in (2, 4, 8)
+    assert prof.filter == prof.plan["filter"] == pick(times)
+    assert any(e.stage == "filter" for e in events)
+    # a resumed profile keeps the choice without measuring again
+    reread = load_profile(prof.path)
+    assert reread.filter == prof.filter

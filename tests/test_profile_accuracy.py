@@ -16,7 +16,7 @@ import sys
 import numpy as np
 import pytest
 
-from test_profile import SETTINGS, write_scene
+from scene_files import SETTINGS, write_scene
 
 from rrcache.errors import RRCacheError
 from rrcache.pipeline import load_for_session

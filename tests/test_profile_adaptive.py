@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from test_profile import SETTINGS, write_scene
+from scene_files import SETTINGS, write_scene
 from rrcache.pipeline import load_for_session
 from rrcache.profiler import profile
 from rrcache.profiler.adaptive import AdaptivePoint, best_at_level, sweep

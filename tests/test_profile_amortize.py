@@ -28,21 +28,9 @@ from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings, load_profile
 from rrcache.selection import AmortizedLoop
 
-from test_profile import SESSION
+from scene_files import SESSION, WAVE, fragment, write_scene
 
-SHADER = """#version 330
-in vec4 v_position;
-in vec3 v_normal;
-in vec3 v_objectPosition;
-uniform vec3 u_light;
-uniform float u_scale;
-out vec4 fragColor;
-
-float wave(vec3 p, float f) {
-    return sin(p.x * f + 1.3 * cos(p.y * f)) * cos(p.z * f * 0.7 + sin(p.x * f * 1.9));
-}
-
-void main() {
+SHADER = fragment("""void main() {
     vec3 p = v_objectPosition * u_scale;
     vec3 nrm = normalize(v_normal);
     vec3 l = normalize(u_light - v_position.xyz);
@@ -53,7 +41,7 @@ void main() {
     }
     fragColor = vec4(vec3(0.9, 0.8, 0.6) * (0.2 + 0.1 * shade), 1.0);
 }
-"""
+""", WAVE)
 
 #: 64×64 at full resolution (the error runs in a window at full pixel density), a 1 s budget:
 #: the costliest node and the estimator are trained
@@ -61,11 +49,7 @@ SETTINGS = dict(periods=(2, 4, 8), timing_frames=6, timing_periods=(2, 8), min_g
 
 
 def _scene(folder):
-    folder.mkdir(parents=True, exist_ok=True)
-    shader, session = folder / "soft.frag", folder / "orbit.json"
-    shader.write_text(SHADER)
-    session.write_text(json.dumps({**SESSION, "resolution": [64, 64]}))
-    return shader, session
+    return write_scene(folder, SHADER, {**SESSION, "resolution": [64, 64]}, "soft.frag")
 
 
 @pytest.fixture(scope="module")

@@ -21,7 +21,7 @@ import sys
 
 import pytest
 
-from test_profile import SESSION
+from scene_files import SESSION
 
 from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings, load_profile, read_store

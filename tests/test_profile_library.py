@@ -21,7 +21,7 @@ from rrcache.errors import RRCacheError
 from rrcache.profiler.library import profile_library
 from rrcache.profiler.manifest import entries_from_globs, read_manifest
 from rrcache.profiles import TrainingSettings, load_profile
-from test_profile import write_scene
+from scene_files import write_scene
 
 #: tiny profiles: four timing frames, no sets, no validation (the summary reads the predictions)
 FAST = dict(periods=[2, 4, 8], resolution=[32, 24], timing_frames=4, timing_periods=[2, 8], min_gain=0.0,

@@ -15,7 +15,7 @@ from rrcache.selection import CachedNode, Selection
 
 import pytest
 
-from test_profile import SESSION
+from scene_files import SESSION
 
 from rrcache.glsl.frontend import describe_change, file_records, load_shader
 from rrcache.profiles import load_profile

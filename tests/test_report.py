@@ -145,7 +145,7 @@ def test_reselection_timing_reports_its_figures(demo):
 def test_tiny_profile_and_the_plots_flag(tmp_path):
     """The tests' tiny scene (nothing beats the original at 64×48): the report still carries every
     node and the four selections; ``plots=False`` writes neither plots nor report."""
-    from test_profile import SETTINGS, write_scene
+    from scene_files import SETTINGS, write_scene
 
     from rrcache.profiler import profile
     from rrcache.profiles import TrainingSettings

@@ -10,6 +10,7 @@ stayed empty and hover and click were dead.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 
@@ -17,9 +18,10 @@ import pytest
 
 from rrcache.profiler import demo_profile
 from rrcache.profiles import load_profile
-from rrcache.report import REPORT_NAME, write_report
+from rrcache.report import write_report
 from rrcache.report.browser import Chromium, find_chromium
 from rrcache.report.html import script_json
+from rrcache.session import load_session
 
 pytestmark = pytest.mark.skipif(find_chromium() is None,
                                 reason="chromium is not installed (Debian: apt-get install -y chromium; .ci/run does)")
@@ -50,6 +52,9 @@ def page(demo, tmp_path_factory):
     shutil.copytree(demo.path, prof_dir)
     prof = load_profile(prof_dir)
     prof.shader, prof.session = str(shader), str(session)
+    # the profile of that shader: its recorded content hash is the new file's
+    prof.shader_files = [{"path": str(shader), "sha256": hashlib.sha256(shader.read_bytes()).hexdigest()}]
+    prof.session_hash = load_session(session).hash
     node = prof.trained_nodes[0]
     node.text = f"{node.text} /* {MARKUP} */"
     path = write_report(prof, prof_dir)

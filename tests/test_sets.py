@@ -28,7 +28,7 @@ from rrcache.model import ModelTable, synthetic_table
 from rrcache.model.sets import SetOption, better, pick, search, set_prediction
 from rrcache.profiles import TrainingSettings, load_profile
 from rrcache.profiles.document import Profile
-from test_profile import SETTINGS, write_scene
+from scene_files import SETTINGS, write_scene
 
 
 def _table(nested: bool = False):

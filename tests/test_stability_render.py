@@ -5,7 +5,6 @@ beyond the 16-bit float range.
 """
 from __future__ import annotations
 
-import json
 import math
 import warnings
 
@@ -25,21 +24,12 @@ from rrcache.profiles.settings import TrainingSettings
 from rrcache.runtime import CacheRuntime
 from rrcache.session import load_session
 
+from scene_files import FIXED_LIGHT, STATIC_CAMERA, fragment, node_named, session_doc, write_scene
+
 AREA = "rendering (EGL, llvmpipe)"
 
 # u_zero is 0: the left 8 columns divide 0 by 0 (NaN), the next 4 divide 1 by 0 (+Inf)
-SHADER = """#version 330
-in vec4 v_position;
-in vec3 v_normal;
-in vec3 v_objectPosition;
-uniform vec3 u_light;
-uniform float u_scale;
-uniform float u_gain;
-uniform float u_zero;
-uniform float u_poison;
-out vec4 fragColor;
-
-void main() {
+SHADER = fragment("""void main() {
     float b = 0.5 + 0.25 * sin(v_objectPosition.x * u_scale) * cos(v_objectPosition.y * u_scale);
     float big = b * u_gain;
     vec3 albedo = vec3(b, b * b, 1.0 - b) * (big / u_gain);
@@ -49,32 +39,21 @@ void main() {
     else if (u_poison > 0.5 && gl_FragCoord.x < 12.0) color = vec3(1.0 / u_zero);
     fragColor = vec4(color, 1.0);
 }
-"""
-CAMERA = [{"frame": 0, "eye": [0, 0.5, 3.2], "target": [0, 0, 0], "up": [0, 1, 0]}]
+""", uniforms=("float u_gain", "float u_zero", "float u_poison"))
+CAMERA = STATIC_CAMERA
 SPHERE = {"procedural": {"type": "icosphere", "radius": 1.0, "subdivisions": 2}}
 
 
 def _files(tmp_path, frames=4, resolution=(32, 32), objects=None, near=0.1, far=50.0, uniforms=None, camera=None):
-    doc = {
-        "rrcache_session": 1, "resolution": list(resolution), "frames": frames, "fps": 30,
-        "camera": {"fov": 45, "near": near, "far": far, "keyframes": camera or CAMERA},
-        "light": {"color": [1, 1, 1], "keyframes": [{"frame": 0, "position": [3, 3, 3]}]},
-        "objects": objects if objects is not None else [SPHERE],
-        "uniforms": {"u_scale": 7.0, "u_gain": 1.0, "u_zero": 0.0, "u_poison": 0.0, **(uniforms or {})},
-    }
-    session = tmp_path / "session.json"
-    session.write_text(json.dumps(doc))
-    shader = tmp_path / "extreme.frag"
-    shader.write_text(SHADER)
-    return shader, session
+    doc = session_doc(resolution, frames, camera or CAMERA, FIXED_LIGHT,
+                      objects if objects is not None else [SPHERE],
+                      {"u_scale": 7.0, "u_gain": 1.0, "u_zero": 0.0, "u_poison": 0.0, **(uniforms or {})},
+                      near, far)
+    return write_scene(tmp_path, SHADER, doc, "extreme.frag", "session.json")
 
 
 def _work(shader_path, session, text="vec3(b, b * b, 1.0 - b)"):
-    shader = load_shader(shader_path, defines=mesh_defines(session_attributes(session)))
-    prepared = prepare_file(shader_path, session)
-    table = cacheable_nodes(shader)
-    node = next(n for n in list(table.nodes) + list(table.excluded) if n.text == text)
-    return table, prepared, node
+    return node_named(shader_path, session, text)
 
 
 def _summary_finite(summary: dict) -> list[str]:

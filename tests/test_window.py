@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from test_profile import write_scene
+from scene_files import write_scene
 
 from rrcache.harness.cached import CachedRenderer, compare
 from rrcache.harness.renderer import Renderer

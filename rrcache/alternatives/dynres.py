@@ -29,20 +29,13 @@ import numpy as np
 
 from rrcache.errors import RRCacheError
 from rrcache.gl.context import get_context
-from rrcache.gl.program import build_program
+from rrcache.gl.program import build_program, fullscreen_vertex
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import FrameResult, Renderer, check_frame_index, session_background
 from rrcache.harness.vertex import vertex_for
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, match_scale
-
-_UPSAMPLE_VERTEX = """#version 330 core
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-"""
 
 _UPSAMPLE_FRAGMENT = """#version 330 core
 uniform sampler2D rr_low;
@@ -104,7 +97,7 @@ class DynresRenderer:
         self._low_fbo = scope.own(ctx.framebuffer([self._low], self._low_depth))
         self._color = scope.own(ctx.texture(self.size, 4, dtype="f4"))
         self._fbo = scope.own(ctx.framebuffer([self._color]))
-        self._upsample = scope.own(build_program(ctx, _UPSAMPLE_VERTEX, _UPSAMPLE_FRAGMENT,
+        self._upsample = scope.own(build_program(ctx, fullscreen_vertex(0.0), _UPSAMPLE_FRAGMENT,
                                                  fragment_name="<rrcache bilinear upsample>"))
         self._upsample["rr_low"].value = 0
         self._upsample["rr_targetSize"].value = tuple(float(v) for v in self.size)
@@ -156,16 +149,18 @@ class DynresRenderer:
         self.release()
 
 
-def measure_scale(prepared, session, size, frames, original: Optional[Renderer] = None):
+def measure_scale(prepared, session, size, frames, original: Optional[Renderer] = None,
+                  on_frame: Optional[Callable] = None):
     """A function ``scale -> Comparison`` measuring dynamic resolution at ``scale`` over
-    ``frames`` side by side with the original (``original`` reused when given)."""
+    ``frames`` side by side with the original (``original`` reused when given;
+    ``on_frame(row, frame, original's frame)`` after each frame)."""
 
     def run(scale: float):
         own = original is None
         ref = Renderer(prepared, session, size) if own else original
         try:
             with DynresRenderer(prepared, session, size, scale) as dyn:
-                return compare_renderers(ref, dyn, frames)
+                return compare_renderers(ref, dyn, frames, on_frame=on_frame)
         finally:
             if own:
                 ref.release()

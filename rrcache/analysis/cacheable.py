@@ -83,12 +83,15 @@ from rrcache.errors import RRCacheError
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import memo_printer, print_expr
 
-from rrcache.glsl.ast import iter_exprs
+from rrcache.glsl.ast import children, iter_exprs
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.rewrite import chain_of, is_live_flag, paused_gc
-from rrcache.glsl.writes import out_qualifiers, written_roots
-from rrcache.analysis.cost import CACHE_LOOKUP_COST, global_constants, loop_trips, op_cost
+from rrcache.glsl.defuse import out_qualifiers, written_roots
+from rrcache.analysis.cost import CACHE_LOOKUP_COST, loop_trips, op_cost
+from rrcache.analysis.loops import Constants, global_scalars
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text
+from rrcache.analysis.sums import name_partial_sums
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
 __all__ = ["REASONS", "CacheableNode", "ExcludedNode", "NodeTable", "cacheable_nodes",
@@ -221,12 +224,16 @@ def find_node(analysed: Union[Any, A.TranslationUnit], node_id: str) -> A.Expr:
 
 @deep
 def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
-                    cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False) -> NodeTable:
+                    cheap_below: int = CACHE_LOOKUP_COST, analysed: bool = False, moving=(),
+                    scores=None) -> NodeTable:
     """Enumerate the cacheable nodes of ``shader`` (a checked :class:`Shader`).
 
     The shader is first analysed (:func:`analyse`: inlining, unrolling loops of at most
-    ``max_iterations`` iterations) unless ``analysed`` says it already is. Nodes whose cost is
-    below ``cheap_below`` are left out as ``cheap``. See the module docstring for the rules.
+    ``max_iterations`` iterations, the terms of sums ordered by ``moving`` and ``scores``: see
+    :mod:`rrcache.analysis.sums`) unless ``analysed`` says it already is. Nodes whose cost is
+    below ``cheap_below`` are left out as ``cheap``. A partial sum of a reordered sum is named by
+    the terms it holds (``radiance: 24 of 25 terms, all but (i=2, j=2)``). See the module
+    docstring for the rules.
 
     >>> from rrcache.glsl.frontend import parse_shader
     >>> t = cacheable_nodes(parse_shader("uniform float u;\\nvoid main() {"
@@ -235,10 +242,11 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
     [('vec4(sin(u))', 'uniform'), ('sin(u)', 'uniform'), ('u', 'uniform')]
     """
     with paused_gc():
-        target = shader if analysed else analyse(shader, max_iterations)
+        target = shader if analysed else analyse(shader, max_iterations, moving=moving, scores=scores)
         table = _Classifier(target, cheap_below).run()
         if not analysed:  # the text as written, and the file, of nodes from inlined code
             attach_source_text(table, shader.unit)
+        name_partial_sums(table, target.unit, moving, scores)
         return table
 
 
@@ -382,7 +390,10 @@ def _differentiated_args(call) -> tuple:
 _SCREEN_BUILTINS = frozenset({"gl_FragCoord"})
 
 
-class _Classifier:
+class _Classifier(NodeVisitor):
+    """Visiting a statement runs the data flow through it; visiting an expression (through
+    :meth:`expr`, which records it) returns ``(_Info, the definition it duplicates or None)``."""
+
     def __init__(self, shader, cheap_below: int):
         self.shader = shader
         self.cheap_below = cheap_below
@@ -398,31 +409,40 @@ class _Classifier:
         # a definition inside a loop left rolled costs its own cost times the loop's trip bound
         # (loop_trips; nested loops multiply): what a value after the loop saves when cached
         self.repeat = 1
-        self.consts = global_constants(shader.unit)
+        self.consts = Constants(global_scalars(shader.info).get)
         info = shader.info
         outs = list(info.outputs)
         self.output = outs[0] if outs else ("gl_FragData" if "gl_FragData" in info.used_globals
                                              else "gl_FragColor")
+        self.top_expr = _TopLevel(self).visit
 
     # ------------------------------------------------------------------ driver
     def run(self) -> NodeTable:
-        unit = self.shader.unit
-        for d in unit.decls:
-            if isinstance(d, A.FunctionDecl) and d.body is not None:
-                if d.name == "main":
-                    self.block(d.body.stmts, _Ctx())
-                else:
-                    for e in iter_exprs(d.body):
-                        self.records.append(_Record(e, "type" if not _is_cacheable_type(e.type)
-                                                    else "dynamic", 0, 0))
-            elif isinstance(d, A.VariableDecl):
-                for decl in d.declarators:
-                    if decl.init is not None:
-                        for e in iter_exprs(decl.init):
-                            self.records.append(_Record(e, "type" if not _is_cacheable_type(e.type)
-                                                        else "uniform", 0, 0))
-                        self.state[(id(d), decl.name)] = (self.new_def(decl.init, True, 0, 0, 0, 0),)
+        for d in self.shader.unit.decls:
+            self.visit(d, None)
         return self.finish()
+
+    def visit_FunctionDecl(self, d: A.FunctionDecl, ctx) -> None:
+        if d.body is None:
+            return
+        if d.name == "main":
+            self.block(d.body.stmts, _Ctx())
+            return
+        for e in iter_exprs(d.body):     # a function the inliner kept: its nodes are dynamic
+            self.records.append(_Record(e, "type" if not _is_cacheable_type(e.type)
+                                        else "dynamic", 0, 0))
+
+    def visit_VariableDecl(self, d: A.VariableDecl, ctx) -> None:
+        """A global declaration (a local one is a statement: :meth:`visit_DeclStmt`)."""
+        for decl in d.declarators:
+            if decl.init is not None:
+                for e in iter_exprs(decl.init):
+                    self.records.append(_Record(e, "type" if not _is_cacheable_type(e.type)
+                                                else "uniform", 0, 0))
+                self.state[(id(d), decl.name)] = (self.new_def(decl.init, True, 0, 0, 0, 0),)
+
+    def visit_Node(self, node, ctx) -> None:
+        """Other declarations, and the statements with nothing to evaluate (``break``...)."""
 
     def finish(self) -> NodeTable:
         nodes: list[CacheableNode] = []
@@ -561,43 +581,44 @@ class _Classifier:
     def block(self, stmts: list, ctx: _Ctx) -> None:
         declared = []
         for s in stmts:
-            self.stmt(s, ctx)
+            self.visit(s, ctx)
             if isinstance(s, A.DeclStmt) and isinstance(s.decl, A.VariableDecl):
                 declared.extend((id(s.decl), d.name) for d in s.decl.declarators)
         for key in declared:     # out of scope: their definitions can no longer be read
             self.state.pop(key, None)
 
-    def stmt(self, s, ctx: _Ctx) -> None:
-        if isinstance(s, A.Compound):
-            self.block(s.stmts, ctx)
-        elif isinstance(s, A.DeclStmt):
-            if isinstance(s.decl, A.VariableDecl):
-                for d in s.decl.declarators:
-                    if d.array_dims:
-                        for x in d.array_dims:
-                            if x is not None:
-                                self.expr(x, ctx)
-                    start = len(self.records)
-                    info = self.expr(d.init, ctx) if d.init is not None else None
-                    made = self.define((id(s.decl), d.name), d.init, info, ctx)
-                    self.sink(start, made)
-        elif isinstance(s, A.ExprStmt):
-            if s.expr is not None:
-                self.top_expr(s.expr, ctx)
-        elif isinstance(s, A.If):
-            self.branch(s, ctx)
-        elif isinstance(s, (A.For, A.While, A.DoWhile)):
-            self.loop(s, ctx)
-        elif isinstance(s, A.Switch):
-            info = self.expr(s.expr, ctx)
-            inner = ctx.but(dynamic=ctx.dynamic or not info.uniform,
-                            varying=ctx.varying or not info.uniform,
-                            region=ctx.region + ((id(s), 0),))
-            before = dict(self.state)
-            self.clobber(s.body, inner)
-            self.block(s.body.stmts, inner)
-            self.state = self.merge(before, self.state)
-        elif isinstance(s, A.Return) and s.expr is not None:
+    def visit_Compound(self, s: A.Compound, ctx: _Ctx) -> None:
+        self.block(s.stmts, ctx)
+
+    def visit_DeclStmt(self, s: A.DeclStmt, ctx: _Ctx) -> None:
+        if not isinstance(s.decl, A.VariableDecl):
+            return
+        for d in s.decl.declarators:
+            if d.array_dims:
+                for x in d.array_dims:
+                    if x is not None:
+                        self.expr(x, ctx)
+            start = len(self.records)
+            info = self.expr(d.init, ctx) if d.init is not None else None
+            made = self.define((id(s.decl), d.name), d.init, info, ctx)
+            self.sink(start, made)
+
+    def visit_ExprStmt(self, s: A.ExprStmt, ctx: _Ctx) -> None:
+        if s.expr is not None:
+            self.top_expr(s.expr, ctx)
+
+    def visit_Switch(self, s: A.Switch, ctx: _Ctx) -> None:
+        info = self.expr(s.expr, ctx)
+        inner = ctx.but(dynamic=ctx.dynamic or not info.uniform,
+                        varying=ctx.varying or not info.uniform,
+                        region=ctx.region + ((id(s), 0),))
+        before = dict(self.state)
+        self.clobber(s.body, inner)
+        self.block(s.body.stmts, inner)
+        self.state = self.merge(before, self.state)
+
+    def visit_Return(self, s: A.Return, ctx: _Ctx) -> None:
+        if s.expr is not None:
             self.expr(s.expr, ctx)
 
     def sink(self, start: int, made: Optional[_Def]) -> None:
@@ -609,7 +630,7 @@ class _Classifier:
             if records[k].sink is None:
                 records[k].sink = made.idx
 
-    def branch(self, s: A.If, ctx: _Ctx) -> None:
+    def visit_If(self, s: A.If, ctx: _Ctx) -> None:
         info = self.expr(s.cond, ctx)
         guard = isinstance(s.cond, A.Ident) and is_live_flag(s.cond.name)
         varying = not info.uniform
@@ -619,14 +640,15 @@ class _Classifier:
         for k, sub in enumerate((s.then, s.else_)):
             self.state = dict(before)
             if sub is not None:
-                self.stmt(sub, ctx.but(dynamic=inner_dyn, varying=ctx.varying or varying,
+                self.visit(sub, ctx.but(dynamic=inner_dyn, varying=ctx.varying or varying,
                                        region=ctx.region + ((id(s), k),)))
             results.append(self.state)
         self.state = self.merge(results[0], results[1])
 
-    def loop(self, s, ctx: _Ctx) -> None:
+    def visit_For(self, s, ctx: _Ctx) -> None:
+        """A loop left rolled (``for``, ``while``, ``do``): its nodes are dynamic."""
         if isinstance(s, A.For) and s.init is not None:
-            self.stmt(s.init, ctx)
+            self.visit(s.init, ctx)
         inner = ctx.but(dynamic=True, varying=True, region=ctx.region + ((id(s), 0),))
         outer_repeat = self.repeat
         self.repeat = outer_repeat * loop_trips(s, self.consts)
@@ -634,32 +656,26 @@ class _Classifier:
         self.clobber(s, inner)
         cond = s.cond
         if isinstance(s, A.DoWhile):
-            self.stmt(s.body, inner)
+            self.visit(s.body, inner)
             self.expr(cond, inner)
         else:
             if isinstance(cond, A.VariableDecl):
-                self.stmt(A.DeclStmt(cond, loc=cond.loc), inner)
+                self.visit(A.DeclStmt(cond, loc=cond.loc), inner)
             elif cond is not None:
                 self.expr(cond, inner)
-            self.stmt(s.body, inner)
+            self.visit(s.body, inner)
             if isinstance(s, A.For) and s.step is not None:
                 self.top_expr(s.step, inner)
         self.repeat = outer_repeat
         self.state = self.merge(before, self.state)
 
+    visit_While = visit_DoWhile = visit_For
+
     # ------------------------------------------------------------------ expressions
-    def top_expr(self, e, ctx: _Ctx) -> None:
-        """An expression statement: an assignment's value is a node, the assignment is not."""
-        if isinstance(e, A.Assign):
-            self.assign(e, ctx, top=True)
-        elif isinstance(e, A.Unary) and e.op in ("++", "--"):
-            index = self.lvalue(e.operand, ctx)
-            self.write(e.operand, None, self.step_info(index), ctx)
-        elif isinstance(e, A.Sequence):
-            for x in e.exprs:
-                self.top_expr(x, ctx)
-        else:
-            self.expr(e, ctx)
+    def step(self, e: A.Unary, ctx: _Ctx) -> None:
+        """``x++``/``x--``: a partial write of ``x``."""
+        index = self.lvalue(e.operand, ctx)
+        self.write(e.operand, None, self.step_info(index), ctx)
 
     def step_info(self, index: Optional[_Info]) -> _Info:
         """The value an increment adds (one ALU operation), with its l-value's indices."""
@@ -742,26 +758,39 @@ class _Classifier:
 
     def expr(self, e, ctx: _Ctx) -> _Info:
         """Visit a value expression (evaluation order), record it, return what it is."""
-        if isinstance(e, A.Ident):
-            info, dup = self.ident(e)
-        elif isinstance(e, (A.IntLit, A.FloatLit, A.BoolLit)):
-            info = _Info(True, 0, False, 0, 0, 0,
-                         self.intern_key(("lit", type(e).__name__, e.value)))
-            dup = None
-        elif isinstance(e, A.Assign):
-            self.assign(e, ctx)
-            info = _Info(False, 0, True, 0, 0, 0, self.intern_key(("fx", id(e))))
-            dup = None
-        elif isinstance(e, A.Unary) and e.op in ("++", "--"):
-            index = self.lvalue(e.operand, ctx)
-            self.write(e.operand, None, self.step_info(index), ctx)
-            info = _Info(False, 0, True, 0, 0, 1, self.intern_key(("fx", id(e))))
-            dup = None
-        else:
-            info = self.compound_expr(e, ctx)
-            dup = None
+        info, dup = self.visit(e, ctx)
         self.record(e, info, ctx, dup)
         return info
+
+    def visit_Ident(self, e: A.Ident, ctx: _Ctx):
+        return self.ident(e)
+
+    def visit_IntLit(self, e, ctx: _Ctx):
+        return _Info(True, 0, False, 0, 0, 0,
+                     self.intern_key(("lit", type(e).__name__, e.value))), None
+
+    visit_FloatLit = visit_BoolLit = visit_IntLit
+
+    def visit_Assign(self, e: A.Assign, ctx: _Ctx):
+        self.assign(e, ctx)
+        return _Info(False, 0, True, 0, 0, 0, self.intern_key(("fx", id(e)))), None
+
+    def visit_Unary(self, e: A.Unary, ctx: _Ctx):
+        if e.op not in ("++", "--"):
+            return self.compound_expr(e, ctx), None
+        self.step(e, ctx)
+        return _Info(False, 0, True, 0, 0, 1, self.intern_key(("fx", id(e)))), None
+
+    def visit_Ternary(self, e: A.Ternary, ctx: _Ctx):
+        return self.compound_expr(e, ctx, first=e.cond, rest=(e.then, e.else_)), None
+
+    def visit_Binary(self, e: A.Binary, ctx: _Ctx):
+        if e.op in ("&&", "||"):
+            return self.compound_expr(e, ctx, first=e.left, rest=(e.right,)), None
+        return self.compound_expr(e, ctx), None
+
+    def visit_Expr(self, e, ctx: _Ctx):
+        return self.compound_expr(e, ctx), None
 
     def ident(self, e: A.Ident):
         sym = e.symbol
@@ -788,13 +817,20 @@ class _Classifier:
         dup_of = defs[0].expr if len(defs) == 1 else None
         return _Info(uniform, flags, False, mask, cost, 0, key), dup_of
 
-    def compound_expr(self, e, ctx: _Ctx) -> _Info:
+    def visit_Call(self, e: A.Call, ctx: _Ctx):
+        return self.compound_expr(e, ctx, e.args, call=True), None
+
+    def compound_expr(self, e, ctx: _Ctx, operands=None, first=None, rest=(),
+                      call: bool = False) -> _Info:
+        """An operation on its ``operands`` (default: its syntax children); ``first``: the
+        condition that decides whether ``rest`` is evaluated (``?:``, ``&&``, ``||``);
+        ``call``: ``e`` is a call (an array constructor's sizes are not operands)."""
         uniform, flags, effects = True, 0, False
         own = op_cost(e)
         keys: list = [type(e).__name__, getattr(e, "op", None), getattr(e, "name", None)]
         out_pos: dict = {}
         diff_pos: tuple = ()
-        if isinstance(e, A.Call):
+        if call:
             if e.kind == "function":
                 uniform, effects = False, True
             if getattr(e.target, "side_effects", False):
@@ -802,16 +838,14 @@ class _Classifier:
             out_pos = {i: q for i, q in enumerate(out_qualifiers(e)) if q != "in"}
             diff_pos = _differentiated_args(e)
         outs = []
-        if isinstance(e, A.Ternary) or (isinstance(e, A.Binary) and e.op in ("&&", "||")):
-            first = e.cond if isinstance(e, A.Ternary) else e.left
+        if first is not None:
             infos = [self.expr(first, ctx)]
-            rest = [e.then, e.else_] if isinstance(e, A.Ternary) else [e.right]
             inner = ctx.but(dynamic=ctx.dynamic or not infos[0].uniform,
                             varying=ctx.varying or not infos[0].uniform)
             infos += [self.expr(x, inner) for x in rest]
         else:
             infos = []
-            for i, c in enumerate(_value_children(e)):
+            for i, c in enumerate(children(e, decl_types=False) if operands is None else operands):
                 if i in out_pos:
                     index = self.lvalue(c, ctx)
                     outs.append((c, out_pos[i], index))
@@ -833,7 +867,7 @@ class _Classifier:
             keys.append(inf.key)
         if diff_pos:
             flags |= _DERIV
-        if isinstance(e, A.Call) and e.kind == "function":
+        if call and e.kind == "function":
             keys.append(id(e))
         info = _Info(uniform, flags, effects, mask, rcost, own, self.intern_key(tuple(keys)))
         for target, qual, index in outs:      # out/inout arguments: written by the call
@@ -859,19 +893,24 @@ class _Classifier:
                                     dup_of is not None, info.key, ctx.region, dup_of))
 
 
-def _value_children(e) -> list:
-    if isinstance(e, A.Call):
-        return list(e.args)
-    if isinstance(e, A.Binary):
-        return [e.left, e.right]
-    if isinstance(e, A.Unary):
-        return [e.operand]
-    if isinstance(e, (A.Field, A.Length)):
-        return [e.obj]
-    if isinstance(e, A.Index):
-        return [e.obj, e.index]
-    if isinstance(e, A.Sequence):
-        return list(e.exprs)
-    if isinstance(e, A.InitList):
-        return list(e.items)
-    return []
+class _TopLevel(NodeVisitor):
+    """An expression statement: an assignment's value is a node, the assignment is not."""
+
+    def __init__(self, classifier: _Classifier):
+        self.c = classifier
+
+    def visit_Assign(self, e: A.Assign, ctx: _Ctx) -> None:
+        self.c.assign(e, ctx, top=True)
+
+    def visit_Unary(self, e: A.Unary, ctx: _Ctx) -> None:
+        if e.op in ("++", "--"):
+            self.c.step(e, ctx)
+        else:
+            self.c.expr(e, ctx)
+
+    def visit_Sequence(self, e: A.Sequence, ctx: _Ctx) -> None:
+        for x in e.exprs:
+            self.visit(x, ctx)
+
+    def generic_visit(self, e, ctx: _Ctx) -> None:
+        self.c.expr(e, ctx)

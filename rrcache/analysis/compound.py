@@ -18,11 +18,12 @@ from __future__ import annotations
 import dataclasses
 
 from rrcache.glsl import ast as A
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.semantic import check
 
 from rrcache.glsl.ast import walk
 from rrcache.glsl.rewrite import clone
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import written_roots
 
 __all__ = ["expand_compound_assignments", "expand_unit"]
 
@@ -54,14 +55,23 @@ def expand_unit(unit: A.TranslationUnit) -> A.TranslationUnit:
     return unit
 
 
-def _simple_target(e: A.Expr) -> bool:
-    if isinstance(e, A.Ident):
+class _SimpleTarget(NodeVisitor):
+    """A variable, a swizzle or field of one, or an element with a literal or variable index."""
+
+    def generic_visit(self, e) -> bool:
+        return False
+
+    def visit_Ident(self, e) -> bool:
         return True
-    if isinstance(e, A.Field):
-        return _simple_target(e.obj)
-    if isinstance(e, A.Index):
-        return _simple_target(e.obj) and isinstance(e.index, (A.IntLit, A.Ident))
-    return False
+
+    def visit_Field(self, e: A.Field) -> bool:
+        return self.visit(e.obj)
+
+    def visit_Index(self, e: A.Index) -> bool:
+        return self.visit(e.obj) and isinstance(e.index, (A.IntLit, A.Ident))
+
+
+_simple_target = _SimpleTarget().visit
 
 
 def _pure(e: A.Expr) -> bool:

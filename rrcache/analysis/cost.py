@@ -46,9 +46,11 @@ from __future__ import annotations
 from rrcache.glsl import ast as A
 
 from rrcache.glsl.ast import walk
+from rrcache.glsl.visitor import NodeVisitor
+from rrcache.analysis.loops import counted_loop
 
 __all__ = ["ADD", "MUL", "DIV", "SQRT", "TRANSCENDENTAL", "TEXTURE", "USER_CALL",
-           "CACHE_LOOKUP_COST", "MAX_LOOP_TRIPS", "op_cost", "subtree_cost", "loop_trips", "global_constants"]
+           "CACHE_LOOKUP_COST", "MAX_LOOP_TRIPS", "op_cost", "subtree_cost", "loop_trips"]
 
 ADD = 1
 MUL = 1
@@ -87,13 +89,10 @@ def _dot(n: int) -> int:
     return 2 * n - 1
 
 
-def op_cost(e: A.Expr) -> int:
-    """The cost of the operation at ``e`` alone (its operands not included).
+class _OpCost(NodeVisitor):
+    """The cost of the operation at an expression alone (its operands not included)."""
 
-    >>> op_cost(A.Binary("/", A.Ident("a"), A.Ident("b")))   # untyped: one component
-    4
-    """
-    if isinstance(e, A.Binary):
+    def visit_Binary(self, e: A.Binary) -> int:
         if e.op == "*":
             lt, rt = getattr(e.left, "type", None), getattr(e.right, "type", None)
             if lt is not None and rt is not None and (lt.is_matrix or rt.is_matrix):
@@ -109,13 +108,30 @@ def op_cost(e: A.Expr) -> int:
         if e.op in ("<", ">", "<=", ">=", "==", "!="):
             return max(_components(e.left), _components(e.right))
         return 1
-    if isinstance(e, A.Unary):
+
+    def visit_Unary(self, e: A.Unary) -> int:
         return _components(e) if e.op == "-" else (0 if e.op == "+" else 1)
-    if isinstance(e, A.Ternary):
+
+    def visit_Ternary(self, e: A.Ternary) -> int:
         return _components(e)
-    if isinstance(e, A.Call):
+
+    def visit_Call(self, e: A.Call) -> int:
         return _call_cost(e)
-    return 0
+
+    def generic_visit(self, e) -> int:
+        return 0
+
+
+def op_cost(e: A.Expr) -> int:
+    """The cost of the operation at ``e`` alone (its operands not included).
+
+    >>> op_cost(A.Binary("/", A.Ident("a"), A.Ident("b")))   # untyped: one component
+    4
+    """
+    return _OP_COST.visit(e)
+
+
+_OP_COST = _OpCost()
 
 
 def _call_cost(e: A.Call) -> int:
@@ -178,80 +194,24 @@ def subtree_cost(e: A.Expr) -> int:
 MAX_LOOP_TRIPS = 4096
 
 
-def global_constants(unit: A.TranslationUnit) -> dict[str, float]:
-    """``const`` globals of ``unit`` initialised with a number literal (``const int STEPS = 80;``).
+def loop_trips(loop, constants) -> int:
+    """How many times the body of a loop left rolled (one with a ``break``, or over the
+    unroller's budget) runs at most: the trip count of its header when it is a counted loop
+    (:func:`rrcache.analysis.loops.counted_loop`, with ``constants`` folding the header's
+    expressions), 1 when it cannot tell (a bound read from a uniform, a ``while`` loop). The
+    static cost of what such a loop computes is its body's times this: one iteration of a
+    64-step ray march is not its cost. At most :data:`MAX_LOOP_TRIPS`.
 
-    >>> from rrcache.glsl.parser import parse_source
-    >>> global_constants(parse_source("#version 330\\nconst int N = 8; const float K = 0.5; uniform int U;"))
-    {'N': 8, 'K': 0.5}
-    """
-    out: dict[str, float] = {}
-    for d in unit.decls:
-        if isinstance(d, A.VariableDecl) and "const" in d.type.qualifiers:
-            for decl in d.declarators:
-                if isinstance(decl.init, (A.IntLit, A.FloatLit)) and not decl.array_dims:
-                    out[decl.name] = decl.init.value
-    return out
-
-
-def _number(e, consts: dict):
-    if isinstance(e, (A.IntLit, A.FloatLit)):
-        return e.value
-    if isinstance(e, A.Ident) and e.name in consts:
-        return consts[e.name]
-    if isinstance(e, A.Unary) and e.op == "-" and not e.postfix:
-        v = _number(e.operand, consts)
-        return None if v is None else -v
-    return None
-
-
-def loop_trips(loop, consts: dict) -> int:
-    """How many times the body of a ``for`` loop left rolled (one with a ``break``, or over the
-    unroller's budget) runs at most, when its header is ``i = a; i <op> b; i += c`` with
-    constant ``a``, ``b``, ``c`` (literals or ``consts``); 1 when it cannot tell (a bound read
-    from a uniform, a ``while`` loop). The static cost of what such a loop computes is its
-    body's times this: one iteration of a 64-step ray march is not its cost. At most
-    :data:`MAX_LOOP_TRIPS`.
-
-    >>> from rrcache.glsl.parser import parse_source
-    >>> unit = parse_source("#version 330\\nconst int N = 80;\\nvoid main() { float t = 0.0;"
-    ...                     " for (int i = 0; i < N; i++) { t += 1.0; if (t > 9.0) break; } }")
-    >>> loop = [n for n in unit.walk() if isinstance(n, A.For)][0]
-    >>> loop_trips(loop, global_constants(unit))
+    >>> from rrcache.glsl.frontend import parse_shader
+    >>> from rrcache.analysis.loops import Constants, global_scalars
+    >>> s = parse_shader("#version 330\\nconst int N = 80;\\nout vec4 c;\\nvoid main() { float t = 0.0;"
+    ...                  " for (int i = 0; i < N; i++) { t += 1.0; if (t > 9.0) break; } c = vec4(t); }")
+    >>> loop = [n for n in s.unit.walk() if isinstance(n, A.For)][0]
+    >>> loop_trips(loop, Constants(global_scalars(s.info).get))
     80
     """
-    if not isinstance(loop, A.For) or loop.cond is None or isinstance(loop.cond, A.VariableDecl):
+    head, _why = counted_loop(loop, constants)
+    if head is None:
         return 1
-    name, start = None, None
-    init = loop.init
-    if isinstance(init, A.DeclStmt) and isinstance(init.decl, A.VariableDecl) and len(init.decl.declarators) == 1:
-        name, start = init.decl.declarators[0].name, _number(init.decl.declarators[0].init, consts)
-    elif isinstance(init, A.ExprStmt) and isinstance(init.expr, A.Assign) and init.expr.op == "=" \
-            and isinstance(init.expr.target, A.Ident):
-        name, start = init.expr.target.name, _number(init.expr.value, consts)
-    cond, step = loop.cond, loop.step
-    if name is None or start is None or not isinstance(cond, A.Binary):
-        return 1
-    if isinstance(cond.left, A.Ident) and cond.left.name == name:
-        op, bound = cond.op, _number(cond.right, consts)
-    elif isinstance(cond.right, A.Ident) and cond.right.name == name:
-        op, bound = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!="}.get(cond.op), _number(cond.left, consts)
-    else:
-        return 1
-    delta = None
-    if isinstance(step, A.Unary) and step.op in ("++", "--") and isinstance(step.operand, A.Ident) \
-            and step.operand.name == name:
-        delta = 1 if step.op == "++" else -1
-    elif isinstance(step, A.Assign) and step.op in ("+=", "-=") and isinstance(step.target, A.Ident) \
-            and step.target.name == name:
-        v = _number(step.value, consts)
-        delta = None if v is None else (v if step.op == "+=" else -v)
-    if bound is None or not delta:
-        return 1
-    span = {"<": bound - start, "<=": bound - start + (1 if delta > 0 else 0),
-            ">": start - bound, ">=": start - bound + (1 if delta < 0 else 0),
-            "!=": abs(bound - start)}.get(op)
-    if span is None or (op in ("<", "<=") and delta < 0) or (op in (">", ">=") and delta > 0):
-        return 1
-    trips = -(-span // abs(delta)) if span > 0 else 0
-    return int(min(max(trips, 1), MAX_LOOP_TRIPS))
+    trips = head.trips(MAX_LOOP_TRIPS)
+    return MAX_LOOP_TRIPS if trips is None else max(trips, 1)

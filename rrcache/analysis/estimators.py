@@ -57,11 +57,13 @@ from typing import Any, Optional
 from rrcache.deep import deep
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_expr
-from rrcache.glsl.ast import walk
+from rrcache.glsl.ast import main_function, walk
+from rrcache.glsl.visitor import NodeVisitor
+from rrcache.analysis.loops import Constants, counted_loop, global_scalars
 from rrcache.analysis.term_range import FLT_MAX, signed_term, term_range
 from rrcache.errors import GLSLError, printable
 from rrcache.glsl.rewrite import paused_gc
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import written_roots
 
 __all__ = ["Estimator", "NotEstimator", "EstimatorTable", "find_estimators", "estimator_loops",
            "loop_header", "display_name", "parse_pragma", "ACCUMULATOR_TYPES", "MAX_SAMPLES",
@@ -74,9 +76,6 @@ MAX_SAMPLES = 65536
 #: the pragma text (after ``#pragma``) that marks a loop as an estimator
 PRAGMA = "rrcache estimator"
 
-_COMPARE = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
-            ">=": lambda a, b: a >= b, "!=": lambda a, b: a != b}
-_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!="}
 
 
 @dataclass
@@ -172,116 +171,48 @@ class EstimatorTable:
 
 # ----------------------------------------------------------------------------- the loops
 
-def _main(unit: A.TranslationUnit) -> Optional[A.FunctionDecl]:
-    for d in unit.decls:
-        if isinstance(d, A.FunctionDecl) and d.name == "main" and d.body is not None:
-            return d
-    return None
+class _Loops(NodeVisitor):
+    """Every loop of a statement in program order, with its depth."""
+
+    def __init__(self):
+        self.found: list = []
+
+    def generic_visit(self, node, depth: int = 0) -> None:
+        for child in A.children(node):
+            if isinstance(child, A.Stmt):
+                self.visit(child, depth)
+
+    def visit_For(self, node, depth: int = 0) -> None:
+        self.found.append((node, depth))
+        self.generic_visit(node, depth + 1)
+
+    visit_While = visit_DoWhile = visit_For
 
 
 def estimator_loops(unit: A.TranslationUnit) -> list[tuple[A.For, int]]:
     """Every loop of ``main`` (``for``, ``while``, ``do``) in program order, with its depth (0: not
     inside another loop). The position in this list (from 1) is the loop's id number."""
-    out: list = []
-
-    def visit(node, depth: int) -> None:
-        if isinstance(node, (A.For, A.While, A.DoWhile)):
-            out.append((node, depth))
-            depth += 1
-        for child in _child_nodes(node):
-            visit(child, depth)
-
-    main = _main(unit)
-    if main is not None:
-        visit(main.body, 0)
-    return out
-
-
-def _child_nodes(node):
-    from rrcache.glsl.ast import children
-
-    return [c for c in children(node) if isinstance(c, A.Stmt)]
-
-
-def _const_values(info) -> dict:
-    if info is None:
-        return {}
-    return {name: sym.const_value for name, sym in info.globals.items()
-            if sym.kind == "const" and isinstance(sym.const_value, (int, float, bool))
-            and not isinstance(sym.const_value, bool) and not sym.type.dims}
-
-
-def _const(e, consts: dict) -> Optional[int]:
-    """The value of a constant integer expression, or None."""
-    if isinstance(e, A.IntLit) and not e.unsigned:
-        return int(e.value)
-    if isinstance(e, A.Ident):
-        v = consts.get(e.name)
-        return v if isinstance(v, int) else None
-    if isinstance(e, A.Unary) and e.op in ("-", "+"):
-        v = _const(e.operand, consts)
-        return None if v is None else (-v if e.op == "-" else v)
-    if isinstance(e, A.Binary) and e.op in ("+", "-", "*", "/"):
-        a, b = _const(e.left, consts), _const(e.right, consts)
-        if a is None or b is None or (e.op == "/" and b == 0):
-            return None
-        if e.op == "/":
-            return int(a / b)  # GLSL integer division truncates
-        return a + b if e.op == "+" else a - b if e.op == "-" else a * b
-    if isinstance(e, A.Call) and e.name == "int" and len(e.args) == 1:
-        return _const(e.args[0], consts)
-    return None
+    main = main_function(unit)
+    if main is None:
+        return []
+    v = _Loops()
+    v.visit(main.body, 0)
+    return v.found
 
 
 def loop_header(loop: A.For, consts: dict) -> tuple[Optional[tuple[str, int, int, int]], str]:
-    """``((index, start, step, samples), "")`` for a constant-bound ``int`` loop, else
-    ``(None, reason)``."""
-    init = loop.init
-    if not (isinstance(init, A.DeclStmt) and isinstance(init.decl, A.VariableDecl)
-            and len(init.decl.declarators) == 1):
-        return None, "the loop does not declare its index in its header"
-    decl = init.decl
-    d = decl.declarators[0]
-    if decl.type.spec.name != "int" or d.array_dims or decl.type.spec.array_dims:
-        return None, "the loop index is not an int"
-    name = d.name
-    start = _const(d.init, consts) if d.init is not None else None
-    if start is None:
-        return None, "the loop index does not start at a constant"
-    cond = loop.cond
-    if not isinstance(cond, A.Binary) or cond.op not in _COMPARE:
-        return None, "the loop condition is not a comparison of the index with a constant"
-    if isinstance(cond.left, A.Ident) and cond.left.name == name:
-        op, bound = cond.op, _const(cond.right, consts)
-    elif isinstance(cond.right, A.Ident) and cond.right.name == name:
-        op, bound = _FLIP[cond.op], _const(cond.left, consts)
-    else:
-        return None, "the loop condition does not compare the index"
-    if bound is None:
-        return None, "the loop bound is not constant"
-    s = loop.step
-    step = None
-    if isinstance(s, A.Unary) and s.op in ("++", "--") and isinstance(s.operand, A.Ident) and s.operand.name == name:
-        step = 1 if s.op == "++" else -1
-    elif isinstance(s, A.Assign) and isinstance(s.target, A.Ident) and s.target.name == name:
-        if s.op in ("+=", "-="):
-            v = _const(s.value, consts)
-            step = None if v is None else (v if s.op == "+=" else -v)
-        elif s.op == "=" and isinstance(s.value, A.Binary) and s.value.op in ("+", "-") \
-                and isinstance(s.value.left, A.Ident) and s.value.left.name == name:
-            v = _const(s.value.right, consts)
-            step = None if v is None else (v if s.value.op == "+" else -v)
-    if not step:
-        return None, "the loop step is not a constant increment of the index"
-    n, v = 0, start
-    while _COMPARE[op](v, bound):
-        n += 1
-        v += step
-        if n > MAX_SAMPLES:
-            return None, f"the loop runs more than {MAX_SAMPLES} times (or forever)"
+    """``((index, start, step, samples), "")`` for a constant-bound ``int`` loop declaring its
+    index in its header (:func:`rrcache.analysis.loops.counted_loop`; ``consts`` the ``const``
+    globals, :func:`rrcache.analysis.loops.global_scalars`), else ``(None, reason)``."""
+    head, why = counted_loop(loop, Constants(consts.get), declared_only=True, bases=("int",))
+    if head is None:
+        return None, why
+    n = head.trips(MAX_SAMPLES)
+    if n is None:
+        return None, f"the loop runs more than {MAX_SAMPLES} times (or forever)"
     if n < 2:
         return None, f"the loop runs {n} time{'s' if n != 1 else ''}"
-    return (name, start, step, n), ""
+    return (head.index, head.start, head.step, n), ""
 
 
 def _declared(node) -> set[str]:
@@ -306,6 +237,9 @@ def _type_name(ident: A.Ident) -> Optional[str]:
     return t.glsl_name() if t is not None and hasattr(t, "glsl_name") else None
 
 
+_EXITS = {A.Break: "break", A.Return: "return", A.Discard: "discard"}
+
+
 def classify(loop, depth: int, consts: dict, pragma: bool):
     """``(header, accumulators, types, reason)`` for one loop (reason "" when it qualifies)."""
     if not isinstance(loop, A.For):
@@ -318,12 +252,9 @@ def classify(loop, depth: int, consts: dict, pragma: bool):
     index = header[0]
     body = loop.body
     for n in walk(body):
-        if isinstance(n, A.Break):
-            return None, [], [], "the body has a break"
-        if isinstance(n, A.Return):
-            return None, [], [], "the body has a return"
-        if isinstance(n, A.Discard):
-            return None, [], [], "the body has a discard"
+        exit_word = _EXITS.get(n.__class__)
+        if exit_word is not None:
+            return None, [], [], f"the body has a {exit_word}"
     locals_ = _declared(body)
     written: dict[str, A.Ident] = {}
     for n in walk(body):
@@ -456,8 +387,13 @@ def _pragmas(shader) -> list[_Pragma]:
     return out
 
 
-def _loop_text(loop) -> str:
-    if isinstance(loop, A.For):
+class _LoopText(NodeVisitor):
+    """A loop's header as the table shows it."""
+
+    def generic_visit(self, loop) -> str:
+        return "do ... while"
+
+    def visit_For(self, loop: A.For) -> str:
         parts = []
         init = loop.init
         if isinstance(init, A.DeclStmt):
@@ -471,9 +407,12 @@ def _loop_text(loop) -> str:
         parts.append(print_expr(loop.cond) if isinstance(loop.cond, A.Expr) else "")
         parts.append(print_expr(loop.step) if loop.step is not None else "")
         return f"for ({'; '.join(parts)})"
-    if isinstance(loop, A.While):
+
+    def visit_While(self, loop: A.While) -> str:
         return f"while ({print_expr(loop.cond) if isinstance(loop.cond, A.Expr) else '...'})"
-    return "do ... while"
+
+
+_loop_text = _LoopText().visit
 
 
 def _marking(loop, pragmas: list[_Pragma], loops: list) -> list[_Pragma]:
@@ -513,7 +452,7 @@ def find_estimators(shader, inlined: Any = None) -> EstimatorTable:
     with paused_gc():
         if inlined is None:
             inlined = inline_calls(shader)
-        consts = _const_values(getattr(shader, "info", None))
+        consts = global_scalars(getattr(shader, "info", None))
         pragmas = _pragmas(shader)
         loops = estimator_loops(inlined.unit)
         found, rejected = [], []

@@ -66,7 +66,8 @@ from rrcache.glsl import ast as A
 from rrcache.glsl.constfold import const_value
 from rrcache.glsl.printer import print_expr
 from rrcache.glsl.types import swizzle_indices
-from rrcache.glsl.writes import lvalue_root, out_qualifiers
+from rrcache.glsl.defuse import definitions, lvalue_root, out_qualifiers, written_roots
+from rrcache.glsl.visitor import NodeVisitor
 
 __all__ = ["term_range", "signed_term", "Interval", "FLT_MAX"]
 
@@ -166,8 +167,9 @@ def _components(t) -> int:
 
 # ----------------------------------------------------------------------------- the pass
 
-class _Body:
-    """The facts about one estimator loop's body that the ranges need."""
+class _Body(NodeVisitor):
+    """The facts about one estimator loop's body that the ranges need; visiting an expression
+    gives its range (:meth:`eval`, which checks it) or raises :class:`_Unknown`."""
 
     def __init__(self, loop: A.For, index: str, start: int, step: int, samples: int,
                  accumulators: Sequence[str], header: HeaderFn, display: Callable[[str], str]):
@@ -200,8 +202,9 @@ class _Body:
         for n in nodes:
             if isinstance(n, A.For):
                 self._inner_index(n)
+        notes = _WriteNotes(self)
         for n in nodes:
-            self._note_write(n)
+            notes.visit(n)
         self.memo: dict[tuple[int, str], object] = {}
         self.active: set[tuple[int, str]] = set()
 
@@ -216,7 +219,7 @@ class _Body:
         if h is None or not isinstance(loop.init, A.DeclStmt):
             return
         name, start, step, n = h
-        inner_writes = {id(r.symbol.decl) for r in _written(loop.body)
+        inner_writes = {id(r.symbol.decl) for r in written_roots(loop.body)
                         if r.name == name and r.symbol is not None}
         decl = loop.init.decl
         if id(decl) in inner_writes:
@@ -233,38 +236,18 @@ class _Body:
         if h is None or not isinstance(loop.init, A.DeclStmt):
             return None
         if any(r.name == h[0] and r.symbol is not None and r.symbol.decl is loop.init.decl
-               for r in _written(loop.body)):
+               for r in written_roots(loop.body)):
             return None
         return h[3]
 
-    def _note_write(self, n: A.Node) -> None:
-        def local_key(target: A.Expr):
-            root = lvalue_root(target)
-            sym = getattr(root, "symbol", None) if root is not None else None
-            if sym is None:
-                return None
-            key = (id(sym.decl), sym.name)
-            return key if key in self.locals else None
-
-        if isinstance(n, A.Assign):
-            key = local_key(n.target)
-            if key is None:
-                return
-            if n.op == "=":
-                self.values[key].append(n.value)
-            else:
-                self.bad.setdefault(key, f"it is updated by `{self.text(n)}` (only plain `=` "
-                                         "assignments give a known range)")
-        elif isinstance(n, A.Unary) and n.op in ("++", "--"):
-            key = local_key(n.operand)
-            if key is not None and key not in self.fixed:
-                self.bad.setdefault(key, f"it is updated by `{self.text(n)}`")
-        elif isinstance(n, A.Call) and n.target is not None:
-            for q, arg in zip(out_qualifiers(n), n.args):
-                if q != "in":
-                    key = local_key(arg)
-                    if key is not None:
-                        self.bad.setdefault(key, f"`{self.text(n)}` writes it (an {q} argument)")
+    def local_key(self, target: A.Expr):
+        """The key of the body's local variable that ``target`` writes, or None."""
+        root = lvalue_root(target)
+        sym = getattr(root, "symbol", None) if root is not None else None
+        if sym is None:
+            return None
+        key = (id(sym.decl), sym.name)
+        return key if key in self.locals else None
 
     # ---- the contributions
 
@@ -286,11 +269,10 @@ class _Body:
             r = self._placed(n, r)
             name = n.target.name
             per_acc[name] = _add(per_acc[name], r) if name in per_acc else r
-        for n in A.walk(self.loop.body):
-            for root, how in _writes_with_node(n):
-                if root.name in self.accumulators and id(how) not in accepted:
-                    raise _Unknown(f"`{self.text(how)}` changes the accumulator "
-                                   f"`{self.display(root.name)}` otherwise than by adding a term")
+        for d in definitions(self.loop.body):
+            if d.root.name in self.accumulators and id(d.node) not in accepted:
+                raise _Unknown(f"`{self.text(d.node)}` changes the accumulator "
+                               f"`{self.display(d.root.name)}` otherwise than by adding a term")
         if not per_acc:
             raise _Unknown("the body adds no term to its accumulators")
         out = _hull(*per_acc.values())
@@ -302,23 +284,11 @@ class _Body:
         count = 1
         child: A.Node = stmt
         node = self.parent.get(id(stmt))
+        placement = _Placement(self, stmt)
         while node is not None:
-            if isinstance(node, (A.If, A.Switch, A.Ternary)):
-                conditional = True
-            elif isinstance(node, A.Binary) and node.op in ("&&", "||", "^^"):
-                conditional = True
-            elif isinstance(node, (A.While, A.DoWhile)):
-                raise _Unknown(f"`{self.text(stmt)}` is inside a while loop of the body (how many "
-                               "times it adds is not known)")
-            elif isinstance(node, A.For):
-                if child is node.body:
-                    n = self.inner_count(node)
-                    if n is None:
-                        raise _Unknown(f"`{self.text(stmt)}` is inside a loop of the body without a "
-                                       "constant trip count")
-                    count *= n
-                elif child is not node.init:
-                    raise _Unknown(f"`{self.text(stmt)}` is in the header of a loop of the body")
+            cond, times = placement.visit(node, child)
+            conditional = conditional or cond
+            count *= times
             child = node
             node = self.parent.get(id(node))
         r = _scale(count, r)
@@ -340,23 +310,25 @@ class _Body:
         return float(lo), float(hi)
 
     def eval(self, e: A.Expr) -> Interval:
-        fn = _EVAL.get(type(e))
-        if fn is None:
-            raise _Unknown(f"`{self.text(e)}` has no known range")
         try:
-            r = fn(self, e)
+            r = self.visit(e)
         except (OverflowError, ValueError, ZeroDivisionError):
             raise _Unknown(f"`{self.text(e)}` has no finite bound") from None
         t = getattr(e, "type", None)
         base = t.base if t is not None and t.base in ("int", "uint") and not t.dims else None
         return self.finite(r, e, base)
 
-    def _literal(self, e) -> Interval:
+    def generic_visit(self, e) -> Interval:
+        raise _Unknown(f"`{self.text(e)}` has no known range")
+
+    def visit_IntLit(self, e) -> Interval:
         v = e.value & 0xFFFFFFFF if isinstance(e, A.IntLit) and e.unsigned else e.value
         v = float(v)
         return v, v
 
-    def _ident(self, e: A.Ident) -> Interval:
+    visit_FloatLit = visit_BoolLit = visit_IntLit
+
+    def visit_Ident(self, e: A.Ident) -> Interval:
         sym = e.symbol
         name = self.display(e.name)
         if sym is None:
@@ -406,7 +378,7 @@ class _Body:
         self.memo[key] = r
         return r
 
-    def _unary(self, e: A.Unary) -> Interval:
+    def visit_Unary(self, e: A.Unary) -> Interval:
         if e.op == "-":
             return _neg(self.eval(e.operand))
         if e.op == "+":
@@ -415,7 +387,7 @@ class _Body:
             return _BOOL
         raise _Unknown(f"`{self.text(e)}` has no known range")
 
-    def _binary(self, e: A.Binary) -> Interval:
+    def visit_Binary(self, e: A.Binary) -> Interval:
         op = e.op
         if op in ("<", "<=", ">", ">=", "==", "!=", "&&", "||", "^^"):
             return _BOOL
@@ -450,37 +422,37 @@ class _Body:
             return float(math.floor(min(qs))), float(math.ceil(max(qs)))
         return _mul(a, (1.0 / b[1], 1.0 / b[0]))
 
-    def _ternary(self, e: A.Ternary) -> Interval:
+    def visit_Ternary(self, e: A.Ternary) -> Interval:
         return _hull(self.eval(e.then), self.eval(e.else_))
 
-    def _sequence(self, e: A.Sequence) -> Interval:
+    def visit_Sequence(self, e: A.Sequence) -> Interval:
         return self.eval(e.exprs[-1])
 
-    def _assign(self, e: A.Assign) -> Interval:
+    def visit_Assign(self, e: A.Assign) -> Interval:
         if e.op == "=":
             return self.eval(e.value)
         raise _Unknown(f"`{self.text(e)}` has no known range")
 
-    def _field(self, e: A.Field) -> Interval:
+    def visit_Field(self, e: A.Field) -> Interval:
         if isinstance(e.obj, A.Call) and _is_texture(e.obj):
             raise _Unknown(_texture_reason(self.text(e)))
         known = _const_hull(e)
         return known if known is not None else self.eval(e.obj)
 
-    def _index(self, e: A.Index) -> Interval:
+    def visit_Index(self, e: A.Index) -> Interval:
         known = _const_hull(e)
         return known if known is not None else self.eval(e.obj)
 
-    def _length(self, e: A.Length) -> Interval:
+    def visit_Length(self, e: A.Length) -> Interval:
         v = const_value(e)
         if isinstance(v, int):
             return float(v), float(v)
         raise _Unknown(f"`{self.text(e)}` has no known range")
 
-    def _init_list(self, e: A.InitList) -> Interval:
+    def visit_InitList(self, e: A.InitList) -> Interval:
         return _hull(*(self.eval(x) for x in e.items))
 
-    def _call(self, e: A.Call) -> Interval:
+    def visit_Call(self, e: A.Call) -> Interval:
         if e.kind == "constructor":
             return self._construct(e)
         if e.kind == "builtin":
@@ -560,31 +532,6 @@ def _const_hull(e: A.Expr) -> Optional[Interval]:
     if not flat or not all(isinstance(v, (int, float)) for v in flat):
         return None
     return float(min(flat)), float(max(flat))
-
-
-def _written(node: A.Node):
-    for _root, _how in _writes_with_node(node, deep=True):
-        yield _root
-
-
-def _writes_with_node(n: A.Node, deep: bool = False):
-    """The variables ``n`` writes, with the node that writes each (only ``n`` itself, or with
-    ``deep`` every node under it)."""
-    for m in (A.walk(n) if deep else (n,)):
-        if isinstance(m, A.Assign):
-            root = lvalue_root(m.target)
-            if root is not None:
-                yield root, m
-        elif isinstance(m, A.Unary) and m.op in ("++", "--"):
-            root = lvalue_root(m.operand)
-            if root is not None:
-                yield root, m
-        elif isinstance(m, A.Call) and m.target is not None:
-            for q, arg in zip(out_qualifiers(m), m.args):
-                if q != "in":
-                    root = lvalue_root(arg)
-                    if root is not None:
-                        yield root, m
 
 
 def _is_texture(e: A.Call) -> bool:
@@ -754,13 +701,77 @@ _BUILTINS: dict[str, Callable[[_Body, A.Call], Interval]] = {
     "isinf": _const_rule(_BOOL),
 }
 
-_EVAL: dict[type, Callable[[_Body, A.Expr], Interval]] = {
-    A.IntLit: _Body._literal, A.FloatLit: _Body._literal, A.BoolLit: _Body._literal,
-    A.Ident: _Body._ident, A.Unary: _Body._unary, A.Binary: _Body._binary,
-    A.Ternary: _Body._ternary, A.Sequence: _Body._sequence, A.Assign: _Body._assign,
-    A.Field: _Body._field, A.Index: _Body._index, A.Length: _Body._length,
-    A.InitList: _Body._init_list, A.Call: _Body._call,
-}
+class _WriteNotes(NodeVisitor):
+    """What a write of a local variable of the body says about its range: a plain ``=`` gives it
+    a value; anything else (``+=``, ``++``, an ``out`` argument) leaves it unknown."""
+
+    def __init__(self, body: _Body):
+        self.body = body
+
+    def generic_visit(self, n) -> None:
+        pass
+
+    def visit_Assign(self, n: A.Assign) -> None:
+        body = self.body
+        key = body.local_key(n.target)
+        if key is None:
+            return
+        if n.op == "=":
+            body.values[key].append(n.value)
+        else:
+            body.bad.setdefault(key, f"it is updated by `{body.text(n)}` (only plain `=` "
+                                     "assignments give a known range)")
+
+    def visit_Unary(self, n: A.Unary) -> None:
+        body = self.body
+        key = body.local_key(n.operand) if n.op in ("++", "--") else None
+        if key is not None and key not in body.fixed:
+            body.bad.setdefault(key, f"it is updated by `{body.text(n)}`")
+
+    def visit_Call(self, n: A.Call) -> None:
+        if n.target is None:
+            return
+        for q, arg in zip(out_qualifiers(n), n.args):
+            if q != "in":
+                key = self.body.local_key(arg)
+                if key is not None:
+                    self.body.bad.setdefault(key, f"`{self.body.text(n)}` writes it (an {q} argument)")
+
+
+class _Placement(NodeVisitor):
+    """What an accumulation ``stmt`` standing under a node (through ``child``) makes of what it
+    adds: ``(conditional, times)``."""
+
+    def __init__(self, body: _Body, stmt: A.Assign):
+        self.body, self.stmt = body, stmt
+
+    def generic_visit(self, node, child) -> tuple[bool, int]:
+        return False, 1
+
+    def visit_If(self, node, child) -> tuple[bool, int]:
+        return True, 1
+
+    visit_Switch = visit_Ternary = visit_If
+
+    def visit_Binary(self, node: A.Binary, child) -> tuple[bool, int]:
+        return node.op in ("&&", "||", "^^"), 1
+
+    def visit_While(self, node, child) -> tuple[bool, int]:
+        raise _Unknown(f"`{self.body.text(self.stmt)}` is inside a while loop of the body (how many "
+                       "times it adds is not known)")
+
+    visit_DoWhile = visit_While
+
+    def visit_For(self, node: A.For, child) -> tuple[bool, int]:
+        if child is node.body:
+            n = self.body.inner_count(node)
+            if n is None:
+                raise _Unknown(f"`{self.body.text(self.stmt)}` is inside a loop of the body without a "
+                               "constant trip count")
+            return False, n
+        if child is not node.init:
+            raise _Unknown(f"`{self.body.text(self.stmt)}` is in the header of a loop of the body")
+        return False, 1
 
 
 def term_range(loop: A.For, index: str, start: int, step: int, samples: int,

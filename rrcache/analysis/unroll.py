@@ -45,14 +45,14 @@ import dataclasses
 import re
 from typing import Optional
 
-import numpy as np
-
 from rrcache.glsl import ast as A
 from rrcache.glsl.semantic import check
 
 from rrcache.glsl.ast import walk
 from rrcache.glsl.rewrite import InlinedLoc, NameAllocator, chain_of, clone, rewrite_scoped
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.visitor import NodeVisitor
+from rrcache.glsl.defuse import written_roots
+from rrcache.analysis.loops import Constants, body_exits, counted_loop, global_scalars, scalar
 
 __all__ = ["unroll_loops", "unroll_unit", "DEFAULT_MAX_ITERATIONS", "DEFAULT_MAX_TOTAL",
            "DEFAULT_MAX_SIZE"]
@@ -62,10 +62,7 @@ DEFAULT_MAX_TOTAL = 4096
 #: the syntax nodes all unrolled copies may add (the paper scenes add under 3,000; node analysis
 #: runs at roughly 10-30k expression nodes per second, see docs/bench_frontend.md)
 DEFAULT_MAX_SIZE = 60_000
-_COMPARE = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal,
-            "!=": np.not_equal, "==": np.equal}
-_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "!=": "!=", "==": "=="}
-_DTYPE = {"int": np.int32, "uint": np.uint32, "float": np.float32}
+_INDEX_TYPES = frozenset({"int", "uint", "float"})
 
 
 def unroll_loops(shader, max_iterations: int = DEFAULT_MAX_ITERATIONS,
@@ -90,11 +87,7 @@ def unroll_unit(unit: A.TranslationUnit, info, max_iterations: int = DEFAULT_MAX
                 max_size: int = DEFAULT_MAX_SIZE) -> A.TranslationUnit:
     """The unrolling pass, in place on ``unit`` (a copy the caller owns). ``info`` is the
     :class:`SemanticInfo` of the input (for the values of ``const`` globals)."""
-    consts = {name: sym.const_value for name, sym in info.globals.items()
-              if sym.kind == "const" and isinstance(sym.const_value, (int, float, bool))
-              and not sym.type.dims}
-    u = _Unroller(unit, consts, max_iterations, max_total, max_size)
-    u.const_bases = {name: info.globals[name].type.base for name in consts}
+    u = _Unroller(unit, global_scalars(info), max_iterations, max_total, max_size)
     for d in unit.decls:
         if isinstance(d, A.FunctionDecl) and d.body is not None:
             u.scopes = [{}]
@@ -113,10 +106,12 @@ def fold_copy(body: A.Compound, unit: A.TranslationUnit) -> list:
     u = _Unroller(unit, {}, DEFAULT_MAX_ITERATIONS, DEFAULT_MAX_TOTAL)
     while A.substitute(body, u.constant_choice, u.chosen_arm):
         pass
-    return u.stmt(body)
+    return u.visit(body)
 
 
-class _Unroller:
+class _Unroller(NodeVisitor):
+    """Visiting a statement returns the statements that replace it."""
+
     def __init__(self, unit, consts, max_iterations, max_total, max_size=DEFAULT_MAX_SIZE):
         self.consts = consts
         self.max_iterations = max_iterations
@@ -124,19 +119,14 @@ class _Unroller:
         self.size_budget = max_size
         self.names = NameAllocator(unit)
         self.scopes: list[dict[str, Optional[tuple[str, object]]]] = [{}]
-        self.const_bases: dict[str, str] = {}
+        self.const = Constants(self.lookup)
 
     # ------------------------------------------------------------------ constants
     def lookup(self, name: str):
         for scope in reversed(self.scopes):
             if name in scope:
                 return scope[name]
-        v = self.consts.get(name)
-        if v is None:
-            return None
-        if isinstance(v, bool):
-            return ("bool", v)
-        return _scalar("float" if isinstance(v, float) else self.const_bases.get(name, "int"), v)
+        return self.consts.get(name)
 
     def invalidate(self, name: str) -> None:
         for scope in reversed(self.scopes):
@@ -144,64 +134,18 @@ class _Unroller:
                 scope[name] = None
                 return
 
-    def const(self, e) -> Optional[tuple[str, object]]:
-        """``(base, value)`` of a constant scalar expression (``int``/``uint`` wrapped to 32
-        bits, ``float`` in single precision, ``bool`` from comparisons and logic), or None."""
-        if isinstance(e, A.IntLit):
-            return _scalar("uint" if e.unsigned else "int", e.value)
-        if isinstance(e, A.FloatLit) and not e.double:
-            return _scalar("float", e.value)
-        if isinstance(e, A.BoolLit):
-            return ("bool", bool(e.value))
-        if isinstance(e, A.Ident):
-            return self.lookup(e.name)
-        if isinstance(e, A.Unary) and e.op in ("-", "+", "!"):
-            v = self.const(e.operand)
-            if v is None:
-                return None
-            if e.op == "!":
-                return ("bool", not v[1]) if v[0] == "bool" else None
-            if v[0] not in _DTYPE:
-                return None
-            return _scalar(v[0], -v[1] if e.op == "-" else v[1])
-        if isinstance(e, A.Binary) and e.op in ("+", "-", "*"):
-            a, b = self.const(e.left), self.const(e.right)
-            if a is None or b is None or a[0] != b[0] or a[0] not in _DTYPE:
-                return None
-            x, y = _DTYPE[a[0]](a[1]), _DTYPE[a[0]](b[1])
-            with np.errstate(all="ignore"):
-                r = x + y if e.op == "+" else x - y if e.op == "-" else x * y
-            return (a[0], r.item())
-        if isinstance(e, A.Binary) and e.op in _COMPARE:
-            a, b = self.const(e.left), self.const(e.right)
-            if a is None or b is None or a[0] != b[0] or a[0] not in _DTYPE:
-                return None
-            return ("bool", bool(_COMPARE[e.op](a[1], b[1])))
-        if isinstance(e, A.Binary) and e.op in ("&&", "||", "^^"):
-            a, b = self.const(e.left), self.const(e.right)
-            if a is None or b is None or a[0] != "bool" or b[0] != "bool":
-                return None
-            return ("bool", a[1] and b[1] if e.op == "&&" else a[1] or b[1] if e.op == "||"
-                    else a[1] != b[1])
-        if isinstance(e, A.Call) and e.name in ("int", "float", "uint") and len(e.args) == 1:
-            v = self.const(e.args[0])
-            if v is None or v[0] not in _DTYPE:
-                return None
-            return _scalar(e.name, v[1])
-        return None
-
     # ------------------------------------------------------------------ statements
     def block(self, stmts: list) -> list:
         out: list = []
         for s in stmts:
-            out.extend(self.stmt(s))
+            out.extend(self.visit(s))
         return out
 
     def sub(self, s):
         if s is None:
             return None
         self.scopes.append({})
-        got = self.stmt(s)
+        got = self.visit(s)
         self.scopes.pop()
         return got[0] if len(got) == 1 else A.Compound(got, loc=s.loc)
 
@@ -219,113 +163,92 @@ class _Unroller:
             if d.init is not None and not d.array_dims and not decl.type.spec.array_dims:
                 v = self.const(d.init)
                 base = decl.type.spec.name
-                if v is not None and base in _DTYPE and v[0] in _DTYPE:
-                    value = _scalar(base, v[1])
+                if v is not None and base in _INDEX_TYPES and v[0] in _INDEX_TYPES:
+                    value = scalar(base, v[1])
                 elif v is not None and base == v[0]:
                     value = v
             self.scopes[-1][d.name] = value
 
-    def stmt(self, s) -> list:
-        if isinstance(s, A.Compound):
-            self.scopes.append({})
-            s.stmts = self.block(s.stmts)
-            self.scopes.pop()
-            return [s]
-        if isinstance(s, A.DeclStmt):
-            self.declare(s.decl)
-            return [s]
-        if isinstance(s, A.ExprStmt):
-            if s.expr is not None:
-                self.writes(s.expr)
-            return [s]
-        if isinstance(s, A.If):
-            cond = self.const(s.cond)
-            if cond is not None and cond[0] == "bool":
-                # a condition made constant by unrolling (``if (i > 0)`` with i = 0): keep the
-                # branch taken only; the other may index out of range (``a[i - 1]``)
-                taken = s.then if cond[1] else s.else_
-                if taken is None:
-                    return []
-                got = self.sub(taken)
-                return [got if isinstance(got, A.Compound) else A.Compound([got], loc=got.loc)]
-            self.writes(s.cond)
-            s.then = self.sub(s.then)
-            s.else_ = self.sub(s.else_)
-            return [s]
-        if isinstance(s, A.Switch):
-            self.writes(s.expr)
-            self.scopes.append({})
-            s.body.stmts = self.block(s.body.stmts)
-            self.scopes.pop()
-            return [s]
-        if isinstance(s, A.For):
-            got = self.try_unroll(s)
-            if got is not None:
-                return got
-            return [self.keep_loop(s)]
-        if isinstance(s, (A.While, A.DoWhile)):
-            return [self.keep_loop(s)]
-        if isinstance(s, A.Return) and s.expr is not None:
+    def generic_visit(self, s) -> list:
+        return [s]
+
+    def visit_Compound(self, s: A.Compound) -> list:
+        self.scopes.append({})
+        s.stmts = self.block(s.stmts)
+        self.scopes.pop()
+        return [s]
+
+    def visit_DeclStmt(self, s: A.DeclStmt) -> list:
+        self.declare(s.decl)
+        return [s]
+
+    def visit_ExprStmt(self, s: A.ExprStmt) -> list:
+        if s.expr is not None:
             self.writes(s.expr)
         return [s]
 
+    def visit_Return(self, s: A.Return) -> list:
+        if s.expr is not None:
+            self.writes(s.expr)
+        return [s]
+
+    def visit_If(self, s: A.If) -> list:
+        cond = self.const(s.cond)
+        if cond is not None and cond[0] == "bool":
+            # a condition made constant by unrolling (``if (i > 0)`` with i = 0): keep the
+            # branch taken only; the other may index out of range (``a[i - 1]``)
+            taken = s.then if cond[1] else s.else_
+            if taken is None:
+                return []
+            got = self.sub(taken)
+            return [got if isinstance(got, A.Compound) else A.Compound([got], loc=got.loc)]
+        self.writes(s.cond)
+        s.then = self.sub(s.then)
+        s.else_ = self.sub(s.else_)
+        return [s]
+
+    def visit_Switch(self, s: A.Switch) -> list:
+        self.writes(s.expr)
+        self.scopes.append({})
+        s.body.stmts = self.block(s.body.stmts)
+        self.scopes.pop()
+        return [s]
+
+    def visit_For(self, s: A.For) -> list:
+        got = self.try_unroll(s)
+        if got is not None:
+            return got
+        return [self.keep_loop(s)]
+
+    def visit_While(self, s) -> list:
+        return [self.keep_loop(s)]
+
+    visit_DoWhile = visit_While
+
     def keep_loop(self, s):
         """A loop left in place: what it writes is unknown from its start."""
-        for root in _stmt_writes(s):
-            self.invalidate(root.name)
+        self.writes(s)
         self.scopes.append({})
-        if isinstance(s, A.For):
-            if s.init is not None:
-                self.stmt(s.init)
-            if isinstance(s.cond, A.VariableDecl):
-                self.declare(s.cond)
-            s.body = self.sub(s.body)
-        elif isinstance(s, A.While):
-            if isinstance(s.cond, A.VariableDecl):
-                self.declare(s.cond)
-            s.body = self.sub(s.body)
-        else:
-            s.body = self.sub(s.body)
+        if isinstance(s, A.For) and s.init is not None:
+            self.visit(s.init)
+        if isinstance(s.cond, A.VariableDecl) and not isinstance(s, A.DoWhile):
+            self.declare(s.cond)
+        s.body = self.sub(s.body)
         self.scopes.pop()
-        for root in _stmt_writes(s):
-            self.invalidate(root.name)
+        self.writes(s)
         return s
 
     # ------------------------------------------------------------------ unrolling
     def try_unroll(self, s: A.For) -> Optional[list]:
-        head = self.loop_header(s)
+        head, _why = counted_loop(s, self.const)
         if head is None:
             return None
-        name, base, start, declared = head
-        step = _step(s.step, name)
-        cond = s.cond
-        if step is None or not isinstance(cond, A.Binary) or cond.op not in _COMPARE:
+        name, base = head.index, head.base
+        if any(r.name == name for r in written_roots(s.body)) or body_exits(s.body):
             return None
-        if isinstance(cond.left, A.Ident) and cond.left.name == name:
-            op, bound_expr = cond.op, cond.right
-        elif isinstance(cond.right, A.Ident) and cond.right.name == name:
-            op, bound_expr = _FLIP[cond.op], cond.left
-        else:
+        values, exit_value = head.run(min(self.max_iterations, self.budget))
+        if values is None:
             return None
-        bound = self.const(bound_expr)
-        delta = self.const(step) if isinstance(step, A.Expr) else ("int", step)
-        if bound is None or delta is None or bound[0] not in _DTYPE or delta[0] not in _DTYPE:
-            return None
-        if any(r.name == name for r in _stmt_writes(s.body)) or _breaks(s.body):
-            return None
-        dtype = _DTYPE[base]
-        values = []
-        # the three in the loop variable's type (``k--`` on a uint steps by 0xFFFFFFFF)
-        start, stop, step_by = (_scalar(base, x) for x in (start, bound[1], delta[1]))
-        if start is None or stop is None or step_by is None:
-            return None
-        v, b, dv = dtype(start[1]), dtype(stop[1]), dtype(step_by[1])
-        with np.errstate(all="ignore"):
-            while bool(_COMPARE[op](v, b)):
-                values.append(v.item())
-                if len(values) > min(self.max_iterations, self.budget):
-                    return None
-                v = dtype(v + dv)
         budget = self.budget
         size = sum(1 for _ in walk(s.body)) * len(values)
         if size > self.size_budget:
@@ -340,19 +263,19 @@ class _Unroller:
             rewrite_scoped(body, {name: _literal(base, value)}, self.names.fresh)
             while A.substitute(body, self.constant_choice, self.chosen_arm):
                 pass
-            copies.extend(self.stmt(body))
+            copies.extend(self.visit(body))
         if any(self.out_of_range(n) for c in copies for n in walk(c, decl_types=False)):
             # a constant index out of range left in a copy (``a[i - 1]`` under a guard this
             # pass does not decide): the unrolled program would not compile; keep the loop
             self.budget = budget
             self.size_budget += size
             return None
-        if not declared:
-            exit_value = _literal(base, v.item())(A.Ident(name, loc=loc))
-            copies.append(A.ExprStmt(A.Assign("=", A.Ident(name, loc=loc), exit_value, loc=loc),
+        if not head.declared:
+            exit_lit = _literal(base, exit_value)(A.Ident(name, loc=loc))
+            copies.append(A.ExprStmt(A.Assign("=", A.Ident(name, loc=loc), exit_lit, loc=loc),
                                      loc=loc))
             self.invalidate(name)
-        return [A.Compound(copies, loc=loc)] if declared else copies
+        return [A.Compound(copies, loc=loc)] if head.declared else copies
 
     def constant_choice(self, n) -> bool:
         """``c ? a : b`` with ``c`` constant (after the loop variable became a literal)."""
@@ -376,47 +299,6 @@ class _Unroller:
         if v is None or v[0] not in ("int", "uint") or bound is None:
             return False
         return v[1] < 0 or v[1] >= bound
-
-    def loop_header(self, s: A.For):
-        """``(name, base, start, declared)`` of a loop variable with a constant start."""
-        init = s.init
-        if isinstance(init, A.DeclStmt) and isinstance(init.decl, A.VariableDecl):
-            decl = init.decl
-            base = decl.type.spec.name
-            if len(decl.declarators) != 1 or base not in _DTYPE or decl.declarators[0].array_dims:
-                return None
-            d = decl.declarators[0]
-            v = self.const(d.init) if d.init is not None else None
-            if v is None or v[0] not in _DTYPE:
-                return None
-            return d.name, base, v[1], True
-        if isinstance(init, A.ExprStmt) and isinstance(init.expr, A.Assign) \
-                and init.expr.op == "=" and isinstance(init.expr.target, A.Ident):
-            t = init.expr.target
-            base = getattr(getattr(t, "type", None), "base", None)
-            if base not in _DTYPE or t.type.size != 1 or t.type.dims:
-                return None
-            v = self.const(init.expr.value)
-            if v is None or v[0] not in _DTYPE:
-                return None
-            return t.name, base, v[1], False
-        return None
-
-
-def _scalar(base: str, value) -> Optional[tuple[str, object]]:
-    """``(base, value)`` with ``value`` converted as GLSL does: ``int``/``uint`` wrap to 32 bits
-    (``-1u`` is 4294967295), ``float`` is rounded to single precision; a ``float`` too large
-    for an integer type (undefined in GLSL) gives None."""
-    if base == "float":
-        return ("float", float(np.float32(value)))
-    if isinstance(value, float):
-        if not np.isfinite(value) or not -2.0 ** 31 <= value < 2.0 ** 32:
-            return None
-        value = int(value)   # towards zero, as GLSL converts
-    value = int(value)
-    if base == "uint":
-        return ("uint", value & 0xFFFFFFFF)
-    return ("int", (value + 2 ** 31) % 2 ** 32 - 2 ** 31)
 
 
 def _literal(base: str, value):
@@ -445,40 +327,3 @@ def _iteration_loc(step: str, loop_loc):
         c = chain_of(loc)
         return InlinedLoc(loc.file, loc.line, loc.col, c[:k] + (where,) + c[k:])
     return fix
-
-
-def _step(step, name: str):
-    """The increment of a step expression: an int for ``++``/``--``, an expression for
-    ``+= c``/``-= c`` (negated for ``-``), None when the step has another form."""
-    if isinstance(step, A.Unary) and step.op in ("++", "--") and isinstance(step.operand, A.Ident) \
-            and step.operand.name == name:
-        return 1 if step.op == "++" else -1
-    if isinstance(step, A.Assign) and isinstance(step.target, A.Ident) and step.target.name == name:
-        if step.op in ("+=", "-="):
-            delta = step.value
-            return delta if step.op == "+=" else A.Unary("-", delta, loc=delta.loc)
-        if step.op == "=" and isinstance(step.value, A.Binary) and step.value.op in ("+", "-") \
-                and isinstance(step.value.left, A.Ident) and step.value.left.name == name:
-            delta = step.value.right
-            return delta if step.value.op == "+" else A.Unary("-", delta, loc=delta.loc)
-    return None
-
-
-def _stmt_writes(s):
-    return written_roots(s)
-
-
-def _breaks(s, depth: int = 0) -> bool:
-    """A ``break``/``continue`` that leaves (or restarts) the loop whose body is ``s``."""
-    if isinstance(s, (A.Break, A.Continue)):
-        return True
-    if isinstance(s, (A.For, A.While, A.DoWhile)):
-        return False
-    if isinstance(s, A.Switch):
-        return any(isinstance(n, A.Continue) for n in walk(s.body, decl_types=False)
-                   if not isinstance(n, (A.For, A.While, A.DoWhile)))
-    if isinstance(s, A.Compound):
-        return any(_breaks(x) for x in s.stmts)
-    if isinstance(s, A.If):
-        return _breaks(s.then) or (s.else_ is not None and _breaks(s.else_))
-    return False

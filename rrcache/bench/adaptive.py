@@ -24,6 +24,7 @@ import sys
 from dataclasses import asdict, dataclass, field
 from typing import Optional, Sequence
 
+from rrcache import atomic
 from rrcache.gl.formats import ERROR_FORMAT
 
 
@@ -151,8 +152,7 @@ def main(argv=None) -> int:
                                               flush=True))
     text = json.dumps(result, indent=1)
     if args.out:
-        with open(args.out, "w") as fh:
-            fh.write(text + "\n")
+        atomic.write_text(args.out, text + "\n")
     print(text)
     return 0
 

@@ -43,7 +43,7 @@ def write_sheet(path: str, panels: Sequence[tuple[str, np.ndarray]], reference: 
     above and the magnified window below, each captioned with its mean RGB L2 error against the
     reference over ``mask`` (the covered pixels). Returns {"window": [row, col, size], "errors":
     {label: error}}."""
-    from rrcache.report.agg import agg_pyplot
+    from rrcache.report.agg import agg_pyplot, save_figure
 
     plt = agg_pyplot()
     h, w = reference.shape[:2]
@@ -66,6 +66,6 @@ def write_sheet(path: str, panels: Sequence[tuple[str, np.ndarray]], reference: 
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return {"window": [row, col, size], "errors": {label: error for label, _, error in columns if error is not None}}

@@ -96,8 +96,10 @@ def time_shader(name: str, source: str, repeat: int = 3) -> FrontendTiming:
 
 def run(shader_path: str | Path, lines: int = 3000, repeat: int = 3) -> list[FrontendTiming]:
     """Time the shader at ``shader_path`` and a ``lines``-line synthetic shader built from it."""
+    from rrcache.glsl.preprocessor import read_source
+
     path = Path(shader_path)
-    source = path.read_text()
+    source, _ = read_source(str(path))
     return [time_shader(str(path), source, repeat),
             time_shader(f"synthetic-{lines}-lines.glsl", synthetic_shader(source, lines), repeat)]
 

@@ -19,9 +19,10 @@ Per scene (:func:`run_scene`):
 4. On the **medium selection** (e3, the threshold of the paper's Fig. 10; the nearest cached
    selection when e3 caches nothing): the three cache algorithms side by side and the cache's
    speed-up limit (every pixel hitting), through :func:`rrcache.bench.cache.run`.
-5. **Equal time** (§5.4): dynamic resolution and simplification tuned to the medium
-   selection's measured speed-up (:mod:`rrcache.alternatives`), then measured over the bench
-   frames beside the original; error and PSNR of all three. The simplification's candidates
+5. **Equal time** (§5.4): dynamic resolution, the render cache of Walter et al. 2002 (its
+   sample share) and simplification tuned to the medium selection's measured speed-up
+   (:mod:`rrcache.alternatives`), then measured over the bench frames beside the original; error
+   and PSNR of all of them. The simplification's candidates
    are the ``candidates`` costliest nodes whose cost is at most what the target allows to save
    (static cost taken as proportional to time, keeping at least half of ``cost / target``);
    a medium selection no faster than the original gets no equal-time comparison.
@@ -45,6 +46,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from rrcache import atomic
 from rrcache.bench.scenes import Scene, scaled_session
 from rrcache.errors import RRCacheError
 from rrcache.jsonable import finite_json as _finite
@@ -129,6 +131,8 @@ class MethodRow:
     original_ms: float
     matched: Optional[bool] = None
     steps: list = field(default_factory=list)
+    #: the median ms of each stage of a frame (the render cache's row)
+    stages: Optional[dict] = None
 
 
 @dataclass
@@ -161,6 +165,11 @@ class SceneResult:
     notes: list = field(default_factory=list)
     wall_s: float = 0.0
     figure: Optional[str] = None
+    #: the cache filter the profile chose (rrcache.profiler.filters) and what each candidate measured
+    filter: Optional[str] = None
+    filter_times: Optional[dict] = None
+    #: the medium selection's misses by cause (rrcache.bench.cache.MissRow as JSON)
+    misses: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         out = asdict(self)
@@ -310,9 +319,13 @@ def _equal_time(work, session, frames, medium: Selection,
     search = list(frames)[:max(1, settings.search_frames)]
 
     try:
-        rows.append(_dynres_row(work, session, frames, search, target, settings, progress))
+        rows.append(dynres_row(work, session, frames, search, target, settings, progress))
     except RRCacheError as err:
         result.notes.append(f"dynamic resolution failed: {err}")
+    try:
+        rows.append(render_cache_row(work, session, frames, search, target, settings, progress))
+    except RRCacheError as err:
+        result.notes.append(f"render cache failed: {err}")
     try:
         row = _simplification_row(work, session, frames, search, target, settings, result, progress)
     except RRCacheError as err:
@@ -323,7 +336,9 @@ def _equal_time(work, session, frames, medium: Selection,
     return rows
 
 
-def _dynres_row(work, session, frames, search, target, settings, progress) -> MethodRow:
+def dynres_row(work, session, frames, search, target, settings, progress, on_frame=None) -> MethodRow:
+    """Dynamic resolution tuned to the ``target`` speed-up over the ``search`` frames, then measured
+    over ``frames`` beside the original (``on_frame(row, frame, original)`` per frame)."""
     from rrcache.alternatives import dynres
 
     def dyn_step(scale, speedup):
@@ -331,12 +346,42 @@ def _dynres_row(work, session, frames, search, target, settings, progress) -> Me
 
     found = dynres.tune_scale(work.prepared, session, None, search, target, lo=settings.min_scale,
                               rel_tol=settings.tolerance, max_steps=settings.max_steps, progress=dyn_step)
-    final = dynres.measure_scale(work.prepared, session, None, frames)(found.value)
+    final = dynres.measure_scale(work.prepared, session, None, frames, on_frame=on_frame)(found.value)
     low = dynres.low_size(tuple(session.resolution), found.value)
     return MethodRow("dynamic resolution", f"scale {found.value:.3f} ({low[0]}×{low[1]}, bilinear)",
                      final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
                      final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                      [list(s) for s in found.steps])
+
+
+#: the equal-time row of the render cache (Walter, Drettakis, Greenberg 2002)
+RENDER_CACHE = "render cache (Walter 2002)"
+
+
+def render_cache_row(work, session, frames, search, target, settings, progress, on_frame=None,
+                     render_cache=None) -> MethodRow:
+    """The render cache with its sample share tuned to the ``target`` speed-up over the ``search``
+    frames (:func:`rrcache.alternatives.render_cache.tune.tune_samples`), then measured over
+    ``frames`` beside the original; ``render_cache``: its other settings (the defaults when None).
+    The row's ``stages`` are the median ms of each stage of its frames."""
+    from rrcache.alternatives.render_cache import RenderCacheSettings
+    from rrcache.alternatives.render_cache.tune import compare, tune_samples
+
+    base = render_cache or RenderCacheSettings()
+
+    def step(share, speedup):
+        _say(progress, f"render cache {share:.2%} of the pixels: {speedup:.2f}× (target {target:.2f}×)")
+
+    found = tune_samples(work.prepared, session, search, target, base, rel_tol=settings.tolerance,
+                         max_steps=settings.max_steps, progress=step)
+    final = compare(work.prepared, session, frames, replace(base, samples=found.value), on_frame=on_frame)
+    row = MethodRow(RENDER_CACHE, f"{found.value:.2%} of the pixels per frame ({final.budget} pixels, "
+                                  f"{base.block}×{base.block} blocks, {base.points_per_pixel:g} points per pixel)",
+                    final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
+                    final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
+                    [list(s) for s in found.steps])
+    row.stages = dict(final.stages)
+    return row
 
 
 def _simplification_row(work, session, frames, search, target, settings, result, progress) -> Optional[MethodRow]:
@@ -422,6 +467,9 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         warnings.simplefilter("always")
         prof = profile(scene.shader, session_path, folder, training, progress=on_event, plots=settings.plots)
     result.notes += [f"profile: {w.message}" for w in caught]
+    work.filter = prof.filter  # the selections compile with the profile's filter
+    result.filter = prof.filter
+    result.filter_times = (prof.plan or {}).get("filter_times")
     counts = prof.counts or {}
     result.profile = str(folder)
     # the profiler's precomputation time: every invocation on its store added up (older
@@ -456,8 +504,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     if medium.kind != "cache":  # an amortized estimator or several nodes: the algorithms and limit are one node's
         what = ("amortized sampling" if medium.kind == "amortize" else "several cached nodes" if medium.multi
                 else f"a selection of kind {medium.kind}")
+        if medium.multi:  # the all-hit limit of the set (the algorithms and the misses are one node's)
+            _set_limit(prof, work, session, frames, medium, result, progress)
         result.notes.append(f"the {medium.label} selection is {medium.describe()} ({what}): the "
-                            "algorithms and the all-hit limit are measured for a single cached node only")
+                            "algorithms and the miss breakdown are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:
             result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
             originals += [r.original_ms for r in result.equal_time[1:]]
@@ -467,7 +517,9 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     _say(progress, f"algorithms and limit on {medium.node}")
     bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
+                            base_filter=prof.filter, limit_filter=prof.filter, misses=True,
                             progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
+    result.misses = [asdict(m) for m in bench.misses]
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),
                                    r.ms_per_frame, r.original_ms_per_frame) for r in bench.algorithms]
     originals += [r.original_ms for r in result.algorithms]
@@ -484,6 +536,21 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     result.original_ms = float(statistics.median(originals)) if originals else _original_ms(work, session, frames)
     result.wall_s = time.time() - started
     return result
+
+
+def _set_limit(prof, work, session, frames, medium: Selection, result: "SceneResult", progress) -> None:
+    """The all-hit limit of a selection of several nodes: its variant with every node hitting."""
+    from rrcache.harness.limit import all_hit_limit, probe_frames
+    from rrcache.pipeline import variant_for_selection
+
+    _say(progress, f"limit of {medium.describe()}")
+    variant, periods = variant_for_selection(work, medium)
+    options = prof.settings.cache_options()
+    limit = all_hit_limit(variant, session, work.prepared, probe_frames(frames), None, period=periods,
+                          color_format=prof.settings.timing_format, **options)
+    result.limit_ms, result.limit_original_ms = limit.limit_ms, limit.original_median_ms
+    result.limit_speedup = limit.original_median_ms / limit.limit_ms
+    result.limit_algorithm = prof.algorithm
 
 
 def _original_ms(work, session, frames) -> float:
@@ -532,6 +599,4 @@ def run(scenes: list, settings: BenchSettings = FULL, out="rrcache-bench", progr
 
 
 def _write(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    atomic.write_text(path, text)

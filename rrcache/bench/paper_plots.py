@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rrcache.report.agg import agg_pyplot
+from rrcache.report.agg import agg_pyplot, save_figure
 
 
 def _x(speedup):
@@ -36,7 +36,8 @@ def write_scene_plot(scene, out) -> str:
             if _x(r.speedup) is not None:
                 ax.scatter([_x(r.speedup)], [r.mean_error], marker=markers.get(r.method, "x"), facecolors="none",
                            edgecolors="tab:gray", zorder=2, label=f"{r.method} ({scene.medium} node)")
-        colours = {"dynamic resolution": "tab:orange", "simplification (Pellacini 2005)": "tab:green"}
+        colours = {"dynamic resolution": "tab:orange", "simplification (Pellacini 2005)": "tab:green",
+                   "render cache (Walter 2002)": "tab:purple"}
         for r in scene.equal_time[1:]:
             if _x(r.speedup) is not None:
                 ax.scatter([_x(r.speedup)], [r.mean_error], marker="*", s=120, color=colours.get(r.method, "tab:red"),
@@ -63,7 +64,7 @@ def write_scene_plot(scene, out) -> str:
         ax.grid(alpha=0.3)
         fig.tight_layout()
         path = Path(out) / f"{scene.name}-error-time.png"
-        fig.savefig(path)
+        save_figure(fig, path)
     finally:
         plt.close(fig)
     return str(path)

@@ -50,12 +50,26 @@ def _what(r) -> tuple[str, str]:
     return _code(r.text if r.parts else None), _f(r.period, "d")
 
 
+def _filter_text(s) -> str:
+    """`` Cache filter: plane (auto: ...)`` from what the profile measured, or nothing."""
+    chosen = getattr(s, "filter", None)
+    if not chosen:
+        return ""
+    times = getattr(s, "filter_times", None) or {}
+    if not times:
+        return f". Cache filter: {chosen}"
+    measured = ", ".join(f"{name} {t['time'] * 100:.0f}% of the original's time at {t['psnr']:.1f} dB"
+                         for name, t in times.items())
+    return f". Cache filter: {chosen} (auto, on the first node: {measured})"
+
+
 def scene_markdown(s) -> str:
     w, h = s.resolution
     lines = [f"### {s.name}", "",
              f"`{s.shader}` over `{s.session}`, {w}×{h}, {s.frames} frames. Profile: `{s.profile}` "
              f"({s.trained_nodes} of {s.cacheable_nodes} nodes trained; precomputation "
-             f"{_f(s.precompute_s, '.1f')} s{', resumed from its store' if s.precompute_resumed else ''}).", ""]
+             f"{_f(s.precompute_s, '.1f')} s{', resumed from its store' if s.precompute_resumed else ''})"
+             f"{_filter_text(s)}.", ""]
     if s.selections:
         lines += ["| level | max error | node | Δn | speed-up | mean error | PSNR dB | hit rate | predicted speed-up |",
                   "|---|---|---|---|---|---|---|---|---|"]
@@ -75,6 +89,12 @@ def scene_markdown(s) -> str:
         which = f", {s.limit_algorithm}" if s.limit_algorithm else ""
         lines += [f"Limit (every pixel hits{which}): {_f(s.limit_ms, '.2f')} ms against {_f(s.limit_original_ms, '.2f')} ms: "
                   f"at most {_f(s.limit_speedup, '.2f')}×.", ""]
+    if getattr(s, "misses", None):
+        from rrcache.bench.cache import MissRow, miss_table
+
+        lines += [f"**Why the {s.medium} node misses** (an untimed run reading the hit maps; a 4×4 block is counted "
+                  "under the cause of most of its missing pixels)", ""]
+        lines += miss_table([MissRow(**m) for m in s.misses]) + [""]
     if s.equal_time:
         lines += _methods(s.equal_time, f"equal time: tuned to the {s.medium} speed-up {_f(s.target_speedup, '.2f')}×")
     if getattr(s, "figure", None):

@@ -51,7 +51,9 @@ def main(argv=None) -> None:
         iter_exprs = _exprs_of
     from rrcache.glsl.frontend import parse_shader
 
-    source = open(args.shader, encoding="utf-8").read()
+    from rrcache.glsl.preprocessor import read_source
+
+    source, _ = read_source(args.shader)
     t0 = time.perf_counter()
     shader = parse_shader(source, args.shader)
     t1 = time.perf_counter()

@@ -15,7 +15,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
+from rrcache import atomic
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
 
 #: name -> (shader, session), relative to the repository root
 PAPER_SCENES = {
@@ -108,8 +110,10 @@ def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: 
     (rewritten only when the content changes, so a profile keyed on it resumes)."""
     source = Path(session_path)
     try:
-        doc = json.loads(source.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as err:
+        doc = json.loads(read_file(source, None).data)
+    except Refused as err:
+        raise RRCacheError(f"cannot read the session: it {err.reason}", str(source), hint="give a session JSON file") from None
+    except ValueError as err:
         raise RRCacheError(f"cannot read the session ({err})", str(source), hint="give a session JSON file") from None
     if not isinstance(doc, dict):
         raise RRCacheError("not a session (no JSON object)", str(source), hint="give a session JSON file")
@@ -127,8 +131,11 @@ def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: 
                                     'session, say "allow_outside_paths": true in it')
         doc["allow_outside_paths"] = True
     out = Path(out_path)
-    out.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps(doc, indent=2) + "\n"
-    if not out.exists() or out.read_text(encoding="utf-8") != text:
-        out.write_text(text, encoding="utf-8")
+    try:
+        same = read_file(out, limit=len(text.encode("utf-8"))).data == text.encode("utf-8")
+    except Refused:
+        same = False
+    if not same:
+        atomic.write_text(out, text)
     return out

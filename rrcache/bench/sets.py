@@ -22,6 +22,8 @@ from typing import Optional
 
 import numpy as np
 
+from rrcache import atomic
+
 
 def _parse_set(text: str) -> tuple[list[str], list[int]]:
     nodes, periods = [], []
@@ -190,13 +192,11 @@ def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measureme
                       f"PSNR {s['measured_psnr'] or float('inf'):.1f} speed-up {s['measured_speedup'] or 1:.2f}× "
                       f"{s['speedups']}", flush=True)
         if a.out:
-            with open(a.out, "w") as f:
-                json.dump(result, f, indent=1)
+            atomic.write_text(a.out, json.dumps(result, indent=1))
         return
     result = measure(a.profile, a.shader, a.session, a.pairs, [_parse_set(s) for s in a.sets])
     if a.out:
-        with open(a.out, "w") as f:
-            json.dump(result, f, indent=1)
+        atomic.write_text(a.out, json.dumps(result, indent=1))
 
 
 if __name__ == "__main__":  # pragma: no cover

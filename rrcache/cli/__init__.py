@@ -16,7 +16,7 @@ import sys
 import click
 
 from rrcache import watchdog
-from rrcache.budgets import budget, reset_budget
+from rrcache.budgets import MAX_READ_BYTES, budget, reset_budget
 from rrcache.errors import RRCacheError, printable
 
 # subcommand name -> module in rrcache.cli (each module defines a click command named `command`)
@@ -56,16 +56,24 @@ class _LazyGroup(click.Group):
               help=f"Refuse expressions nested deeper (default {budget.expression_depth:,}).")
 @click.option("--max-texture-pixels", type=click.IntRange(min=1), default=None, metavar="N",
               help=f"Refuse textures of more pixels, read from the header (default {budget.image_pixels:,}).")
-@click.option("--max-source-bytes", type=click.IntRange(min=1), default=None, metavar="N",
+@click.option("--max-source-bytes", type=click.IntRange(min=1, max=MAX_READ_BYTES), default=None, metavar="N",
               help=f"Refuse shaders whose sources (with includes) are larger (default {budget.source_bytes:,}).")
+@click.option("--max-document-bytes", type=click.IntRange(min=1, max=MAX_READ_BYTES), default=None, metavar="N",
+              help=f"Refuse larger session files and profile.json (default {budget.document_bytes:,}).")
+@click.option("--max-asset-bytes", type=click.IntRange(min=1, max=MAX_READ_BYTES), default=None, metavar="N",
+              help=f"Refuse larger mesh and texture files, measured before reading (default {budget.asset_bytes:,}).")
+@click.option("--max-session-values", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Refuse sessions of more JSON values, keyframes mostly (default {budget.session_values:,}).")
+@click.option("--max-session-objects", type=click.IntRange(min=1), default=None, metavar="N",
+              help=f"Refuse sessions of more objects (default {budget.session_objects:,}).")
 @click.option("--frame-timeout", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
               help="Stop with an error when one frame takes longer than S seconds (what is done is kept).")
 @click.option("--allow-outside-paths", is_flag=True,
               help="Let sessions name meshes, textures and include folders outside their own folder tree.")
 @click.version_option(package_name="rrcache")
 @click.pass_context
-def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, frame_timeout,
-        allow_outside_paths):
+def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_bytes, max_document_bytes,
+        max_asset_bytes, max_session_values, max_session_objects, frame_timeout, allow_outside_paths):
     """rrcache: speed up expensive pixel shaders with a reverse reprojection cache."""
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
@@ -76,8 +84,11 @@ def cli(ctx, debug, max_ast_nodes, max_depth, max_texture_pixels, max_source_byt
         budget.expression_depth = max_depth
     if max_texture_pixels is not None:
         budget.image_pixels = max_texture_pixels
-    if max_source_bytes is not None:
-        budget.source_bytes = max_source_bytes
+    for name, value in (("source_bytes", max_source_bytes), ("document_bytes", max_document_bytes),
+                        ("asset_bytes", max_asset_bytes), ("session_values", max_session_values),
+                        ("session_objects", max_session_objects)):
+        if value is not None:
+            setattr(budget, name, value)
     budget.allow_outside_paths = allow_outside_paths
     if frame_timeout is not None and not math.isfinite(frame_timeout):
         raise click.BadParameter("must be a finite number of seconds", param_hint="--frame-timeout")

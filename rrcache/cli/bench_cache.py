@@ -6,6 +6,11 @@ original in one run (see :mod:`rrcache.bench.cache`).
 results, the read-back; each stage's fixed cost at 8×8 and its cost per covered pixel), for the
 three-pass and two-pass algorithms in each of ``--formats`` (default rgba32f, rgba8: the colour
 target timings used before and the one applications draw into), side by side with the original.
+
+``--filters bilinear,edge,plane`` (the default) times the hit test and reconstruction filters at the
+compared period, and ``--misses`` (on by default) sorts each one's misses by cause (refresh, the
+depth-edge band, disocclusion, off screen), as shares of the covered pixels and of the 4×4 blocks
+that hold a miss (see :mod:`rrcache.runtime.misses`).
 """
 from __future__ import annotations
 
@@ -38,15 +43,23 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
               help="Payload layouts of --breakdown, side by side: f4, f2 (precision), and "
                    "f4-packed (32-bit with the inverse depth packed into the payload's free "
                    "channel: one render target and one fetch fewer).")
-@click.option("--algorithms", default="three-pass,two-pass", show_default=True,
-              help="Algorithms of --breakdown, side by side.")
+@click.option("--algorithms", default=None,
+              help="Algorithms side by side ('' for none): default all three at the compared period, "
+                   "three-pass,two-pass with --breakdown.")
+@click.option("--blocks", default="1,2,4", show_default=True,
+              help="Refresh block sizes compared at the compared period ('' for none).")
+@click.option("--filters", default="bilinear,edge,plane", show_default=True,
+              help="Hit test and reconstruction filters timed at the compared period ('' for none).")
+@click.option("--misses/--no-misses", default=True, show_default=True,
+              help="Sort each filter's misses by cause (refresh, depth-edge band, disocclusion, off screen) "
+                   "in an untimed run that reads the hit maps.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 @click.option("--markdown", is_flag=True, help="Print Markdown tables.")
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, node, periods, compare_period, frames, repeats, resolution, timing_format, breakdown,
-            formats, payloads, algorithms, as_json, markdown, quiet, vert, include_dirs):
+            formats, payloads, algorithms, blocks, filters, misses, as_json, markdown, quiet, vert, include_dirs):
     """Measure the cache on one node of SHADER over SESSION."""
     from rrcache.bench.cache import PAYLOAD_LAYOUTS, breakdown as run_breakdown, run
 
@@ -63,9 +76,25 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
     payload_list = [p.strip() for p in payloads.split(",") if p.strip()]
     if not payload_list or any(p not in PAYLOAD_LAYOUTS for p in payload_list):
         raise click.BadParameter(f"{payloads!r}: give some of {', '.join(PAYLOAD_LAYOUTS)}", param_hint="--payloads")
+    if algorithms is None:
+        algorithms = "three-pass,two-pass" if breakdown else "three-pass,two-pass,one-pass"
     algorithm_list = [a.strip() for a in algorithms.split(",") if a.strip()]
-    if not algorithm_list or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
+    if (breakdown and not algorithm_list) or any(a not in ("three-pass", "two-pass", "one-pass") for a in algorithm_list):
         raise click.BadParameter(f"{algorithms!r}: give three-pass, two-pass and/or one-pass", param_hint="--algorithms")
+    try:
+        block_list = [int(b) for b in blocks.split(",") if b.strip()]
+    except ValueError:
+        raise click.BadParameter(f"{blocks!r} is not a comma-separated list of block sizes", param_hint="--blocks")
+    from rrcache.runtime import BLOCK_SIZES
+
+    if any(b not in BLOCK_SIZES for b in block_list):
+        raise click.BadParameter(f"{blocks!r}: give block sizes from {', '.join(map(str, BLOCK_SIZES))}",
+                                 param_hint="--blocks")
+    from rrcache.runtime.glsl import FILTERS
+
+    filter_list = [f.strip() for f in filters.split(",") if f.strip()]
+    if any(f not in FILTERS for f in filter_list):
+        raise click.BadParameter(f"{filters!r}: give some of {', '.join(FILTERS)}", param_hint="--filters")
     with Reporter(err, quiet=quiet) as reporter:
         if breakdown:
             bench = run_breakdown(shader, session, node, algorithms=tuple(algorithm_list), formats=tuple(format_list),
@@ -75,7 +104,8 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
         else:
             bench = run(shader, session, node, period_list, compare_period, frames, resolution=resolution,
                         repeats=repeats, progress=reporter.update, color_format=timing_format, vertex=vert,
-                        include_dirs=include_dirs)
+                        include_dirs=include_dirs, filters=tuple(filter_list), misses=misses,
+                        algorithms=tuple(algorithm_list), blocks=tuple(block_list))
     if as_json:
         click.echo(json.dumps(bench.to_json()))
     else:

@@ -5,7 +5,7 @@ import json
 
 import click
 from rich.console import Console
-from rich.table import Table
+from rrcache.cli.tables import TextTable
 
 
 @click.command("bench-frontend")
@@ -27,24 +27,24 @@ def command(shader, lines, repeat, as_json, generated):
         if as_json:
             click.echo(json.dumps(rows))
             return
-        table = Table(title="node analysis of generated shaders (fresh process each; median of %d)" % repeat)
-        for col in ("shader", "lines", "AST exprs", "parse s", "analyse s", "CPU s", "µs/expr", "peak MB"):
-            table.add_column(col, justify="right" if col != "shader" else "left")
+        table = TextTable("node analysis of generated shaders (fresh process each; median of %d)" % repeat,
+                          [(col, "right" if col != "shader" else "left") for col in (
+                              "shader", "lines", "AST exprs", "parse s", "analyse s", "CPU s", "µs/expr", "peak MB")])
         for r in rows:
             table.add_row(r["shader"], str(r["lines"]), str(r["exprs"]), f"{r['parse_s']:.2f}",
                           f"{r['analyse_s']:.2f}", f"{r['analyse_cpu_s']:.2f}",
                           f"{1e6 * r['analyse_cpu_s'] / max(1, r['exprs']):.0f}",
                           str(r["rss_peak_mb"]))
-        Console().print(table)
+        table.print(Console())
         return
     timings = run(shader, lines, repeat)
     if as_json:
         click.echo(json.dumps([dict(name=t.name, lines=t.lines, parse_s=t.parse_s, analyse_s=t.analyse_s,
                                     total_s=t.total_s, nodes=t.nodes) for t in timings]))
         return
-    table = Table(title="front-end + analysis (median of %d runs)" % repeat)
-    for col in ("shader", "lines", "parse s", "analyse s", "total s", "nodes"):
-        table.add_column(col, justify="right" if col != "shader" else "left")
+    table = TextTable("front-end + analysis (median of %d runs)" % repeat,
+                      [(col, "right" if col != "shader" else "left")
+                       for col in ("shader", "lines", "parse s", "analyse s", "total s", "nodes")])
     for t in timings:
         table.add_row(t.name, str(t.lines), f"{t.parse_s:.3f}", f"{t.analyse_s:.3f}", f"{t.total_s:.3f}", str(t.nodes))
-    Console().print(table)
+    table.print(Console())

@@ -31,11 +31,11 @@ import click
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse_defines, vert_option
 from rrcache.cli.sources import describe_selection, refuse_with_level, resolve
-from rrcache.runtime import ALGORITHMS, DEFAULT_PERIOD, FILTERS
+from rrcache.runtime import ALGORITHMS, DEFAULT_FILTER, DEFAULT_PERIOD, FILTERS
 from rrcache.selection import AMORTIZE_PAYLOADS
 
 #: what --target writes: GLSL 3.30 core files, or WebGL2 (GLSL ES 3.00 and a page)
-TARGETS = ("glsl",)  # webgl2 lands with rrcache.webgl
+TARGETS = ("glsl", "webgl2")
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "estimator": "--estimator", "samples": "--samples", "blend": "--lambda",
                "history": "--history", "period": "--period", "algorithm": "--algorithm", "filter_": "--filter",
@@ -60,7 +60,7 @@ _LEVEL_OWNS = {"node": "--node", "estimator": "--estimator", "samples": "--sampl
               help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default=None,
               help="Cache algorithm (default: the profile's with a PROFILE, else three-pass).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True)
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True)
 @click.option("--payload", type=click.Choice(AMORTIZE_PAYLOADS), default="f4", show_default=True,
               help="32- or 16-bit floats; u8 (with --estimator and --history slots): 8 bits by the range of "
                    "the estimator's terms.")

@@ -36,14 +36,15 @@ import json
 
 import click
 
-import os
 import re
 
 from rrcache.analysis.cacheable import REASONS
 from rrcache.analysis.estimators import display_name, find_estimators
 from rrcache.analysis.source_text import display_file
 from rrcache.cli.options import include_dirs_option, parse_defines, vert_option
+from rrcache.budgets import budget
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
 from rrcache.pipeline import load_for_session
 
 _TEXT_WIDTH = 70
@@ -121,12 +122,11 @@ def model_vertex_tests(paths, defines) -> list[str]:
     leaves undefined (what a session's meshes would define)."""
     found: list[str] = []
     for path in paths:
-        if not path or str(path).startswith("<") or not os.path.isfile(path):
+        if not path or str(path).startswith("<"):
             continue
         try:
-            with open(path, encoding="utf-8", errors="replace") as f:
-                text = f.read()
-        except OSError:
+            text = read_file(path, budget.source_bytes).data.decode("utf-8", "replace")
+        except Refused:
             continue
         for line in _MODEL_VERTEX_TEST.finditer(text):
             for name in re.findall(r"\bMODEL_VERTEX_\w+", line.group(0)):

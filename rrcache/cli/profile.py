@@ -21,18 +21,19 @@ import warnings
 
 import click
 from rich.console import Console
-from rich.table import Table
 
 from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
-from rrcache.harness.timing import UNRELIABLE_NOISE
-from rrcache.model.psnr import VISIBLE_DB, psnr_text
+from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
-from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.document import algorithm_line, filter_line
+from rrcache.profiles.notices import ceiling_noise, run_warnings
 from rrcache.profiles.store import STORE_NAME
-from rrcache.profiles.settings import ALGORITHM_CHOICES, DEFAULT_PERIODS, LEVEL_KINDS, TrainingSettings, parse_periods
+from rrcache.profiles.settings import (ALGORITHM_CHOICES, DEFAULT_PERIODS, FILTER_CHOICES, LEVEL_KINDS, TrainingSettings,
+                                      parse_periods)
 
 
 def _periods(ctx, param, value):
@@ -91,6 +92,9 @@ def _fmt(value, spec=".3g", none="–"):
               help="Refresh periods at which each node is timed (default: 2,8,50).")
 @click.option("--algorithm", type=click.Choice(ALGORITHM_CHOICES), default="auto", show_default=True,
               help="auto: time three-pass and two-pass on the first node and keep the faster.")
+@click.option("--filter", "filter_", type=click.Choice(FILTER_CHOICES), default="auto", show_default=True,
+              help="The cache's hit test and payload reconstruction: auto measures bilinear against plane on "
+                   "the first node and keeps plane where faster at about the same PSNR (docs/misses.md).")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
@@ -127,12 +131,12 @@ def _fmt(value, spec=".3g", none="–"):
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            algorithm, filter_, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
             wait, max_sets, defines, adaptive, max_flip, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
-    kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm,
+    kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
                   validate=not no_validate, validation_frames=validation_frames, levels=levels)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),
@@ -160,8 +164,8 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         _interrupted(out, err_console)
         sys.exit(130)
     console = Console()
-    if not console.is_terminal:
-        console = Console(width=120)
+    if not console.is_terminal:  # a pipe, a file: whole lines, never wrapped or cut
+        console = Console(soft_wrap=True)
     _summary(prof, console)
 
 
@@ -188,18 +192,12 @@ def _verdict(prof, console: Console) -> None:
     console.print(f"answer: {v['answer']}", highlight=False)
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-    _ceiling_noise(ceiling, console)
+    for line in ceiling_noise(ceiling):
+        console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
     console.print(f"why: {v['reason']}", highlight=False)
     console.print("what would change it:", highlight=False)
     for change in v["changes"]:
         console.print(f"  - {change}", highlight=False)
-
-
-def _ceiling_noise(ceiling, console: Console) -> None:
-    if ceiling is not None and ceiling.noise > UNRELIABLE_NOISE:
-        console.print(f"warning: the original's repeated frames varied by ±{ceiling.noise:.0%} while the ceiling was "
-                      "measured: other work on the machine made it unreliable; profile again on a quieter machine "
-                      "(the profile folder keeps it: use --fresh)", highlight=False)
 
 
 def _summary(prof, console: Console) -> None:
@@ -221,9 +219,10 @@ def _summary(prof, console: Console) -> None:
                   f"computed; {c.get('error_runs_skipped', 0)} error and {c.get('timing_runs_skipped', 0)} timing "
                   "runs were stored and skipped", highlight=False)
     console.print(f"μ = {_fmt(prof.mu)} ({prof.mu_quality}); overhead {_fmt(prof.overhead_ms, '.3f')} ms; "
-                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {_fmt(prof.pixels, '.0f')} pixels; "
+                  f"original {_fmt(prof.original_ms, '.3f')} ms per frame over {prof.pixels:,.0f} covered pixels; "
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
+    console.print(f"filter: {filter_line(prof)}", highlight=False)
     if prof.plan:
         from rrcache.profiler.plan import Plan
 
@@ -234,36 +233,18 @@ def _summary(prof, console: Console) -> None:
     ceiling = prof.measured_ceiling
     if ceiling is not None:
         console.print(f"ceiling: {ceiling.summary()}", highlight=False)
-        _ceiling_noise(ceiling, console)
-    noise = prof.timing_noise
-    if noise is not None and not prof.timing_reliable:
-        console.print(f"warning: the original's times varied by ±{noise:.0%} between timing runs of the same frame: "
-                      "other work on the machine made the timings unreliable; profile again on a quieter machine",
-                      highlight=False)
-    console.print(_table(prof))
-    for s in prof.selections:
-        if s.fallback:
-            console.print(f"{s.label}: {s.fallback}", highlight=False)
-        if s.level_met is False:
-            console.print(f"{s.label}: MISSED its level: {s.level_note}", highlight=False)
+    _table(prof).print(console)
     for line in calibration_lines(prof):
-        console.print(line, highlight=False)
-    if any(s.visible_artifacts for s in prof.selections):
-        marked = ", ".join(s.label for s in prof.selections if s.visible_artifacts)
-        console.print(f"{marked}: {_visible_words(prof)}: visible artifacts (a choice, not a default)",
-                      highlight=False)
-    noisy = [s.label for s in prof.selections if s.measured_noise is not None and s.measured_noise > UNRELIABLE_NOISE]
-    if noisy:
-        console.print(f"warning: {', '.join(noisy)} measured while the original's frame times varied by more than "
-                      f"{UNRELIABLE_NOISE:.0%}: the machine's load made those speed-ups unreliable", highlight=False)
-
-
-def _visible_words(prof) -> str:
-    from rrcache.model.levels import VISIBLE_FLIP
-
-    if any(s.visible_artifacts and s.measured_flip is not None for s in prof.selections):
-        return f"mean FLIP ≥ {VISIBLE_FLIP:g} as measured (below {VISIBLE_DB:.0f} dB PSNR where only predicted)"
-    return f"below {VISIBLE_DB:.0f} dB PSNR (predicted)"
+        console.print(line, highlight=False, markup=False, soft_wrap=True)
+    # what the measurements imply (the run's own warnings were printed as they came)
+    for line in run_warnings(prof, stored=False):
+        console.print(f"warning: {line}", highlight=False, markup=False, soft_wrap=True)
+    level = next((s.label for s in prof.selections if s.parts), None)
+    if level is not None:
+        console.print(f"next: {prof.path / 'report.html'} says what each level's files are and how to run them; "
+                      f"'rrcache instance {prof.path} --level {level} --out DIR' writes a level's shaders again "
+                      "(--target webgl2: a page that runs them in a browser)", highlight=False, markup=False,
+                      soft_wrap=True)
 
 
 def calibration_lines(prof) -> list[str]:
@@ -383,17 +364,15 @@ def level_status(s) -> str:
     return f"met, try {s.tries}" if s.tries > 1 else "met"
 
 
-def _table(prof) -> Table:
-    table = Table(title="selections (pred. = predicted by the models, meas. = measured by validation)")
-    for name in ("level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
-                 "FLIP meas.", "level met"):
-        if name == "node":
-            table.add_column(name, justify="left", no_wrap=True, overflow="ellipsis", max_width=36)
-        else:
-            table.add_column(name, justify="right")
+def _table(prof) -> TextTable:
+    table = TextTable("selections (pred. = predicted by the models, meas. = measured by validation)",
+                      [(name, "left" if name in ("level", "node") else "right") for name in (
+                          "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
+                          "FLIP meas.", "level met")])
     for s in prof.selections:
         if s.multi:  # several nodes, each at its own period
-            node, period = " + ".join(s.nodes), "/".join(str(p) for p in s.periods)
+            node = " + ".join(f"{p.node}: {p.text or prof.node(p.node).text}" for p in s.parts)
+            period = "/".join(str(p) for p in s.periods)
         elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
             part = s.parts[0]
             slots = " slots" if part.history == "slots" else ""

@@ -51,12 +51,13 @@ def _duration(seconds: float) -> str:
 class Eta:
     """The time left, or None ("estimating") until the estimate is stable.
 
-    Each update projects the whole run's duration from the average rate so far (elapsed ×
-    total / done). The estimate is shown once at least ``min_share`` of the work is done, at
-    least ``min_seconds`` have passed, and the last ``samples`` projections (taken at least
-    ``spacing`` seconds apart) agree within ``agree`` (±25%); it goes back to "estimating"
-    whenever they stop agreeing (the rate changed, or the plan grew or shrank). Work that starts
-    again from 0 (a new counter) starts a new estimate.
+    Each update projects when the work will be done from the average rate since its counter
+    started (a new counter, one that goes back to fewer done, starts where the last update of
+    the old one was). The estimate is shown once at least ``min_share`` of the work is done, at
+    least ``min_seconds`` have passed on this counter, and the last ``samples`` projections
+    (taken at least ``spacing`` seconds apart) agree within ``agree`` (25%) of the counter's
+    projected duration; it goes back to "estimating" whenever they stop agreeing (the rate changed, or the
+    plan grew or shrank).
 
     >>> eta = Eta(min_seconds=10, spacing=2)
     >>> [eta.update(t, t, 100) for t in (1, 3, 5)]      # too early: estimating
@@ -65,38 +66,45 @@ class Eta:
     (88.0, '88 s')
     >>> eta.update(14, 20, 100) is None                 # the rate changed: estimating again
     True
+    >>> eta.update(20, 2, 50) is None                   # a new counter: a new estimate
+    True
     """
 
     def __init__(self, min_share: float = 0.05, min_seconds: float = 20.0, agree: float = 0.25,
                  samples: int = 3, spacing: float = 5.0):
         self.min_share, self.min_seconds, self.agree = min_share, min_seconds, agree
         self.samples, self.spacing = samples, spacing
-        self._projections: list[tuple[float, float]] = []  # (elapsed, projected duration)
-        self._last_done = 0
+        self._projections: list[tuple[float, float]] = []  # (elapsed, projected time left)
+        self._origin = 0.0  # when the current counter started
+        self._last = (0.0, 0)  # the last update's (elapsed, done)
         self._left: Optional[float] = None
 
     def update(self, elapsed: float, done: Optional[int], total: Optional[int]) -> Optional[float]:
         """Record progress; return the seconds left, or None while estimating."""
         self._left = None
-        if done is None or not total or done <= 0:
+        if done is None or not total:
             return None
-        if done < self._last_done:  # a new counter: a new estimate
+        elapsed = float(elapsed)
+        if done < self._last[1]:  # a new counter: a new estimate, from the old one's last update
             self._projections = []
-        self._last_done = done
-        if done >= total:
+            self._origin = self._last[0]
+        self._last = (elapsed, done)
+        spent = elapsed - self._origin
+        if done <= 0 or done >= total or spent <= 0:
             return None
-        projected = float(elapsed) * total / done
+        left = spent / done * (total - done)
         if self._projections and elapsed - self._projections[-1][0] < self.spacing:
-            self._projections[-1] = (self._projections[-1][0], projected)
+            self._projections[-1] = (self._projections[-1][0], elapsed + left)
         else:
-            self._projections.append((float(elapsed), projected))
+            self._projections.append((elapsed, elapsed + left))
         self._projections = self._projections[-self.samples:]
-        recent = [p for _, p in self._projections]
-        if (done / total < self.min_share or elapsed < self.min_seconds or len(recent) < self.samples
-                or max(recent) > (1 + self.agree) * min(recent)):
+        ends = [end for _, end in self._projections]
+        span = max(ends) - min(ends)
+        if (done / total < self.min_share or spent < self.min_seconds or len(ends) < self.samples
+                or span > self.agree * (spent + left)):
             return None
-        self._left = max(0.0, projected - float(elapsed))
-        return self._left
+        self._left = left
+        return left
 
     def text(self) -> str:
         """The last update's estimate in words, or "estimating"."""

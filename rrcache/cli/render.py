@@ -6,6 +6,7 @@ shader and report per frame.
     rrcache render marble.frag session.json --node n2575 --period 16 --json
     rrcache render marble.rrprofile --level e2            # the profile's e2 choice, as it chose it
     rrcache render marble.rrprofile --node n74 --period 8 # another choice, with the profile's options
+    rrcache render marble.frag session.json --method render-cache --samples 0.05   # the render cache
 
 With ``--node`` the variant caching that node is rendered beside the original (``--node A --period
 50 --node B --period 4``: several nodes, each at its own period, paired in order), frame by frame in
@@ -24,6 +25,10 @@ profile chose, and the refresh block, pattern and depth tolerance to the profile
 adaptive threshold or amortized m and λ), over the profile's validation frames, drawn into the
 profile's timing colour format (``--color-format rgba32f`` for the exact error): what the profile
 measured when it validated the level, again.
+
+``--method render-cache --samples F`` compares the render cache of Walter et al. 2002 (forward
+reprojection, F of the pixels shaded per frame) with the original instead: a baseline at equal
+time, never a choice the profiler makes (:mod:`rrcache.cli.method`).
 
 Frames are drawn into ``--color-format`` (default: rgba8 for a comparison without ``--out``, as
 applications draw; rgba32f otherwise: exact images, and NaN/Inf can only be counted in a float
@@ -57,10 +62,12 @@ from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
 from rrcache.harness.prepare import prepare_file
 from rrcache.harness.renderer import frame_indices, render
-from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD,
+from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
+from rrcache.cli.method import check_method, method_option, render_cache, samples_option
+from rrcache.cli.repeats import run_repeats
 
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm", "block": "--block",
@@ -93,7 +100,7 @@ _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm
               help=f"Refresh block size k in pixels (default: the profile's, else {DEFAULT_BLOCK}).")
 @click.option("--refresh", type=click.Choice(REFRESH_MODES), default=None,
               help=f"Refresh pattern (default: the profile's, else {DEFAULT_REFRESH}).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default="bilinear", show_default=True,
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True,
               help="Payload reconstruction filter.")
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
               help="Cache precision: 32- or 16-bit float.")
@@ -109,12 +116,14 @@ _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm
               help="With --node or --level: run the side-by-side comparison this many times (the speed-up is "
                    "the median repeat, with the range).")
 @adaptive_options
+@method_option
+@samples_option
 @quiet_option
 @vert_option
 @click.pass_context
 def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, defines, include_dirs, level, node,
             period, algorithm, block, refresh, filter_, payload, depth_epsilon, color_format, repeats, adaptive,
-            fast_period, spread, quiet, vert):
+            fast_period, spread, method, samples, quiet, vert):
     """Render SESSION through the fragment shader SHADER (or a PROFILE's shader and session) and
     report time and coverage per frame; with --node or --level, compare a cached variant with the
     original."""
@@ -126,13 +135,18 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                                "--level e2)")
     if level is not None:
         refuse_with_level(ctx, _LEVEL_OWNS)
+    check_method(method, samples, {"--node": bool(node), "--level": level is not None})
     loaded = load_session(source.session)
-    cached = bool(node) or level is not None
+    cached = bool(node) or level is not None or method == "render-cache"
     if color_format == "auto":
         # a replay is exact (its images, its NaN/Inf counts need floats); a comparison is a
         # timing: as applications draw (as the profile timed it), unless its images are written
         timing = prof.settings.timing_format if prof is not None else DEFAULT_TIMING_FORMAT
         color_format = timing if cached and not out_dir else ERROR_FORMAT
+    if method == "render-cache":
+        render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_json, color_format, repeats,
+                     err_console, quiet)
+        return
     if level is not None:
         from rrcache.profiles import choice
 
@@ -265,22 +279,10 @@ def _compare(work, loaded, variant, what: str, setup: dict, out_dir, frame_count
         err_console.print(f"{what}\n  with {setup['said']}; colour target {color_format}, {len(indices)} frames",
                           highlight=False, markup=False, soft_wrap=True)
     label = setup.get("level") or " + ".join(nodes or [])
-    runs = []
-    with Reporter(err_console, quiet=quiet or len(indices) * repeats < 2) as reporter:
-        for repeat in range(repeats):
-            count = {"n": 0}
-
-            def done(row, got, ref, repeat=repeat):
-                if out is not None and repeat == 0:
-                    stem = out / f"frame_{row.index:04d}"
-                    write_image(stem.with_suffix(".exr"), got.image)
-                    write_image(stem.with_suffix(".png"), got.image)
-                    write_image(out / f"original_{row.index:04d}.png", ref.image)
-                count["n"] += 1
-                reporter.update(f"[{repeat + 1}/{repeats}] {label} beside the original", count["n"], len(indices))
-
-            runs.append(compare(variant, loaded, work.prepared, indices, period=setup["period"], resolution=resolution,
-                                on_frame=done, color_format=color_format, **setup["options"]))
+    runs = run_repeats(lambda done: compare(variant, loaded, work.prepared, indices, period=setup["period"],
+                                            resolution=resolution, on_frame=done, color_format=color_format,
+                                            **setup["options"]),
+                       len(indices), repeats, out, label, err_console, quiet)
     # the median repeat by speed-up stands for the run; the range is every repeat's
     speedups = sorted(r.speedup for r in runs)
     result = sorted(runs, key=lambda r: r.speedup)[len(runs) // 2]

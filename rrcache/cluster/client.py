@@ -60,8 +60,9 @@ class Cluster:
     def describe(self) -> str:
         renderers = sorted({str(info.get("renderer")) for info in self.workers.values()})
         where = "started here" if self.local is not None else f"scheduler {self.client.scheduler.address}"
-        text = (f"Dask cluster ({where}): {len(self.workers)} workers on {len(self.hosts)} "
-                f"host{'s' if len(self.hosts) != 1 else ''} ({', '.join(renderers)})")
+        workers, hosts = len(self.workers), len(self.hosts)
+        text = (f"Dask cluster ({where}): {workers} worker{'s' if workers != 1 else ''} on {hosts} "
+                f"host{'s' if hosts != 1 else ''} ({', '.join(renderers)})")
         return text + (f", dashboard {self.dashboard}" if self.dashboard else ", no dashboard (install bokeh)")
 
     def close(self) -> None:

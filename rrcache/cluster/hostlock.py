@@ -30,6 +30,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import os
+import stat
 import tempfile
 
 from rrcache.errors import RRCacheError
@@ -45,7 +46,12 @@ def default_path() -> str:
 
 def _open(path: str) -> int:
     try:
-        return os.open(path, os.O_RDONLY | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        # never through a link (the default lives in the shared temporary folder); a regular file only
+        fd = os.open(path, os.O_RDONLY | os.O_CREAT | os.O_CLOEXEC | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise OSError(0, "not a regular file")
+        return fd
     except OSError as err:
         raise RRCacheError(f"cannot open the host's timing lock: {err.strerror or err}", path,
                            hint=f"set {LOCK_ENV} to a file every rrcache worker on this machine can open") from None

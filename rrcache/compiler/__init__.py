@@ -38,7 +38,7 @@ from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.locate import prepare
 from rrcache.compiler.passes import build_pass
 from rrcache.compiler.variant import PassSource, Variant
-from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.cache import ALGORITHMS, DEFAULT_FILTER, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS, depth_channel_for
 
 __all__ = ["instance", "instance_nodes", "check_algorithm", "Variant", "PassSource"]
@@ -59,7 +59,7 @@ def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: 
 
 @deep
 def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three-pass",
-             filter: str = "bilinear", payload_dtype: str = "f4", vertex=None, pack_depth: bool = False,
+             filter: str = DEFAULT_FILTER, payload_dtype: str = "f4", vertex=None, pack_depth: bool = False,
              adaptive: bool = False) -> Variant:
     """Compile the variant of ``analysed`` that caches node ``node_id`` with ``algorithm``.
 

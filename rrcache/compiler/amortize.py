@@ -65,7 +65,7 @@ from rrcache.glsl.legacy import to_core
 from rrcache.glsl.parser import parse_source
 from rrcache.glsl.semantic import check
 from rrcache.glsl.rewrite import clone, rewrite_scoped
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import written_roots
 from rrcache.analysis.unroll import fold_copy
 from rrcache.analysis.estimators import Estimator, EstimatorTable, display_name, find_estimators
 from rrcache.glsl.ast import main_function, walk

@@ -39,18 +39,29 @@ from typing import Optional
 
 from rrcache.glsl import ast as A
 from rrcache.glsl.ast import main_function, walk
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import declared, written_roots
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.compiler.locate import Site
 
 
-def _simple(s: A.Stmt) -> bool:
-    if isinstance(s, A.Compound):
-        return all(_simple(x) for x in s.stmts)
-    if isinstance(s, A.DeclStmt):
-        if not isinstance(s.decl, A.VariableDecl) or not s.decl.declarators:
-            return False
-    elif not isinstance(s, A.ExprStmt):
+class _Simple(NodeVisitor):
+    """Whether a statement may move: expression statements, local declarations and blocks of
+    them, calling no user function and no side-effecting built-in."""
+
+    def generic_visit(self, s) -> bool:
         return False
+
+    def visit_Compound(self, s: A.Compound) -> bool:
+        return all(self.visit(x) for x in s.stmts)
+
+    def visit_DeclStmt(self, s: A.DeclStmt) -> bool:
+        return isinstance(s.decl, A.VariableDecl) and bool(s.decl.declarators) and _pure(s)
+
+    def visit_ExprStmt(self, s: A.ExprStmt) -> bool:
+        return _pure(s)
+
+
+def _pure(s: A.Stmt) -> bool:
     for n in walk(s):
         if isinstance(n, A.Call) and (n.kind == "function" or isinstance(n.target, A.FunctionDecl)
                                       or getattr(n.target, "side_effects", False)):
@@ -58,34 +69,20 @@ def _simple(s: A.Stmt) -> bool:
     return True
 
 
+_simple = _Simple().visit
+
+
 def _uses(node: A.Node) -> Counter:
     return Counter(n.name for n in walk(node) if isinstance(n, A.Ident))
 
 
 def _writes(s: A.Stmt) -> set[str]:
-    out: set[str] = set()
-    for n in walk(s):
-        if isinstance(n, A.Declarator):
-            out.add(n.name)
-        elif isinstance(n, A.Expr):
-            out.update(r.name for r in written_roots(n))
-        if isinstance(n, A.Assign):
-            root = n.target
-            while isinstance(root, (A.Field, A.Index)):
-                root = root.obj
-            if isinstance(root, A.Ident):
-                out.add(root.name)
-        elif isinstance(n, A.Unary) and n.op in ("++", "--"):
-            root = n.operand
-            while isinstance(root, (A.Field, A.Index)):
-                root = root.obj
-            if isinstance(root, A.Ident):
-                out.add(root.name)
-    return out
+    """The names ``s`` declares or writes (:mod:`rrcache.glsl.defuse`)."""
+    return {d.name for d in declared(s)} | {r.name for r in written_roots(s)}
 
 
 def _reads(s: A.Stmt) -> set[str]:
-    return {n.name for n in walk(s) if isinstance(n, A.Ident)}
+    return set(_uses(s))
 
 
 def move_feeders(site: Site, setter: A.If, miss_branch: A.Compound,

@@ -25,26 +25,35 @@ from __future__ import annotations
 from typing import Optional
 
 from rrcache.glsl import ast as A
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.ast import own_parts, post_order
 from rrcache.compiler.locate import PLACEHOLDER, Site
 from rrcache.compiler.replace import NODE_VAR, node_variable, replace_node
 
 
-def _has_effect(n: A.Node) -> bool:
-    if isinstance(n, A.Assign):
+class _HasEffect(NodeVisitor):
+    """Whether evaluating a node itself has a side effect (its operands not included)."""
+
+    def generic_visit(self, n) -> bool:
+        return False
+
+    def visit_Assign(self, n) -> bool:
         return True
-    if isinstance(n, A.Unary) and n.op in ("++", "--"):
-        return True
-    if isinstance(n, A.Declarator):
-        return True
-    if isinstance(n, A.Call):
+
+    visit_Declarator = visit_Assign
+
+    def visit_Unary(self, n: A.Unary) -> bool:
+        return n.op in ("++", "--")
+
+    def visit_Call(self, n: A.Call) -> bool:
         if n.kind == "function" or isinstance(n.target, A.FunctionDecl):
             return True
         target = n.target
-        if target is not None and (getattr(target, "side_effects", False)
-                                   or any(q != "in" for q in getattr(target, "qualifiers", ()))):
-            return True
-    return False
+        return target is not None and (getattr(target, "side_effects", False)
+                                       or any(q != "in" for q in getattr(target, "qualifiers", ())))
+
+
+_has_effect = _HasEffect().visit
 
 
 def side_effect_before(stmt: A.Stmt) -> bool:

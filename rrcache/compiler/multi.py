@@ -16,7 +16,7 @@ from rrcache.compiler.multi_locate import prepare_nodes
 from rrcache.compiler.multi_passes import build_multi_pass, has_discard, node_order
 from rrcache.compiler.multi_variant import MultiVariant
 from rrcache.compiler.variant import PassSource
-from rrcache.runtime.cache import ALGORITHMS, PAYLOAD_DTYPES
+from rrcache.runtime.cache import ALGORITHMS, DEFAULT_FILTER, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS
 
 
@@ -29,7 +29,7 @@ def _table_entry(analysed: Any, node_id: Any):
 
 @deep
 def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "three-pass",
-                   filter: str = "bilinear", payload_dtype: str = "f4", vertex=None) -> MultiVariant:
+                   filter: str = DEFAULT_FILTER, payload_dtype: str = "f4", vertex=None) -> MultiVariant:
     """Compile the variant of ``analysed`` that caches every node of ``node_ids`` (at least two;
     ids of the node table, or expression nodes), each with its own payload and, at run time, its
     own period (:class:`rrcache.runtime.CacheRuntime` with ``period=(Δn_0, Δn_1, …)`` in this

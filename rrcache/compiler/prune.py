@@ -50,19 +50,15 @@ from typing import Iterable, Optional
 
 from rrcache.glsl import ast as A
 from rrcache.glsl.ast import main_function, walk
-from rrcache.glsl.writes import written_roots
+from rrcache.glsl.defuse import definitions, uses, var_key
+from rrcache.glsl.visitor import NodeVisitor
 
 DEAD, CONTROL, ESSENTIAL = 0, 1, 2
 
-Key = tuple
 
-
-def var_key(ident: A.Ident) -> Key:
-    """The identity of the variable an identifier refers to: its declaration and name."""
-    sym = ident.symbol
-    if sym is None:
-        return ("name", ident.name)
-    return (id(sym.decl), sym.name)
+def _global(ident: A.Ident) -> bool:
+    """Whether an identifier names something other than a local variable or a parameter."""
+    return ident.symbol is not None and ident.symbol.kind not in ("local", "param")
 
 
 def _observable(ident: A.Ident) -> bool:
@@ -88,7 +84,9 @@ class _Effects:
         self.essential = False
 
 
-class _Liveness:
+class _Liveness(NodeVisitor):
+    """Visiting a statement with the variables live after it returns ``(live before, status)``."""
+
     def __init__(self, unit: A.TranslationUnit, main: A.FunctionDecl):
         self.functions = {}
         for d in unit.decls:
@@ -116,16 +114,13 @@ class _Liveness:
         self.summaries[name] = eff  # GLSL has no recursion; this also stops a malformed cycle
         for fd in self.functions.get(name, []):
             for n in walk(fd.body):
-                if isinstance(n, A.Ident) and n.symbol is not None and n.symbol.kind not in ("local", "param"):
-                    eff.reads.add(var_key(n))
-                elif isinstance(n, A.Discard):
+                if n.__class__ is A.Discard:
                     eff.essential = True
-                elif isinstance(n, A.Call):
+                elif n.__class__ is A.Call:
                     self._call_effects(n, eff)
-                elif isinstance(n, A.Expr):
-                    for root in written_roots(n):
-                        if root.symbol is not None and root.symbol.kind not in ("local", "param"):
-                            eff.writes.add(var_key(root))
+            eff.reads |= {var_key(n) for n in walk(fd.body) if n.__class__ is A.Ident
+                          and _global(n)}
+            eff.writes |= {var_key(d.root) for d in definitions(fd.body) if _global(d.root)}
         return eff
 
     def _call_effects(self, call: A.Call, eff: _Effects) -> None:
@@ -141,20 +136,13 @@ class _Liveness:
         eff = _Effects()
         if node is None:
             return eff
-        assigned_whole = set()
         if isinstance(node, A.Assign) and node.op == "=" and isinstance(node.target, A.Ident):
             eff.kills.add(var_key(node.target))
         for n in walk(node):
-            if isinstance(n, A.Assign) and n.op == "=" and isinstance(n.target, A.Ident):
-                assigned_whole.add(id(n.target))
-            elif isinstance(n, A.Call):
+            if n.__class__ is A.Call:
                 self._call_effects(n, eff)
-        for n in walk(node):
-            if isinstance(n, A.Ident) and id(n) not in assigned_whole:
-                eff.reads.add(var_key(n))
-            if isinstance(n, A.Expr):
-                for root in written_roots(n):
-                    eff.writes.add(var_key(root))
+        eff.reads.update(var_key(n) for n in uses(node))
+        eff.writes.update(var_key(d.root) for d in definitions(node))
         return eff
 
     # ----------------------------------------------------------------------- statements
@@ -167,50 +155,52 @@ class _Liveness:
         return live, status
 
     def stmt(self, s: A.Stmt, live: set) -> tuple[set, int]:
-        live_in, st = self._stmt(s, set(live))
+        live_in, st = self.visit(s, set(live))
         self.status[id(s)] = st
         return live_in, st
 
-    def _stmt(self, s: A.Stmt, live: set) -> tuple[set, int]:
-        if isinstance(s, A.Compound):
-            return self.block(s.stmts, live)
-        if isinstance(s, A.ExprStmt):
-            if s.expr is None:
-                return live, DEAD
-            eff = self.effects(s.expr)
-            if eff.essential or eff.writes & live:
-                return (live - eff.kills) | eff.reads, ESSENTIAL
+    def visit_Compound(self, s: A.Compound, live: set) -> tuple[set, int]:
+        return self.block(s.stmts, live)
+
+    def visit_ExprStmt(self, s: A.ExprStmt, live: set) -> tuple[set, int]:
+        if s.expr is None:
             return live, DEAD
-        if isinstance(s, A.DeclStmt):
-            return self.decl(s.decl, live)
-        if isinstance(s, A.If):
-            t_in, t_st = self.stmt(s.then, live)
-            e_in, e_st = self.stmt(s.else_, live) if s.else_ is not None else (live, DEAD)
-            eff = self.effects(s.cond)
-            st = max(t_st, e_st)
-            if eff.essential or eff.writes & live:
-                st = ESSENTIAL
-            if st == DEAD:
-                return live, DEAD
-            if st == CONTROL and not self.control_reads:
-                return t_in | e_in, st
-            return t_in | e_in | eff.reads, st
-        if isinstance(s, (A.For, A.While)):
-            return self.loop(s, live)
-        if isinstance(s, A.DoWhile):
-            return self.do_while(s, live)
-        if isinstance(s, A.Switch):
-            return self.switch(s, live)
-        if isinstance(s, A.Break):
-            target = self.loops[-1].brk if self.loops else live
-            return set(target), CONTROL
-        if isinstance(s, A.Continue):
-            cont = next((lp.cont for lp in reversed(self.loops) if lp.cont is not None), None)
-            return set(cont if cont is not None else live), CONTROL
-        if isinstance(s, A.Return):
-            return set(self.observable) | self.effects(s.expr).reads, ESSENTIAL
-        if isinstance(s, A.Discard):
-            return set(), ESSENTIAL
+        eff = self.effects(s.expr)
+        if eff.essential or eff.writes & live:
+            return (live - eff.kills) | eff.reads, ESSENTIAL
+        return live, DEAD
+
+    def visit_DeclStmt(self, s: A.DeclStmt, live: set) -> tuple[set, int]:
+        return self.decl(s.decl, live)
+
+    def visit_If(self, s: A.If, live: set) -> tuple[set, int]:
+        t_in, t_st = self.stmt(s.then, live)
+        e_in, e_st = self.stmt(s.else_, live) if s.else_ is not None else (live, DEAD)
+        eff = self.effects(s.cond)
+        st = max(t_st, e_st)
+        if eff.essential or eff.writes & live:
+            st = ESSENTIAL
+        if st == DEAD:
+            return live, DEAD
+        if st == CONTROL and not self.control_reads:
+            return t_in | e_in, st
+        return t_in | e_in | eff.reads, st
+
+    def visit_Break(self, s: A.Break, live: set) -> tuple[set, int]:
+        target = self.loops[-1].brk if self.loops else live
+        return set(target), CONTROL
+
+    def visit_Continue(self, s: A.Continue, live: set) -> tuple[set, int]:
+        cont = next((lp.cont for lp in reversed(self.loops) if lp.cont is not None), None)
+        return set(cont if cont is not None else live), CONTROL
+
+    def visit_Return(self, s: A.Return, live: set) -> tuple[set, int]:
+        return set(self.observable) | self.effects(s.expr).reads, ESSENTIAL
+
+    def visit_Discard(self, s: A.Discard, live: set) -> tuple[set, int]:
+        return set(), ESSENTIAL
+
+    def generic_visit(self, s: A.Node, live: set) -> tuple[set, int]:
         return live, CONTROL  # a case label outside a switch body, or anything unforeseen
 
     def decl(self, decl, live: set) -> tuple[set, int]:
@@ -241,7 +231,7 @@ class _Liveness:
             return out
         return self.effects(cond).reads
 
-    def loop(self, s, live: set) -> tuple[set, int]:
+    def visit_For(self, s, live: set) -> tuple[set, int]:
         saved = self.control_reads
         self.control_reads = False
         try:
@@ -289,7 +279,9 @@ class _Liveness:
                 live_in |= self.effects(init.expr).reads
         return live_in, ESSENTIAL
 
-    def do_while(self, s: A.DoWhile, live: set) -> tuple[set, int]:
+    visit_While = visit_For
+
+    def visit_DoWhile(self, s: A.DoWhile, live: set) -> tuple[set, int]:
         saved = self.control_reads
         self.control_reads = False
         try:
@@ -319,7 +311,7 @@ class _Liveness:
             return live, DEAD
         return body_in | cond_reads, ESSENTIAL
 
-    def switch(self, s: A.Switch, live: set) -> tuple[set, int]:
+    def visit_Switch(self, s: A.Switch, live: set) -> tuple[set, int]:
         self.loops.append(_Loop(set(live), None))
         try:
             cur = set(live)
@@ -344,7 +336,9 @@ class _Liveness:
         return entries | eff.reads, ESSENTIAL
 
 
-class _Rebuild:
+class _Rebuild(NodeVisitor):
+    """Visiting a kept statement drops what it holds that is dead."""
+
     def __init__(self, lv: _Liveness):
         self.lv = lv
         # (the list holding the statement or None, the DeclStmt, its original declarators)
@@ -360,7 +354,7 @@ class _Rebuild:
                            and bool(s.decl.declarators))
             if isinstance(s, A.Case) or self.kept(s) or is_var_decl:
                 # a declaration whose variables are all dead stays a candidate for restore()
-                self.stmt(s, out)
+                self.visit(s, out)
                 if not (isinstance(s, A.Compound) and not s.stmts):
                     out.append(s)
         return out
@@ -370,20 +364,29 @@ class _Rebuild:
             return None
         if not self.kept(s):
             return None if optional else A.Compound([], loc=s.loc)
-        self.stmt(s, None)
+        self.visit(s, None)
         return s
 
-    def stmt(self, s: A.Stmt, container: Optional[list]) -> None:
-        if isinstance(s, A.Compound):
-            s.stmts = self.block(s.stmts)
-        elif isinstance(s, A.If):
-            s.then = self.sub(s.then, optional=False)
-            s.else_ = self.sub(s.else_, optional=True)
-        elif isinstance(s, (A.For, A.While, A.DoWhile)):
-            s.body = self.sub(s.body, optional=False)
-        elif isinstance(s, A.Switch):
-            s.body.stmts = self.block(s.body.stmts)
-        elif isinstance(s, A.DeclStmt) and isinstance(s.decl, A.VariableDecl) and s.decl.declarators:
+    def generic_visit(self, s: A.Stmt, container: Optional[list]) -> None:
+        pass
+
+    def visit_Compound(self, s: A.Compound, container: Optional[list]) -> None:
+        s.stmts = self.block(s.stmts)
+
+    def visit_If(self, s: A.If, container: Optional[list]) -> None:
+        s.then = self.sub(s.then, optional=False)
+        s.else_ = self.sub(s.else_, optional=True)
+
+    def visit_For(self, s, container: Optional[list]) -> None:
+        s.body = self.sub(s.body, optional=False)
+
+    visit_While = visit_DoWhile = visit_For
+
+    def visit_Switch(self, s: A.Switch, container: Optional[list]) -> None:
+        s.body.stmts = self.block(s.body.stmts)
+
+    def visit_DeclStmt(self, s: A.DeclStmt, container: Optional[list]) -> None:
+        if isinstance(s.decl, A.VariableDecl) and s.decl.declarators:
             original = list(s.decl.declarators)
             s.decl.declarators = [d for d in original if self.lv.live_decl.get(id(d), False)]
             self.decls.append((container, s, original))
@@ -429,7 +432,7 @@ def prune_main(unit: A.TranslationUnit) -> None:
     lv.stmt(main.body, set(lv.observable))
     lv.status[id(main.body)] = ESSENTIAL
     rb = _Rebuild(lv)
-    rb.stmt(main.body, None)
+    rb.visit(main.body, None)
     rb.restore(main)
     tidy_blocks(main.body)
 
@@ -441,6 +444,44 @@ def _header_names(s: A.Stmt) -> set[str]:
     if isinstance(cond, A.VariableDecl):
         decls.append(cond)
     return {d.name for v in decls if isinstance(v, A.VariableDecl) for d in v.declarators}
+
+
+class _Tidy(NodeVisitor):
+    """In place: the empty blocks dropped and single nested blocks flattened (:func:`tidy_blocks`)."""
+
+    def generic_visit(self, s, keep_names: frozenset = frozenset()) -> None:
+        pass
+
+    def visit_Compound(self, s: A.Compound, keep_names: frozenset = frozenset()) -> None:
+        out = []
+        for x in s.stmts:
+            self.visit(x)
+            if not (isinstance(x, A.Compound) and not x.stmts):
+                out.append(x)
+        while len(out) == 1 and isinstance(out[0], A.Compound) and not (
+                keep_names and keep_names & {d.name for x in out[0].stmts if isinstance(x, A.DeclStmt)
+                                             and isinstance(x.decl, A.VariableDecl)
+                                             for d in x.decl.declarators}):
+            out = out[0].stmts
+        s.stmts = out
+
+    def visit_If(self, s: A.If, keep_names: frozenset = frozenset()) -> None:
+        self.visit(s.then)
+        if s.else_ is not None:
+            self.visit(s.else_)
+
+    def visit_For(self, s, keep_names: frozenset = frozenset()) -> None:
+        self.visit(s.body, frozenset(_header_names(s)))
+
+    visit_While = visit_DoWhile = visit_For
+
+    def visit_Switch(self, s: A.Switch, keep_names: frozenset = frozenset()) -> None:
+        for x in s.body.stmts:
+            self.visit(x)
+        # labels left with no statement after them (their code was pruned) end the body: a
+        # label must precede a statement, and nothing would run there anyway
+        while s.body.stmts and isinstance(s.body.stmts[-1], A.Case):
+            s.body.stmts.pop()
 
 
 def tidy_blocks(s: Optional[A.Stmt], keep_names: frozenset = frozenset()) -> None:
@@ -466,44 +507,34 @@ def tidy_blocks(s: Optional[A.Stmt], keep_names: frozenset = frozenset()) -> Non
         }
     }
     """
-    if isinstance(s, A.Compound):
-        out = []
-        for x in s.stmts:
-            tidy_blocks(x)
-            if not (isinstance(x, A.Compound) and not x.stmts):
-                out.append(x)
-        while len(out) == 1 and isinstance(out[0], A.Compound) and not (
-                keep_names and keep_names & {d.name for x in out[0].stmts if isinstance(x, A.DeclStmt)
-                                             and isinstance(x.decl, A.VariableDecl)
-                                             for d in x.decl.declarators}):
-            out = out[0].stmts
-        s.stmts = out
-    elif isinstance(s, A.If):
-        tidy_blocks(s.then)
-        tidy_blocks(s.else_)
-    elif isinstance(s, (A.For, A.While, A.DoWhile)):
-        tidy_blocks(s.body, frozenset(_header_names(s)))
-    elif isinstance(s, A.Switch):
-        for x in s.body.stmts:
-            tidy_blocks(x)
-        # labels left with no statement after them (their code was pruned) end the body: a
-        # label must precede a statement, and nothing would run there anyway
-        while s.body.stmts and isinstance(s.body.stmts[-1], A.Case):
-            s.body.stmts.pop()
+    if s is not None:
+        _Tidy().visit(s, keep_names)
+
+
+class _Names(NodeVisitor):
+    """Names a declaration references: identifiers, called functions and constructors, type
+    names (struct types)."""
+
+    def __init__(self):
+        self.found: set[str] = set()
+
+    def visit_Ident(self, n) -> None:
+        self.found.add(n.name)
+
+    def visit_Call(self, n) -> None:
+        self.found.add(n.name)
+        self.generic_visit(n)
+
+    def visit_TypeSpecifier(self, n) -> None:
+        if n.name:
+            self.found.add(n.name)
+        self.generic_visit(n)
 
 
 def _names(node: A.Node) -> set[str]:
-    """Names a declaration references: identifiers, called functions and constructors, type
-    names (struct types)."""
-    out = set()
-    for n in walk(node):
-        if isinstance(n, A.Ident):
-            out.add(n.name)
-        elif isinstance(n, A.Call):
-            out.add(n.name)
-        elif isinstance(n, A.TypeSpecifier) and n.name:
-            out.add(n.name)
-    return out
+    v = _Names()
+    v.visit(node)
+    return v.found
 
 
 def prune_globals(unit: A.TranslationUnit, keep: Iterable[A.Node] = ()) -> None:
@@ -554,19 +585,28 @@ def prune_globals(unit: A.TranslationUnit, keep: Iterable[A.Node] = ()) -> None:
                                                      for n in d.names))]
 
 
-def _needed(d, refs: set[str]) -> bool:
-    if isinstance(d, A.FunctionDecl):
+class _Needed(NodeVisitor):
+    """Whether a global declaration is referenced by a name in ``refs``."""
+
+    def visit_FunctionDecl(self, d: A.FunctionDecl, refs: set) -> bool:
         return d.name in refs
-    if isinstance(d, A.VariableDecl):
+
+    def visit_VariableDecl(self, d: A.VariableDecl, refs: set) -> bool:
         if any(x.name in refs for x in d.declarators):
             return True
         st = d.type.spec.struct
         return st is not None and st.name is not None and st.name in refs
-    if isinstance(d, A.InterfaceBlock):
+
+    def visit_InterfaceBlock(self, d: A.InterfaceBlock, refs: set) -> bool:
         if d.instance_name:
             return d.instance_name in refs
         return any(x.name in refs for m in d.members for x in m.declarators)
-    return True  # precision and qualifier declarations (checked against what remains)
+
+    def generic_visit(self, d, refs: set) -> bool:
+        return True  # precision and qualifier declarations (checked against what remains)
+
+
+_needed = _Needed().visit
 
 
 def prune(unit: A.TranslationUnit, keep: Iterable[A.Node] = ()) -> A.TranslationUnit:

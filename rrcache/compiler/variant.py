@@ -134,23 +134,21 @@ class Variant:
             **({"adaptive": True} if self.adaptive else {}),
         }
 
-    def write(self, out_dir: "str | os.PathLike[str]", period: Optional[int] = None,
+    def write(self, out_dir: "str | os.PathLike[str] | atomic.OutputFolder", period: Optional[int] = None,
               runtime: Optional[dict] = None) -> list[str]:
         """Write ``<pass>.vert``, ``<pass>.frag`` and ``manifest.json`` (recording ``period``
-        and ``runtime``, see :meth:`manifest`) into ``out_dir`` (created when missing); returns
-        the paths written."""
-        out_dir = os.fspath(out_dir)
-        os.makedirs(out_dir, exist_ok=True)
+        and ``runtime``, see :meth:`manifest`) into ``out_dir`` (a folder path, created when
+        missing, or an open :class:`~rrcache.atomic.OutputFolder`) by :mod:`rrcache.atomic`'s
+        rule; returns the paths written."""
+        if not isinstance(out_dir, atomic.OutputFolder):
+            with atomic.OutputFolder(out_dir) as folder:
+                return self.write(folder, period, runtime)
         written = []
         # each file whole or not at all (a full disk leaves no truncated shader or manifest)
         for name, src in self.passes.items():
             for ext, text in (("vert", src.vertex), ("frag", src.fragment)):
-                path = os.path.join(out_dir, f"{name}.{ext}")
-                atomic.write_text(path, text if text.endswith("\n") else text + "\n")
-                written.append(path)
-        path = os.path.join(out_dir, "manifest.json")
-        atomic.write_text(path, json.dumps(self.manifest(period, runtime), indent=2) + "\n")
-        written.append(path)
+                written.append(out_dir.write_text(f"{name}.{ext}", text if text.endswith("\n") else text + "\n"))
+        written.append(out_dir.write_text("manifest.json", json.dumps(self.manifest(period, runtime), indent=2) + "\n"))
         return written
 
     def build_programs(self, ctx: moderngl.Context) -> dict[str, moderngl.Program]:

@@ -81,6 +81,18 @@ def _stage_section(log: str) -> tuple[str, str]:
     return m.group(1), log[m.end():]
 
 
+def fullscreen_vertex(depth: float = 0.0) -> str:
+    """The vertex shader of one triangle covering the viewport (three vertices, no attributes) at
+    NDC depth ``depth`` (-1: window depth 0, the nearest): for full-screen passes.
+
+    >>> "gl_VertexID" in fullscreen_vertex() and "-1.0, 1.0)" in fullscreen_vertex(-1.0)
+    True
+    """
+    return ("#version 330 core\nvoid main() {\n"
+            "    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n"
+            f"    gl_Position = vec4(p * 2.0 - 1.0, {float(depth)!r}, 1.0);\n}}\n")
+
+
 def build_program(
     ctx: moderngl.Context,
     vertex_src: str,

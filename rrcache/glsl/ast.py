@@ -540,31 +540,21 @@ def own_parts(s: Stmt) -> list[Node]:
     >>> [type(p).__name__ for p in own_parts(loop)]
     ['DeclStmt', 'Binary', 'Unary']
     """
-    if isinstance(s, ExprStmt):
-        return [s.expr] if s.expr is not None else []
-    if isinstance(s, DeclStmt):
-        return [s.decl]
-    if isinstance(s, If):
-        return [s.cond]
-    if isinstance(s, For):
-        return [x for x in (s.init, s.cond, s.step) if x is not None]
-    if isinstance(s, (While, DoWhile)):
-        return [s.cond]
-    if isinstance(s, Switch):
-        return [s.expr]
-    if isinstance(s, (Return, Case)):
-        return [s.expr] if s.expr is not None else []
-    return []
+    return [p for p in (getattr(s, f) for f in _OWN_PARTS.get(s.__class__, ())) if p is not None]
+
+
+#: the fields of each statement class that :func:`own_parts` and :func:`branches` give
+_OWN_PARTS = {ExprStmt: ("expr",), DeclStmt: ("decl",), If: ("cond",), For: ("init", "cond", "step"),
+              While: ("cond",), DoWhile: ("cond",), Switch: ("expr",), Return: ("expr",),
+              Case: ("expr",)}
+_BRANCHES = {If: ("then", "else_"), For: ("body",), While: ("body",), DoWhile: ("body",),
+             Switch: ("body",)}
 
 
 def branches(s: Stmt) -> list[tuple[str, Stmt]]:
     """The sub-statements of ``if``, the loops and ``switch`` as ``(field name, statement)``
     (a block's statements are ``s.stmts``)."""
-    if isinstance(s, If):
-        return [(f, getattr(s, f)) for f in ("then", "else_") if getattr(s, f) is not None]
-    if isinstance(s, (For, While, DoWhile, Switch)):
-        return [("body", s.body)]
-    return []
+    return [(f, getattr(s, f)) for f in _BRANCHES.get(s.__class__, ()) if getattr(s, f) is not None]
 
 
 def main_function(unit: TranslationUnit) -> Optional[FunctionDecl]:

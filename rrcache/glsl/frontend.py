@@ -20,9 +20,10 @@ from rrcache.budgets import budget
 from rrcache.deep import deep
 from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.builtins import NON_FRAGMENT_VARIABLES
 from rrcache.glsl.parser import parse_preprocessed
-from rrcache.glsl.preprocessor import preprocess
+from rrcache.glsl.preprocessor import preprocess, read_source
 from rrcache.glsl.semantic import SemanticInfo, check
 from rrcache.glsl.types import Type
 
@@ -124,7 +125,7 @@ def parse_shader(source: str, filename: str = "<string>",
     _reject_multiple_outputs(frag_data, info)
     path = None if filename.startswith("<") else filename
     files = list(pp.files) or ([filename] if path else [])
-    digests = file_digests(source, files, filename)
+    digests = file_digests(source, files, filename, pp.file_hashes)
     return Shader(
         path=path, source=source, unit=unit, info=info, version=info.version,
         profile=unit.profile or ("es" if info.es else None),
@@ -178,39 +179,16 @@ def load_shader(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
     Type('vec3')
     """
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as f:
-            data = f.read(budget.source_bytes + 1)
-    except OSError as e:
-        raise GLSLError(f"cannot read shader file '{path}': {e.strerror or e}", None,
-                        "check the path" if isinstance(e, FileNotFoundError) else None) from None
-    if len(data) > budget.source_bytes:
-        raise GLSLError(f"the shader file is larger than {budget.source_bytes:,} bytes, the analysis budget",
-                        SourceLoc(path, 1, 1), "raise it with 'rrcache --max-source-bytes N ...'")
-    try:
-        source = data.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        line = data.count(b"\n", 0, e.start) + 1
-        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
-        raise GLSLError("the shader file is not valid UTF-8", SourceLoc(path, line, col),
-                        "save the shader as UTF-8") from None
+    source, _ = read_source(path)
     return parse_shader(source, path, defines, include_dirs)
 
 
-def file_digests(source: str, files: list[str], filename: str) -> list[str]:
+def file_digests(source: str, files: list[str], filename: str, read: Mapping[str, str]) -> list[str]:
     """The sha256 of each file's content, ``files`` order: the main file's from ``source`` (the
-    text that was parsed), the included ones as read from disk now."""
-    out = []
-    for path in files or [filename]:
-        if path == filename:
-            out.append(hashlib.sha256(source.encode("utf-8")).hexdigest())
-            continue
-        try:
-            with open(path, "rb") as f:
-                out.append(hashlib.sha256(f.read()).hexdigest())
-        except OSError:
-            out.append("<unreadable>")
-    return out
+    text that was parsed), the included ones' from what the preprocessor read (``read``:
+    :attr:`~rrcache.glsl.preprocessor.Preprocessed.file_hashes`); no file is opened again."""
+    return [hashlib.sha256(source.encode("utf-8")).hexdigest() if path == filename else read[path]
+            for path in files or [filename]]
 
 
 def _hash(digests: list[str], defines: Mapping[str, object]) -> str:
@@ -280,37 +258,63 @@ def _unsupported(what: str, loc: Optional[SourceLoc], filename: str) -> Unsuppor
         SourceLoc(filename, 1, 1), "pass the fragment (pixel) shader")
 
 
+class _OtherStages(NodeVisitor):
+    """Raises for what only another stage writes; collects the ``gl_FragData[...]`` indices."""
+
+    def __init__(self, filename: str):
+        self.filename = filename
+        self.frag_data: list[A.Index] = []
+
+    def refuse(self, what: str, loc) -> UnsupportedShaderError:
+        return _unsupported(what, loc, self.filename)
+
+    def visit_Index(self, node: A.Index) -> None:
+        if isinstance(node.obj, A.Ident) and node.obj.name == "gl_FragData":
+            self.frag_data.append(node)
+        self.generic_visit(node)
+
+    def visit_Ident(self, node: A.Ident) -> None:
+        if node.name in NON_FRAGMENT_VARIABLES:
+            raise self.refuse(f"non-fragment shader (it uses '{node.name}')", node.loc)
+
+    def visit_Call(self, node: A.Call) -> None:
+        if node.name in _OTHER_STAGE_FUNCTIONS:
+            raise self.refuse(f"{_OTHER_STAGE_FUNCTIONS[node.name]} shader (it calls "
+                              f"'{node.name}')", node.loc)
+        self.generic_visit(node)
+
+    def visit_FullType(self, node: A.FullType) -> None:
+        if "attribute" in node.qualifiers:
+            raise self.refuse("vertex shader (it declares an 'attribute')", node.loc)
+        self.generic_visit(node)
+
+    def visit_Layout(self, node: A.Layout) -> None:
+        for name, _ in node.items:
+            if name in _OTHER_STAGE_LAYOUTS:
+                raise self.refuse(f"{_OTHER_STAGE_LAYOUTS[name]} shader (layout '{name}')",
+                                  node.loc)
+        self.generic_visit(node)
+
+    def visit_VariableDecl(self, node: A.VariableDecl) -> None:
+        for d in node.declarators:
+            if d.name in NON_FRAGMENT_VARIABLES:
+                raise self.refuse(f"non-fragment shader (it declares '{d.name}')",
+                                  d.loc or node.loc)
+        self.generic_visit(node)
+
+    def visit_InterfaceBlock(self, node: A.InterfaceBlock) -> None:
+        if node.block_name == "gl_PerVertex":
+            raise self.refuse("non-fragment shader (it declares 'gl_PerVertex')", node.loc)
+        self.generic_visit(node)
+
+
 def _reject_other_stages(unit: A.TranslationUnit, filename: str) -> list[A.Index]:
     """Raise for a non-fragment stage; returns the ``gl_FragData[...]`` index nodes. Runs before
     :func:`check`, so that a vertex shader is reported as one rather than as an undeclared
     ``gl_Position``."""
-    frag_data: list[A.Index] = []
-    for node in unit.walk():
-        if (isinstance(node, A.Index) and isinstance(node.obj, A.Ident)
-                and node.obj.name == "gl_FragData"):
-            frag_data.append(node)
-        if isinstance(node, A.Ident) and node.name in NON_FRAGMENT_VARIABLES:
-            raise _unsupported(f"non-fragment shader (it uses '{node.name}')", node.loc,
-                               filename)
-        if isinstance(node, A.Call) and node.name in _OTHER_STAGE_FUNCTIONS:
-            raise _unsupported(f"{_OTHER_STAGE_FUNCTIONS[node.name]} shader (it calls "
-                               f"'{node.name}')", node.loc, filename)
-        if isinstance(node, A.FullType) and "attribute" in node.qualifiers:
-            raise _unsupported("vertex shader (it declares an 'attribute')", node.loc, filename)
-        if isinstance(node, A.Layout):
-            for name, _ in node.items:
-                if name in _OTHER_STAGE_LAYOUTS:
-                    raise _unsupported(f"{_OTHER_STAGE_LAYOUTS[name]} shader "
-                                       f"(layout '{name}')", node.loc, filename)
-        if isinstance(node, A.VariableDecl):
-            for d in node.declarators:
-                if d.name in NON_FRAGMENT_VARIABLES:
-                    raise _unsupported(f"non-fragment shader (it declares '{d.name}')",
-                                       d.loc or node.loc, filename)
-        if isinstance(node, A.InterfaceBlock) and node.block_name == "gl_PerVertex":
-            raise _unsupported("non-fragment shader (it declares 'gl_PerVertex')", node.loc,
-                               filename)
-    return frag_data
+    v = _OtherStages(filename)
+    v.visit(unit)
+    return v.frag_data
 
 
 def _reject_multiple_outputs(frag_data: list[A.Index], info: SemanticInfo) -> None:

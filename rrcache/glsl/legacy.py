@@ -22,12 +22,12 @@ fragment shader (the version of every variant rrcache emits):
 from __future__ import annotations
 
 import copy
-from dataclasses import fields
-from typing import Callable, Optional
+from typing import Optional
 
 from rrcache.errors import UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.lexer import KEYWORDS, PRECISION_QUALIFIERS, RESERVED_WORDS, is_keyword
+from rrcache.glsl.visitor import NodeTransformer, NodeVisitor
 
 #: The colour output that replaces gl_FragColor / gl_FragData[0].
 FRAG_COLOR = "rr_FragColor"
@@ -69,50 +69,6 @@ _ES_ONLY_EXTENSIONS = frozenset({
     "GL_OES_standard_derivatives", "GL_EXT_shader_texture_lod", "GL_EXT_frag_depth",
     "GL_EXT_draw_buffers", "GL_OES_texture_3D",
 })
-
-
-def _skip(node, name: str) -> bool:
-    """Fields that are not part of the tree: places and semantic annotations."""
-    if name == "loc":
-        return True
-    if isinstance(node, A.Expr) and name == "type":
-        return True
-    return (isinstance(node, A.Call) and name in ("target", "kind")) or (
-        isinstance(node, A.Ident) and name == "symbol")
-
-
-def _rewrite(node, fn: Callable):
-    """Rewrite a tree bottom-up in place: every child is replaced by ``fn(child)``."""
-    for f in fields(node):
-        if _skip(node, f.name):
-            continue
-        value = getattr(node, f.name)
-        if isinstance(value, A.Node):
-            setattr(node, f.name, fn(_rewrite(value, fn)))
-        elif isinstance(value, list):
-            new = []
-            for item in value:
-                if isinstance(item, A.Node):
-                    item = fn(_rewrite(item, fn))
-                    if item is None:
-                        continue
-                elif isinstance(item, tuple):
-                    item = tuple(fn(_rewrite(x, fn)) if isinstance(x, A.Node) else x
-                                 for x in item)
-                new.append(item)
-            setattr(node, f.name, new)
-    return node
-
-
-def _all_nodes(unit: A.TranslationUnit):
-    out = []
-
-    def visit(n):
-        out.append(n)
-        return n
-
-    _rewrite(unit, visit)
-    return out
 
 
 def _target_version(unit: A.TranslationUnit) -> tuple[int, Optional[str]]:
@@ -157,122 +113,10 @@ def to_core(unit: A.TranslationUnit) -> A.TranslationUnit:
     u = copy.deepcopy(unit)
     version, profile = _target_version(unit)
     was_es = unit.profile == "es" or unit.version in (100, 300, 310, 320)
-    clash = _clash_names(unit, version, profile)
-    nodes = _all_nodes(u)
-
-    user_functions = {n.name for n in nodes if isinstance(n, A.FunctionDecl)}
-    declared: set[str] = set(user_functions)
-    members: set[str] = set()
-    for n in nodes:
-        if isinstance(n, A.StructMember):
-            members.update(d.name for d in n.declarators)
-        elif isinstance(n, A.Declarator):
-            declared.add(n.name)
-        elif isinstance(n, A.Param) and n.name:
-            declared.add(n.name)
-        elif isinstance(n, A.StructSpecifier) and n.name:
-            declared.add(n.name)
-    declared -= members
-    renames = {name: f"rr_{name}" for name in declared if name in clash}
-    member_renames = {name: f"rr_{name}" for name in members if name in clash
-                      and is_keyword(name, version, profile)}
-    struct_names = {n.name for n in nodes if isinstance(n, A.StructSpecifier) and n.name}
-    uses_frag_color = False
-
-    def qualifiers(quals: list) -> list:
-        out = []
-        for q in quals:
-            if isinstance(q, str):
-                if q in PRECISION_QUALIFIERS:
-                    continue
-                if q == "varying":
-                    q = "in"
-            out.append(q)
-        return out
-
-    def fix(n):
-        nonlocal uses_frag_color
-        if isinstance(n, (A.FullType, A.InterfaceBlock, A.QualifierDecl)):
-            if isinstance(n, A.FullType) and "attribute" in n.qualifiers:
-                raise _unsupported(
-                    "'attribute' declares a vertex shader input", n,
-                    "rrcache optimises fragment shaders; pass the fragment shader file")
-            had = bool(n.qualifiers)
-            n.qualifiers = qualifiers(n.qualifiers)
-            if isinstance(n, A.QualifierDecl):
-                n.names = [FRAG_COLOR if x in ("gl_FragColor",) else renames.get(x, x)
-                           for x in n.names]
-                if had and not n.qualifiers:
-                    return None
-            return n
-        if isinstance(n, A.PrecisionDecl):
-            return None
-        if isinstance(n, A.DeclStmt) and n.decl is None:
-            return None
-        if isinstance(n, A.Ident):
-            if n.name == "gl_FragColor":
-                uses_frag_color = True
-                return A.Ident(FRAG_COLOR, loc=n.loc)
-            if n.name == "gl_FragDepthEXT":
-                return A.Ident("gl_FragDepth", loc=n.loc)
-            if n.name == "gl_FragData":
-                raise _unsupported("gl_FragData used without a constant index", n,
-                                   "write gl_FragData[0] or gl_FragColor")
-            n.name = renames.get(n.name, n.name)
-            return n
-        if isinstance(n, A.Declarator) or isinstance(n, A.Param):
-            if n.name:
-                n.name = renames.get(n.name, n.name)
-            return n
-        if isinstance(n, A.FunctionDecl):
-            n.name = renames.get(n.name, n.name)
-            return n
-        if isinstance(n, A.StructSpecifier):
-            if n.name:
-                n.name = renames.get(n.name, n.name)
-            for m in n.members:
-                for d in m.declarators:
-                    d.name = member_renames.get(d.name, d.name)
-            return n
-        if isinstance(n, A.TypeSpecifier):
-            if n.name in struct_names:
-                n.name = renames.get(n.name, n.name)
-            return n
-        if isinstance(n, A.Field):
-            n.name = member_renames.get(n.name, n.name)
-            return n
-        if isinstance(n, A.Call):
-            if n.name in user_functions or n.name in struct_names:
-                n.name = renames.get(n.name, n.name)
-                return n
-            new = LEGACY_TEXTURE_FUNCTIONS.get(n.name)
-            if new is None:
-                return n
-            call = A.Call(new, n.args, n.array_dims, loc=n.loc)
-            if n.name.startswith("shadow"):
-                return A.Call("vec4", [call], loc=n.loc)
-            return call
-        return n
-
-    def frag_data(n):
-        """gl_FragData[i] must be rewritten before the generic pass sees the bare name."""
-        nonlocal uses_frag_color
-        if isinstance(n, A.Index) and isinstance(n.obj, A.Ident) and n.obj.name == "gl_FragData":
-            idx = n.index
-            if isinstance(idx, A.IntLit) and idx.value == 0:
-                uses_frag_color = True
-                return A.Ident(FRAG_COLOR, loc=n.loc)
-            if isinstance(idx, A.IntLit):
-                raise _unsupported(
-                    f"gl_FragData[{idx.value}] writes several colour outputs", n,
-                    "rrcache handles shaders with one colour output (gl_FragData[0])")
-            raise _unsupported("gl_FragData indexed by a non-constant expression", n,
-                               "write gl_FragData[0] or gl_FragColor")
-        return n
-
-    _rewrite(u, frag_data)
-    _rewrite(u, fix)
-    if uses_frag_color:
+    fix = _ToCore(u, version, profile, _clash_names(unit, version, profile))
+    _FragData(fix).visit(u)
+    fix.visit(u)
+    if fix.uses_frag_color:
         decl = A.VariableDecl(
             A.FullType(["out"], A.TypeSpecifier("vec4")), [A.Declarator(FRAG_COLOR)])
         u.decls.insert(0, decl)
@@ -284,3 +128,162 @@ def to_core(unit: A.TranslationUnit) -> A.TranslationUnit:
     u.extensions = [ext for ext, _ in kept]
     u.extension_locs = [loc for _, loc in kept]
     return u
+
+
+def _qualifiers(quals: list) -> list:
+    out = []
+    for q in quals:
+        if isinstance(q, str):
+            if q in PRECISION_QUALIFIERS:
+                continue
+            if q == "varying":
+                q = "in"
+        out.append(q)
+    return out
+
+
+class _FragData(NodeTransformer):
+    """``gl_FragData[0]`` becomes ``rr_FragColor``, before :class:`_ToCore` sees the bare name."""
+
+    def __init__(self, core: "_ToCore"):
+        self.core = core
+
+    def visit_Index(self, n: A.Index):
+        self.generic_visit(n)
+        if not (isinstance(n.obj, A.Ident) and n.obj.name == "gl_FragData"):
+            return n
+        idx = n.index
+        if isinstance(idx, A.IntLit) and idx.value == 0:
+            self.core.uses_frag_color = True
+            return A.Ident(FRAG_COLOR, loc=n.loc)
+        if isinstance(idx, A.IntLit):
+            raise _unsupported(
+                f"gl_FragData[{idx.value}] writes several colour outputs", n,
+                "rrcache handles shaders with one colour output (gl_FragData[0])")
+        raise _unsupported("gl_FragData indexed by a non-constant expression", n,
+                           "write gl_FragData[0] or gl_FragColor")
+
+
+class _ToCore(NodeTransformer):
+    """The rewrite of every node (bottom-up: children first) into core GLSL."""
+
+    def __init__(self, u: A.TranslationUnit, version: int, profile: Optional[str],
+                 clash: frozenset):
+        nodes = list(A.walk(u))
+        self.user_functions = {n.name for n in nodes if isinstance(n, A.FunctionDecl)}
+        declared: set[str] = set(self.user_functions)
+        members: set[str] = set()
+        _Declared(declared, members).visit(u)
+        declared -= members
+        self.renames = {name: f"rr_{name}" for name in declared if name in clash}
+        self.member_renames = {name: f"rr_{name}" for name in members if name in clash
+                               and is_keyword(name, version, profile)}
+        self.struct_names = {n.name for n in nodes if isinstance(n, A.StructSpecifier) and n.name}
+        self.uses_frag_color = False
+
+    def visit_FullType(self, n):
+        self.generic_visit(n)
+        if "attribute" in n.qualifiers:
+            raise _unsupported(
+                "'attribute' declares a vertex shader input", n,
+                "rrcache optimises fragment shaders; pass the fragment shader file")
+        n.qualifiers = _qualifiers(n.qualifiers)
+        return n
+
+    def visit_InterfaceBlock(self, n):
+        self.generic_visit(n)
+        n.qualifiers = _qualifiers(n.qualifiers)
+        return n
+
+    def visit_QualifierDecl(self, n):
+        self.generic_visit(n)
+        had = bool(n.qualifiers)
+        n.qualifiers = _qualifiers(n.qualifiers)
+        n.names = [FRAG_COLOR if x in ("gl_FragColor",) else self.renames.get(x, x)
+                   for x in n.names]
+        return None if had and not n.qualifiers else n
+
+    def visit_PrecisionDecl(self, n):
+        return None
+
+    def visit_DeclStmt(self, n):
+        self.generic_visit(n)
+        return None if n.decl is None else n
+
+    def visit_Ident(self, n):
+        if n.name == "gl_FragColor":
+            self.uses_frag_color = True
+            return A.Ident(FRAG_COLOR, loc=n.loc)
+        if n.name == "gl_FragDepthEXT":
+            return A.Ident("gl_FragDepth", loc=n.loc)
+        if n.name == "gl_FragData":
+            raise _unsupported("gl_FragData used without a constant index", n,
+                               "write gl_FragData[0] or gl_FragColor")
+        n.name = self.renames.get(n.name, n.name)
+        return n
+
+    def visit_Declarator(self, n):
+        self.generic_visit(n)
+        if n.name:
+            n.name = self.renames.get(n.name, n.name)
+        return n
+
+    visit_Param = visit_FunctionDecl = visit_Declarator
+
+    def visit_StructSpecifier(self, n):
+        self.generic_visit(n)
+        if n.name:
+            n.name = self.renames.get(n.name, n.name)
+        for m in n.members:
+            for d in m.declarators:
+                d.name = self.member_renames.get(d.name, d.name)
+        return n
+
+    def visit_TypeSpecifier(self, n):
+        self.generic_visit(n)
+        if n.name in self.struct_names:
+            n.name = self.renames.get(n.name, n.name)
+        return n
+
+    def visit_Field(self, n):
+        self.generic_visit(n)
+        n.name = self.member_renames.get(n.name, n.name)
+        return n
+
+    def visit_Call(self, n):
+        self.generic_visit(n)
+        if n.name in self.user_functions or n.name in self.struct_names:
+            n.name = self.renames.get(n.name, n.name)
+            return n
+        new = LEGACY_TEXTURE_FUNCTIONS.get(n.name)
+        if new is None:
+            return n
+        call = A.Call(new, n.args, n.array_dims, loc=n.loc)
+        if n.name.startswith("shadow"):
+            return A.Call("vec4", [call], loc=n.loc)
+        return call
+
+
+class _Declared(NodeVisitor):
+    """The names a unit declares (variables, parameters, struct types) and its struct members."""
+
+    def __init__(self, declared: set, members: set):
+        self.declared, self.members = declared, members
+
+    def visit_StructMember(self, n):
+        self.members.update(d.name for d in n.declarators)
+        self.generic_visit(n)
+
+    def visit_Declarator(self, n):
+        self.declared.add(n.name)
+        self.generic_visit(n)
+
+    def visit_Param(self, n):
+        if n.name:
+            self.declared.add(n.name)
+        self.generic_visit(n)
+
+    def visit_StructSpecifier(self, n):
+        if n.name:
+            self.declared.add(n.name)
+        self.generic_visit(n)

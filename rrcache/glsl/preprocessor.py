@@ -20,6 +20,7 @@ identifiers are 0. Every problem raises :class:`rrcache.errors.PreprocessorError
 from __future__ import annotations
 
 import gc
+import hashlib
 import os
 import re
 from bisect import bisect_right
@@ -27,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Iterator, Mapping, Sequence
 
 from rrcache.errors import PreprocessorError, SourceLoc, printable as _printable
+from rrcache.files import Refused, open_file, read_file
 from rrcache.glsl.extensions import predefined as predefined_extensions
 
 __all__ = ["PPToken", "Preprocessed", "preprocess", "preprocess_file"]
@@ -60,6 +62,9 @@ class Preprocessed:
     extension_locs: list[SourceLoc] = field(default_factory=list)  # where each #extension stands
     pragmas: list[tuple[str, SourceLoc]] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    #: the sha256 of the bytes read of each included file (by its path in ``files``): what the
+    #: shader's hash is made of, never a second read of the path
+    file_hashes: dict[str, str] = field(default_factory=dict)
     #: without ``#version``: the language the shader was read as, and why (None with one)
     assumed: str | None = None
 
@@ -799,39 +804,69 @@ class _Preprocessor:
         including = self.includes[-1][1]
         dirs = ([os.path.dirname(including)] if not including.startswith("<") else [])
         dirs += self.include_dirs
-        found = None
         for d in dirs:
             cand = os.path.normpath(os.path.join(d, path)) if d else os.path.normpath(path)
             tried.append(cand)
-            if os.path.isfile(cand):
-                found = cand
+            # by rrcache.files' rule: opened once, the opened file checked (kind, folder, size),
+            # read from that descriptor; a link flipped after a check cannot redirect the read
+            opened = self._open_include(path, cand, first.loc)
+            if opened is not None:
                 break
-        if found is None:
+        else:
             raise _err(f"cannot find include file '{_printable(path)}' (tried: "
                        f"{', '.join(map(_printable, tried)) or 'none'})",
                        first.loc, "add its directory to the include directories (-I DIR, or the "
                        "session's \"include_dirs\")")
-        real = self._confined(path, found, first.loc)
-        text = _read_text(found, first.loc, self)
-        self.run_file(text, found, real, first.loc)
+        with opened:
+            text = _decode(self._take(opened, path, first.loc), opened.path, self)
+        self.run_file(text, cand, opened.real, first.loc)
 
-    def _confined(self, path: str, found: str, loc: SourceLoc) -> str:
-        """The real path of the include file ``found``, which must be a shader file inside the
-        main file's folder tree or an include directory's; anything else is refused without
-        reading it (a shader from the web must not read, nor leak, the machine's other files)."""
-        real = os.path.realpath(found)
-        if not any(real == r or real.startswith(r.rstrip(os.sep) + os.sep) for r in self.roots):
-            where = " and ".join(_printable(r) for r in self.roots) or "no folder (no include directory given)"
-            raise _err(f"#include '{_printable(path)}' resolves to {_printable(real)}, outside the folders "
-                       f"includes are read from ({where})", loc,
-                       "includes come from the shader's own folder tree and the include directories; "
-                       "add a folder with -I DIR (or the session's \"include_dirs\") if you trust it")
-        ext = os.path.splitext(real)[1].lower()
+    def _open_include(self, path: str, cand: str, loc: SourceLoc):
+        """The include file ``cand`` opened by the rule, or None when there is none (or only a
+        folder) there: it must be a shader file inside the main file's folder tree or an include
+        directory's; anything else is refused without reading it (a shader from the web must not
+        read, nor leak, the machine's other files)."""
+        from rrcache.budgets import budget
+
+        try:
+            opened = open_file(cand, budget.source_bytes - self.source_bytes, self.roots)
+        except Refused as err:
+            if err.kind == "missing" or (err.kind == "type" and os.path.isdir(cand)):
+                return None
+            if err.kind == "outside":
+                where = " and ".join(_printable(r) for r in self.roots) or "no folder (no include directory given)"
+                raise _err(f"#include '{_printable(path)}' resolves to {_printable(err.real)}, outside the folders "
+                           f"includes are read from ({where})", loc,
+                           "includes come from the shader's own folder tree and the include directories; "
+                           "add a folder with -I DIR (or the session's \"include_dirs\") if you trust it") from None
+            if err.kind == "size":
+                size = f" ({err.size:,} bytes)" if err.size is not None else ""
+                raise _err(f"'{_printable(cand)}'{size} takes the shader's sources past {budget.source_bytes:,} bytes, "
+                           "the analysis budget; nothing of it was read", loc,
+                           "raise it with 'rrcache --max-source-bytes N ...'") from None
+            raise _err(f"cannot read #include '{_printable(path)}' ({_printable(cand)}): {_printable(err.reason)}",
+                       loc, err.hint) from None
+        ext = os.path.splitext(opened.real)[1].lower()
         if ext not in SHADER_EXTENSIONS:
+            opened.close()
             raise _err(f"#include '{_printable(path)}' is not a shader file (its name ends in "
                        f"'{_printable(ext) or 'no extension'}')", loc,
                        f"includes must be shader sources: {' '.join(sorted(SHADER_EXTENSIONS))}")
-        return real
+        return opened
+
+    def _take(self, opened, path: str, loc: SourceLoc) -> bytes:
+        """The bytes of an opened include, within what is left of the source budget; their
+        sha256 is recorded for the shader's hash (:attr:`Preprocessed.file_hashes`)."""
+        from rrcache.budgets import budget
+
+        try:
+            data = opened.read(budget.source_bytes - self.source_bytes)
+        except Refused:
+            raise _err(f"'{_printable(opened.path)}' takes the shader's sources past {budget.source_bytes:,} bytes, "
+                       "the analysis budget", loc, "raise it with 'rrcache --max-source-bytes N ...'") from None
+        self.source_bytes += len(data)
+        self.result.file_hashes[os.path.normpath(opened.path)] = hashlib.sha256(data).hexdigest()
+        return data
 
     # -- macro expansion -----------------------------------------------------------------------
     def _expand(self, toks: list[_Tok], depth: int = 0) -> list[_Tok]:
@@ -979,20 +1014,28 @@ SHADER_EXTENSIONS = frozenset({".glsl", ".frag", ".vert", ".fs", ".vs", ".fsh", 
                                ".h", ".inc", ".glslinc", ".hlsl", ".comp", ".geom", ".tesc", ".tese",
                                ".shader", ".fx", ".cginc"})
 
-def _read_text(path: str, loc: SourceLoc | None, pp: "_Preprocessor | None" = None) -> str:
+def read_source(path: str, what: str = "shader file") -> tuple[str, str]:
+    """The text of the shader file ``path`` and the sha256 of its bytes, read by
+    :mod:`rrcache.files`' rule within the source budget (``rrcache --max-source-bytes``): a FIFO
+    or a device is refused as what it is, a file larger than the budget before a byte is read.
+    Problems raise :class:`PreprocessorError` naming the file (and the line and column of a NUL
+    byte or invalid UTF-8)."""
     from rrcache.budgets import budget
 
-    limit = budget.source_bytes - (pp.source_bytes if pp is not None else 0)
     try:
-        with open(path, "rb") as f:
-            data = f.read(limit + 1)
-    except OSError as e:
-        raise _err(f"cannot read '{_printable(path)}': {e.strerror or e}", loc) from None
-    if len(data) > limit:
-        raise _err(f"'{_printable(path)}' takes the shader's sources past {budget.source_bytes:,} bytes, the "
-                   "analysis budget", loc, "raise it with 'rrcache --max-source-bytes N ...'")
-    if pp is not None:
-        pp.source_bytes += len(data)
+        got = read_file(path, budget.source_bytes)
+    except Refused as err:
+        if err.kind == "size":
+            size = f"{err.size:,} bytes, " if err.size is not None else ""
+            raise _err(f"the {what} is {size}larger than {budget.source_bytes:,} bytes, the analysis budget",
+                       SourceLoc(path, 1, 1), "raise it with 'rrcache --max-source-bytes N ...'") from None
+        raise _err(f"cannot read {what} '{_printable(path)}': " + (
+            "not found" if err.kind == "missing" and "NUL" not in err.reason else f"it {_printable(err.reason)}"), None,
+                   "check the path" if err.kind == "missing" else err.hint) from None
+    return _decode(got.data, path, None), got.sha256
+
+
+def _decode(data: bytes, path: str, pp: "_Preprocessor | None") -> str:
     nul = data.find(b"\0")
     if nul >= 0:
         line = data.count(b"\n", 0, nul) + 1
@@ -1078,4 +1121,5 @@ def preprocess_file(path: str | os.PathLike, defines: Mapping[str, object] | Non
     ('shaders/glslviewer_basic.glsl', True)
     """
     path = os.fspath(path)
-    return preprocess(_read_text(path, None), path, defines, include_dirs)
+    text, _ = read_source(path)
+    return preprocess(text, path, defines, include_dirs)

@@ -16,6 +16,7 @@ from typing import Optional
 from rrcache.errors import SourceLoc
 from rrcache.glsl import ast as A
 from rrcache.glsl.parser import BINARY_PRECEDENCE
+from rrcache.glsl.visitor import NodeVisitor
 
 INDENT = "    "
 
@@ -53,27 +54,45 @@ def _literal_ok(text: Optional[str], value, is_float: bool) -> bool:
         return False
 
 
+class _Precedence(NodeVisitor):
+    """The precedence level of an expression node."""
+
+    def visit_Sequence(self, e) -> int:
+        return P_SEQUENCE
+
+    def visit_Assign(self, e) -> int:
+        return P_ASSIGN
+
+    def visit_Ternary(self, e) -> int:
+        return P_TERNARY
+
+    def visit_Binary(self, e: A.Binary) -> int:
+        return BINARY_PRECEDENCE[e.op]
+
+    def visit_Unary(self, e: A.Unary) -> int:
+        return P_POSTFIX if e.postfix else P_UNARY
+
+    def visit_Index(self, e) -> int:
+        return P_POSTFIX
+
+    visit_Field = visit_Length = visit_Call = visit_Index
+
+    def visit_IntLit(self, e) -> int:
+        return P_UNARY if e.value < 0 else P_PRIMARY
+
+    visit_FloatLit = visit_IntLit
+
+    def generic_visit(self, e) -> int:
+        return P_PRIMARY
+
+
 def expr_precedence(e: A.Expr) -> int:
     """The precedence level of an expression node (see the ``P_*`` constants).
 
     >>> expr_precedence(A.Binary("+", A.Ident("a"), A.Ident("b"))) < expr_precedence(A.Ident("a"))
     True
     """
-    if isinstance(e, A.Sequence):
-        return P_SEQUENCE
-    if isinstance(e, A.Assign):
-        return P_ASSIGN
-    if isinstance(e, A.Ternary):
-        return P_TERNARY
-    if isinstance(e, A.Binary):
-        return BINARY_PRECEDENCE[e.op]
-    if isinstance(e, A.Unary):
-        return P_POSTFIX if e.postfix else P_UNARY
-    if isinstance(e, (A.Index, A.Field, A.Length, A.Call)):
-        return P_POSTFIX
-    if isinstance(e, (A.IntLit, A.FloatLit)) and e.value < 0:
-        return P_UNARY
-    return P_PRIMARY
+    return _PRECEDENCE.visit(e)
 
 
 def print_expr(e: A.Expr, need: int = P_SEQUENCE) -> str:
@@ -83,7 +102,7 @@ def print_expr(e: A.Expr, need: int = P_SEQUENCE) -> str:
     '(a + b) * c'
     """
     text = _expr(e)
-    return f"({text})" if expr_precedence(e) < need else text
+    return f"({text})" if _PRECEDENCE.visit(e) < need else text
 
 
 def _dims(dims, pe=None) -> str:
@@ -93,88 +112,126 @@ def _dims(dims, pe=None) -> str:
     return "".join("[]" if d is None else f"[{pe(d)}]" for d in dims)
 
 
-def _expr(e: A.Expr, pe=None) -> str:
-    """The text of ``e`` unparenthesised; its operands are printed by ``pe`` (default
-    :func:`print_expr`; :func:`memo_printer` passes its own, and then a ``Binary`` operand is
-    printed by ``pe`` instead of down the left spine, which gives the same text)."""
-    spine = pe is None
-    pe = pe or print_expr
-    if isinstance(e, A.Ident):
+class _ExprText(NodeVisitor):
+    """The text of an expression unparenthesised; ``pe`` prints its operands, ``spine`` says
+    whether a ``Binary`` left operand may be printed down the spine (see :func:`_expr`)."""
+
+    def visit_Ident(self, e: A.Ident, pe, spine) -> str:
         return e.name
-    if isinstance(e, A.IntLit):
+
+    def visit_IntLit(self, e: A.IntLit, pe, spine) -> str:
         if _literal_ok(e.text, e.value, False) and ("u" in e.text[-2:].lower()) == e.unsigned:
             return e.text
         return f"{e.value}{'u' if e.unsigned else ''}"
-    if isinstance(e, A.FloatLit):
+
+    def visit_FloatLit(self, e: A.FloatLit, pe, spine) -> str:
         if _literal_ok(e.text, e.value, True) and e.text.lower().endswith("lf") == e.double:
             return e.text
         return _float_text(e.value, e.double)
-    if isinstance(e, A.BoolLit):
+
+    def visit_BoolLit(self, e: A.BoolLit, pe, spine) -> str:
         return "true" if e.value else "false"
-    if isinstance(e, A.Binary):
+
+    def visit_Binary(self, e: A.Binary, pe, spine) -> str:
         # down the left spine without recursion: `a + 1.0 + 1.0 + ...` (100,000 terms) prints
         tails = []
+        binary = A.Binary
         while True:
             p = BINARY_PRECEDENCE[e.op]
             tails.append(f" {e.op} {pe(e.right, p + 1)}")
             left = e.left
-            if spine and isinstance(left, A.Binary) and BINARY_PRECEDENCE[left.op] >= p:
+            if spine and left.__class__ is binary and BINARY_PRECEDENCE[left.op] >= p:
                 e = left
                 continue
             tails.append(pe(left, p))
             break
         tails.reverse()
         return "".join(tails)
-    if isinstance(e, A.Unary):
+
+    def visit_Unary(self, e: A.Unary, pe, spine) -> str:
         if e.postfix:
             return pe(e.operand, P_POSTFIX) + e.op
         inner = pe(e.operand, P_UNARY)
         if e.op in ("+", "-", "++", "--") and inner[:1] in ("+", "-"):
             inner = f"({inner})"
         return e.op + inner
-    if isinstance(e, A.Assign):
+
+    def visit_Assign(self, e: A.Assign, pe, spine) -> str:
         return f"{pe(e.target, P_TERNARY + 1)} {e.op} {pe(e.value, P_ASSIGN)}"
-    if isinstance(e, A.Ternary):
+
+    def visit_Ternary(self, e: A.Ternary, pe, spine) -> str:
         return (f"{pe(e.cond, P_TERNARY + 1)} ? {pe(e.then, P_SEQUENCE)} : "
                 f"{pe(e.else_, P_ASSIGN)}")
-    if isinstance(e, A.Sequence):
+
+    def visit_Sequence(self, e: A.Sequence, pe, spine) -> str:
         return ", ".join(pe(x, P_ASSIGN) for x in e.exprs)
-    if isinstance(e, A.Call):
+
+    def visit_Call(self, e: A.Call, pe, spine) -> str:
         args = ", ".join(pe(a, P_ASSIGN) for a in e.args)
         return f"{e.name}{_dims(e.array_dims, pe)}({args})"
-    if isinstance(e, (A.Field, A.Length, A.Index)):
+
+    def _obj(self, e, pe) -> str:
         obj = pe(e.obj, P_POSTFIX)
         if isinstance(e.obj, (A.IntLit, A.FloatLit)) and not obj.startswith("("):
             obj = f"({obj})"
-        if isinstance(e, A.Field):
-            return f"{obj}.{e.name}"
-        if isinstance(e, A.Length):
-            return f"{obj}.length()"
-        return f"{obj}[{pe(e.index)}]"
-    if isinstance(e, A.InitList):
+        return obj
+
+    def visit_Field(self, e: A.Field, pe, spine) -> str:
+        return f"{self._obj(e, pe)}.{e.name}"
+
+    def visit_Length(self, e: A.Length, pe, spine) -> str:
+        return f"{self._obj(e, pe)}.length()"
+
+    def visit_Index(self, e: A.Index, pe, spine) -> str:
+        return f"{self._obj(e, pe)}[{pe(e.index)}]"
+
+    def visit_InitList(self, e: A.InitList, pe, spine) -> str:
         return "{" + ", ".join(pe(x, P_ASSIGN) for x in e.items) + "}"
-    raise TypeError(f"cannot print {type(e).__name__} as an expression")
+
+    def generic_visit(self, e, pe, spine) -> str:
+        raise TypeError(f"cannot print {type(e).__name__} as an expression")
 
 
-def memo_printer():
+_PRECEDENCE = _Precedence()
+_EXPR_TEXT = _ExprText()
+
+
+def _expr(e: A.Expr, pe=None) -> str:
+    """The text of ``e`` unparenthesised; its operands are printed by ``pe`` (default
+    :func:`print_expr`; :func:`memo_printer` passes its own, and then a ``Binary`` operand is
+    printed by ``pe`` instead of down the left spine, which gives the same text)."""
+    return _EXPR_TEXT.visit(e, pe or print_expr, pe is None)
+
+
+def memo_printer(ident_text=None):
     """A :func:`print_expr` that remembers the text of every expression it prints (by ``id``),
     so that printing every node of a tree, each with its operands, costs each node's own text
     once. Only for a tree that stays alive and unchanged while the printer is used; recursive,
     so for expressions of bounded depth (the node table's texts of at most a few hundred nodes).
+    ``ident_text(ident, need)``, when given, may print an identifier otherwise (a text, or None
+    to print its name).
 
     >>> pe = memo_printer()
     >>> e = A.Binary("*", A.Binary("+", A.Ident("a"), A.Ident("b")), A.Ident("c"))
     >>> pe(e), pe(e.left), pe(e.left, P_POSTFIX)
     ('(a + b) * c', 'a + b', '(a + b)')
+    >>> memo_printer(lambda i, need: "x" if i.name == "b" else None)(e)
+    '(a + x) * c'
     """
     cache: dict[int, str] = {}
     get = cache.get
+    precedence = _PRECEDENCE.visit
+    ident = A.Ident
 
     def pe(e: A.Expr, need: int = P_SEQUENCE) -> str:
+        if ident_text is not None and e.__class__ is ident:
+            text = ident_text(e, need)
+            if text is not None:
+                return text
         text = get(id(e))
         if text is None:
             text = cache[id(e)] = _expr(e, pe)
-        return f"({text})" if expr_precedence(e) < need else text
+        return f"({text})" if precedence(e) < need else text
 
     return pe
 
@@ -205,10 +262,32 @@ def _declarators(decls: list[A.Declarator]) -> str:
     return ", ".join(out)
 
 
-class _Printer:
+class _InlineDecl(NodeVisitor):
+    """A declaration on one line, without the final ';' (for-loop initialisers)."""
+
+    def __init__(self, printer: "_Printer"):
+        self.p = printer
+
+    def visit_VariableDecl(self, d: A.VariableDecl) -> str:
+        return _join(self.p.type_inline(d.type), _declarators(d.declarators))
+
+    def visit_PrecisionDecl(self, d: A.PrecisionDecl) -> str:
+        return f"precision {d.precision} {self.p.spec_inline(d.spec)}"
+
+    def visit_QualifierDecl(self, d: A.QualifierDecl) -> str:
+        return _join(_qualifiers(d.qualifiers), ", ".join(d.names))
+
+    def generic_visit(self, d) -> str:
+        raise TypeError(f"cannot print {type(d).__name__} on one line")
+
+
+class _Printer(NodeVisitor):
+    """Visiting a declaration or a statement emits its lines."""
+
     def __init__(self) -> None:
         self.lines: list[tuple[str, Optional[SourceLoc]]] = []
         self.level = 0
+        self.decl_inline = _InlineDecl(self).visit
 
     def emit(self, text: str, loc: Optional[SourceLoc]) -> None:
         self.lines.append((INDENT * self.level + text if text else "", loc))
@@ -242,40 +321,37 @@ class _Printer:
         self.emit(_join("}" + _dims(spec_dims), tail) + ";", None)
 
     # ------------------------------------------------------------------ declarations
-    def decl_inline(self, d) -> str:
-        """A declaration on one line, without the final ';' (for-loop initialisers)."""
-        if isinstance(d, A.VariableDecl):
-            return _join(self.type_inline(d.type), _declarators(d.declarators))
-        if isinstance(d, A.PrecisionDecl):
-            return f"precision {d.precision} {self.spec_inline(d.spec)}"
-        if isinstance(d, A.QualifierDecl):
-            return _join(_qualifiers(d.qualifiers), ", ".join(d.names))
-        raise TypeError(f"cannot print {type(d).__name__} on one line")
+    def visit_FunctionDecl(self, d: A.FunctionDecl) -> None:
+        params = ", ".join(
+            _join(self.type_inline(p.type), (p.name or "") + _dims(p.array_dims))
+            for p in d.params)
+        head = f"{self.type_inline(d.return_type)} {d.name}({params})"
+        if d.body is None:
+            self.emit(head + ";", d.loc)
+        else:
+            self.emit(head, d.loc)
+            self.visit_Compound(d.body)
 
-    def declaration(self, d) -> None:
-        if isinstance(d, A.FunctionDecl):
-            params = ", ".join(
-                _join(self.type_inline(p.type), (p.name or "") + _dims(p.array_dims))
-                for p in d.params)
-            head = f"{self.type_inline(d.return_type)} {d.name}({params})"
-            if d.body is None:
-                self.emit(head + ";", d.loc)
-            else:
-                self.emit(head, d.loc)
-                self.compound(d.body)
-        elif isinstance(d, A.InterfaceBlock):
-            self.emit(_join(_qualifiers(d.qualifiers), d.block_name, "{"), d.loc)
-            self.members(d.members)
-            tail = (d.instance_name or "") + _dims(d.array_dims)
-            self.emit(_join("}", tail) + ";", None)
-        elif isinstance(d, A.VariableDecl) and d.type.spec.struct is not None:
+    def visit_InterfaceBlock(self, d: A.InterfaceBlock) -> None:
+        self.emit(_join(_qualifiers(d.qualifiers), d.block_name, "{"), d.loc)
+        self.members(d.members)
+        tail = (d.instance_name or "") + _dims(d.array_dims)
+        self.emit(_join("}", tail) + ";", None)
+
+    def visit_VariableDecl(self, d: A.VariableDecl) -> None:
+        if d.type.spec.struct is not None:
             self.block_decl(_qualifiers(d.type.qualifiers), d.type.spec.struct,
                             d.type.spec.array_dims, _declarators(d.declarators), d.loc)
         else:
             self.emit(self.decl_inline(d) + ";", d.loc)
 
+    def visit_PrecisionDecl(self, d) -> None:
+        self.emit(self.decl_inline(d) + ";", d.loc)
+
+    visit_QualifierDecl = visit_PrecisionDecl
+
     # ------------------------------------------------------------------ statements
-    def compound(self, c: A.Compound, switch: bool = False) -> None:
+    def visit_Compound(self, c: A.Compound, switch: bool = False) -> None:
         self.emit("{", c.loc)
         self.level += 1
         in_case = False
@@ -283,11 +359,11 @@ class _Printer:
             if switch and isinstance(s, A.Case):
                 if in_case:
                     self.level -= 1
-                self.statement(s)
+                self.visit(s)
                 self.level += 1
                 in_case = True
             else:
-                self.statement(s)
+                self.visit(s)
         if in_case:
             self.level -= 1
         self.level -= 1
@@ -295,61 +371,69 @@ class _Printer:
 
     def sub(self, s: A.Stmt) -> None:
         if isinstance(s, A.Compound):
-            self.compound(s)
+            self.visit_Compound(s)
         else:
             self.level += 1
-            self.statement(s)
+            self.visit(s)
             self.level -= 1
 
-    def statement(self, s: A.Stmt) -> None:
-        loc = s.loc
-        if isinstance(s, A.Compound):
-            self.compound(s)
-        elif isinstance(s, A.DeclStmt):
-            self.declaration(s.decl)
-        elif isinstance(s, A.ExprStmt):
-            self.emit(";" if s.expr is None else print_expr(s.expr) + ";", loc)
-        elif isinstance(s, A.If):
-            self.emit(f"if ({print_expr(s.cond)})", loc)
-            then = s.then
-            if s.else_ is not None and _dangles(then):
-                then = A.Compound([then], loc=then.loc)
-            self.sub(then)
-            if s.else_ is not None:
-                self.emit("else", None)
-                self.sub(s.else_)
-        elif isinstance(s, A.For):
-            if s.init is None:
-                init = ""
-            elif isinstance(s.init, A.DeclStmt):
-                init = self.decl_inline(s.init.decl)
-            else:
-                init = "" if s.init.expr is None else print_expr(s.init.expr)
-            step = "" if s.step is None else " " + print_expr(s.step)
-            self.emit(f"for ({init}; {self.condition(s.cond)};{step})".replace("; ;", ";;"), loc)
-            self.sub(s.body)
-        elif isinstance(s, A.While):
-            self.emit(f"while ({self.condition(s.cond)})", loc)
-            self.sub(s.body)
-        elif isinstance(s, A.DoWhile):
-            self.emit("do", loc)
-            self.sub(s.body)
-            self.emit(f"while ({print_expr(s.cond)});", None)
-        elif isinstance(s, A.Switch):
-            self.emit(f"switch ({print_expr(s.expr)})", loc)
-            self.compound(s.body, switch=True)
-        elif isinstance(s, A.Case):
-            self.emit("default:" if s.expr is None else f"case {print_expr(s.expr, P_TERNARY)}:", loc)
-        elif isinstance(s, A.Return):
-            self.emit("return;" if s.expr is None else f"return {print_expr(s.expr)};", loc)
-        elif isinstance(s, A.Break):
-            self.emit("break;", loc)
-        elif isinstance(s, A.Continue):
-            self.emit("continue;", loc)
-        elif isinstance(s, A.Discard):
-            self.emit("discard;", loc)
+    def visit_DeclStmt(self, s: A.DeclStmt) -> None:
+        self.visit(s.decl)
+
+    def visit_ExprStmt(self, s: A.ExprStmt) -> None:
+        self.emit(";" if s.expr is None else print_expr(s.expr) + ";", s.loc)
+
+    def visit_If(self, s: A.If) -> None:
+        self.emit(f"if ({print_expr(s.cond)})", s.loc)
+        then = s.then
+        if s.else_ is not None and _DANGLES.visit(then):
+            then = A.Compound([then], loc=then.loc)
+        self.sub(then)
+        if s.else_ is not None:
+            self.emit("else", None)
+            self.sub(s.else_)
+
+    def visit_For(self, s: A.For) -> None:
+        if s.init is None:
+            init = ""
+        elif isinstance(s.init, A.DeclStmt):
+            init = self.decl_inline(s.init.decl)
         else:
-            raise TypeError(f"cannot print {type(s).__name__} as a statement")
+            init = "" if s.init.expr is None else print_expr(s.init.expr)
+        step = "" if s.step is None else " " + print_expr(s.step)
+        self.emit(f"for ({init}; {self.condition(s.cond)};{step})".replace("; ;", ";;"), s.loc)
+        self.sub(s.body)
+
+    def visit_While(self, s: A.While) -> None:
+        self.emit(f"while ({self.condition(s.cond)})", s.loc)
+        self.sub(s.body)
+
+    def visit_DoWhile(self, s: A.DoWhile) -> None:
+        self.emit("do", s.loc)
+        self.sub(s.body)
+        self.emit(f"while ({print_expr(s.cond)});", None)
+
+    def visit_Switch(self, s: A.Switch) -> None:
+        self.emit(f"switch ({print_expr(s.expr)})", s.loc)
+        self.visit_Compound(s.body, switch=True)
+
+    def visit_Case(self, s: A.Case) -> None:
+        self.emit("default:" if s.expr is None else f"case {print_expr(s.expr, P_TERNARY)}:", s.loc)
+
+    def visit_Return(self, s: A.Return) -> None:
+        self.emit("return;" if s.expr is None else f"return {print_expr(s.expr)};", s.loc)
+
+    def visit_Break(self, s: A.Break) -> None:
+        self.emit("break;", s.loc)
+
+    def visit_Continue(self, s: A.Continue) -> None:
+        self.emit("continue;", s.loc)
+
+    def visit_Discard(self, s: A.Discard) -> None:
+        self.emit("discard;", s.loc)
+
+    def generic_visit(self, s) -> None:
+        raise TypeError(f"cannot print {type(s).__name__} as a statement")
 
     def condition(self, c) -> str:
         if c is None:
@@ -359,17 +443,22 @@ class _Printer:
         return print_expr(c)
 
 
-def _dangles(s: A.Stmt) -> bool:
-    """Whether an ``else`` printed after ``s`` would attach to an ``if`` inside ``s``."""
-    while True:
-        if isinstance(s, A.If):
-            if s.else_ is None:
-                return True
-            s = s.else_
-        elif isinstance(s, (A.For, A.While)):
-            s = s.body
-        else:
-            return False
+class _Dangles(NodeVisitor):
+    """Whether an ``else`` printed after a statement would attach to an ``if`` inside it."""
+
+    def visit_If(self, s: A.If) -> bool:
+        return s.else_ is None or self.visit(s.else_)
+
+    def visit_For(self, s) -> bool:
+        return self.visit(s.body)
+
+    visit_While = visit_For
+
+    def generic_visit(self, s) -> bool:
+        return False
+
+
+_DANGLES = _Dangles()
 
 
 def _header(unit: A.TranslationUnit) -> list[tuple[str, Optional[SourceLoc]]]:
@@ -408,7 +497,7 @@ def print_with_map(unit: A.TranslationUnit) -> tuple[str, list[Optional[SourceLo
             isinstance(d, A.VariableDecl) and d.type.spec.struct is not None)
         if p.lines and (spacious or prev) and p.lines[-1][0]:
             p.emit("", None)
-        p.declaration(d)
+        p.visit(d)
         prev = spacious
     text = "\n".join(line for line, _ in p.lines) + "\n"
     return text, [loc for _, loc in p.lines]

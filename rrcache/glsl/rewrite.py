@@ -37,6 +37,7 @@ from typing import Callable, Optional, Union
 from rrcache.errors import SourceLoc, UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.types import Type
+from rrcache.glsl.visitor import NodeTransformer, NodeVisitor
 
 _CLONE_FIELDS: dict[type, tuple[str, ...]] = {}
 
@@ -137,22 +138,25 @@ def paused_gc():
 # ----------------------------------------------------------------------------- names
 
 
+class _ReservedNames(NodeVisitor):
+    """Refuses a declared name (variable, parameter, function) starting with ``_rr``."""
+
+    decl_types = False
+
+    def visit_Declarator(self, n) -> None:
+        if n.name and n.name.startswith(RESERVED_PREFIX):
+            raise UnsupportedShaderError(
+                f"the name '{n.name}' starts with '{RESERVED_PREFIX}', which rrcache reserves "
+                "for the variables it generates", n.loc, "rename it")
+        self.generic_visit(n)
+
+    visit_Param = visit_FunctionDecl = visit_Declarator
+
+
 def check_reserved_names(unit: A.TranslationUnit) -> None:
     """Raise :class:`UnsupportedShaderError` when the shader declares a name starting with
     ``_rr`` (reserved for the variables the passes generate)."""
-    for n in A.walk(unit, decl_types=False):
-        names: list[tuple[str, Optional[SourceLoc]]] = []
-        if isinstance(n, A.Declarator):
-            names.append((n.name, n.loc))
-        elif isinstance(n, A.Param) and n.name:
-            names.append((n.name, n.loc))
-        elif isinstance(n, A.FunctionDecl):
-            names.append((n.name, n.loc))
-        for name, loc in names:
-            if name.startswith(RESERVED_PREFIX):
-                raise UnsupportedShaderError(
-                    f"the name '{name}' starts with '{RESERVED_PREFIX}', which rrcache reserves "
-                    "for the variables it generates", loc, "rename it")
+    _ReservedNames().visit(unit)
 
 
 class NameAllocator:
@@ -236,7 +240,11 @@ def rewrite_scoped(stmt: A.Stmt, initial: dict[str, Replacement],
     return stmt
 
 
-class _ScopedRewriter:
+class _ScopedRewriter(NodeTransformer):
+    """Visiting a statement rewrites it in place; visiting an expression returns its rewrite."""
+
+    decl_types = False
+
     def __init__(self, initial, rename_decl):
         self.scopes: list[dict[str, Replacement]] = [dict(initial)]
         self.rename_decl = rename_decl
@@ -248,22 +256,15 @@ class _ScopedRewriter:
         return None
 
     def expr(self, e):
-        if e is None:
-            return None
-        if isinstance(e, A.Ident):
-            rep = self.lookup(e.name)
-            if isinstance(rep, str):
-                e.name = rep
-                return e
-            if rep is not None:
-                return rep(e)
+        return None if e is None else self.visit(e)
+
+    def visit_Ident(self, e: A.Ident):
+        rep = self.lookup(e.name)
+        if isinstance(rep, str):
+            e.name = rep
             return e
-        for name in A.child_fields(e.__class__, decl_types=False):
-            value = getattr(e, name)
-            if isinstance(value, A.Expr):
-                setattr(e, name, self.expr(value))
-            elif isinstance(value, list):
-                setattr(e, name, [self.expr(x) if isinstance(x, A.Expr) else x for x in value])
+        if rep is not None:
+            return rep(e)
         return e
 
     def declare(self, d: A.Declarator) -> None:
@@ -280,55 +281,73 @@ class _ScopedRewriter:
             for d in decl.declarators:
                 self.declare(d)
 
+    def condition(self, s) -> None:
+        """A loop's condition: a declaration (``while (bool b = ...)``) or an expression."""
+        if isinstance(s.cond, A.VariableDecl):
+            self.var_decl(s.cond)
+        else:
+            s.cond = self.expr(s.cond)
+
     def stmt(self, s) -> None:
-        if s is None:
-            return
-        if isinstance(s, A.Compound):
-            self.scopes.append({})
-            for x in s.stmts:
-                self.stmt(x)
-            self.scopes.pop()
-        elif isinstance(s, A.DeclStmt):
-            self.var_decl(s.decl)
-        elif isinstance(s, A.ExprStmt):
-            s.expr = self.expr(s.expr)
-        elif isinstance(s, A.If):
-            s.cond = self.expr(s.cond)
-            self.sub(s.then)
-            self.sub(s.else_)
-        elif isinstance(s, A.For):
-            self.scopes.append({})
-            self.stmt(s.init)
-            if isinstance(s.cond, A.VariableDecl):
-                self.var_decl(s.cond)
-            else:
-                s.cond = self.expr(s.cond)
-            s.step = self.expr(s.step)
-            self.sub(s.body)
-            self.scopes.pop()
-        elif isinstance(s, A.While):
-            self.scopes.append({})
-            if isinstance(s.cond, A.VariableDecl):
-                self.var_decl(s.cond)
-            else:
-                s.cond = self.expr(s.cond)
-            self.sub(s.body)
-            self.scopes.pop()
-        elif isinstance(s, A.DoWhile):
-            self.sub(s.body)
-            s.cond = self.expr(s.cond)
-        elif isinstance(s, A.Switch):
-            s.expr = self.expr(s.expr)
-            self.stmt(s.body)
-        elif isinstance(s, A.Return):
-            s.expr = self.expr(s.expr)
-        elif isinstance(s, A.Case):
-            s.expr = self.expr(s.expr)
+        if s is not None:
+            self.visit(s)
+
+    def visit_Stmt(self, s):
+        return s     # break, continue, discard
+
+    def visit_Compound(self, s: A.Compound):
+        self.scopes.append({})
+        for x in s.stmts:
+            self.visit(x)
+        self.scopes.pop()
+        return s
+
+    def visit_DeclStmt(self, s: A.DeclStmt):
+        self.var_decl(s.decl)
+        return s
+
+    def visit_ExprStmt(self, s: A.ExprStmt):
+        s.expr = self.expr(s.expr)
+        return s
+
+    visit_Return = visit_Case = visit_ExprStmt
+
+    def visit_If(self, s: A.If):
+        s.cond = self.expr(s.cond)
+        self.sub(s.then)
+        self.sub(s.else_)
+        return s
+
+    def visit_For(self, s: A.For):
+        self.scopes.append({})
+        self.stmt(s.init)
+        self.condition(s)
+        s.step = self.expr(s.step)
+        self.sub(s.body)
+        self.scopes.pop()
+        return s
+
+    def visit_While(self, s: A.While):
+        self.scopes.append({})
+        self.condition(s)
+        self.sub(s.body)
+        self.scopes.pop()
+        return s
+
+    def visit_DoWhile(self, s: A.DoWhile):
+        self.sub(s.body)
+        s.cond = self.expr(s.cond)
+        return s
+
+    def visit_Switch(self, s: A.Switch):
+        s.expr = self.expr(s.expr)
+        self.visit(s.body)
+        return s
 
     def sub(self, s) -> None:
         """A sub-statement (if branch, loop body): its own scope."""
         if s is None:
             return
         self.scopes.append({})
-        self.stmt(s)
+        self.visit(s)
         self.scopes.pop()

@@ -24,6 +24,7 @@ from typing import Any, Optional, Union
 
 from rrcache.errors import SemanticError, SourceLoc
 from rrcache.glsl import ast as A
+from rrcache.glsl.visitor import NodeVisitor
 from rrcache.glsl.builtins import BUILTIN_VARIABLES, BuiltinFunction
 from rrcache.glsl.builtins import lookup as builtin_lookup
 from rrcache.glsl.constfold import const_value
@@ -182,7 +183,10 @@ def _qual_words(ftype: A.FullType) -> tuple[str, ...]:
     return tuple(q for q in ftype.qualifiers if isinstance(q, str))
 
 
-class _Checker:
+class _Checker(NodeVisitor):
+    """Visiting a declaration or statement checks it; visiting an expression (through
+    :meth:`expr`, which annotates it) returns its type."""
+
     def __init__(self, unit: A.TranslationUnit):
         profile = unit.profile
         version = unit.version or (100 if profile == "es" else 110)
@@ -202,19 +206,6 @@ class _Checker:
         self.edge_loc: dict[tuple[str, str], Optional[SourceLoc]] = {}
         self.builtin_symbols: dict[str, Symbol] = {}
         self.overload_cache: dict[tuple, Any] = {}
-        self.expr_dispatch = {
-            A.Ident: self._ident, A.IntLit: self._intlit, A.FloatLit: self._floatlit,
-            A.BoolLit: self._boollit, A.Unary: self._unary, A.Binary: self._binary,
-            A.Assign: self._assign, A.Ternary: self._ternary, A.Sequence: self._sequence,
-            A.Call: self._call, A.Field: self._field, A.Index: self._index,
-            A.Length: self._length, A.InitList: self._bare_init_list,
-        }
-        self.stmt_dispatch = {
-            A.Compound: self._compound, A.DeclStmt: self._decl_stmt, A.ExprStmt: self._expr_stmt,
-            A.If: self._if, A.For: self._for, A.While: self._while, A.DoWhile: self._do,
-            A.Switch: self._switch, A.Case: self._case, A.Break: self._break,
-            A.Continue: self._continue, A.Return: self._return, A.Discard: lambda s: None,
-        }
 
     # ================================================================== scopes
     def push(self) -> None:
@@ -387,18 +378,35 @@ class _Checker:
         return self.info
 
     def external(self, decl: A.Node) -> None:
-        if isinstance(decl, A.FunctionDecl):
-            self.function(decl)
-        elif isinstance(decl, A.VariableDecl):
-            self.var_decl(decl)
-        elif isinstance(decl, A.InterfaceBlock):
-            self.interface_block(decl)
-        elif isinstance(decl, A.QualifierDecl):
-            self.qualifier_decl(decl)
-        elif isinstance(decl, A.PrecisionDecl):
-            self.precision_decl(decl)
-        else:
-            raise _err(f"unexpected declaration {type(decl).__name__}", decl)
+        self.visit(decl)
+
+    # a declaration, global or in a statement
+    def visit_VariableDecl(self, decl: A.VariableDecl) -> None:
+        self.var_decl(decl)
+
+    def visit_PrecisionDecl(self, decl: A.PrecisionDecl) -> None:
+        self.precision_decl(decl)
+
+    def visit_FunctionDecl(self, decl: A.FunctionDecl) -> None:
+        if not self.scope.is_global:
+            raise _err("functions cannot be declared inside a function", decl)
+        self.function(decl)
+
+    def visit_InterfaceBlock(self, decl: A.InterfaceBlock) -> None:
+        self.global_only(decl)
+        self.interface_block(decl)
+
+    def visit_QualifierDecl(self, decl: A.QualifierDecl) -> None:
+        self.global_only(decl)
+        self.qualifier_decl(decl)
+
+    def global_only(self, decl: A.Node) -> None:
+        if not self.scope.is_global:
+            raise _err(f"{type(decl).__name__} is not allowed inside a function", decl)
+
+    def generic_visit(self, node: A.Node) -> None:
+        self.global_only(node)
+        raise _err(f"unexpected declaration {type(node).__name__}", node)
 
     def layouts(self, qualifiers: list) -> None:
         for q in qualifiers:
@@ -627,34 +635,29 @@ class _Checker:
 
     # ================================================================== statements
     def stmt(self, s: A.Stmt) -> None:
-        self.stmt_dispatch[type(s)](s)
+        self.visit(s)
 
     def sub_stmt(self, s: A.Stmt) -> None:
         if isinstance(s, A.Compound):
-            self._compound(s)
+            self.visit_Compound(s)
         else:
             self.push()
             self.stmt(s)
             self.pop()
 
-    def _compound(self, s: A.Compound) -> None:
+    def visit_Compound(self, s: A.Compound) -> None:
         self.push()
         for sub in s.stmts:
             self.stmt(sub)
         self.pop()
 
-    def _decl_stmt(self, s: A.DeclStmt) -> None:
-        d = s.decl
-        if isinstance(d, A.VariableDecl):
-            self.var_decl(d)
-        elif isinstance(d, A.PrecisionDecl):
-            self.precision_decl(d)
-        elif isinstance(d, A.FunctionDecl):
-            raise _err("functions cannot be declared inside a function", d)
-        else:
-            raise _err(f"{type(d).__name__} is not allowed inside a function", d)
+    def visit_DeclStmt(self, s: A.DeclStmt) -> None:
+        self.visit(s.decl)
 
-    def _expr_stmt(self, s: A.ExprStmt) -> None:
+    def visit_Discard(self, s: A.Discard) -> None:
+        pass
+
+    def visit_ExprStmt(self, s: A.ExprStmt) -> None:
         if s.expr is not None:
             self.expr(s.expr)
 
@@ -669,7 +672,7 @@ class _Checker:
         if t != BOOL:
             raise _err(f"{what} condition must be a scalar bool, not '{t}'", node)
 
-    def _if(self, s: A.If) -> None:
+    def visit_If(self, s: A.If) -> None:
         self.condition(s.cond, "if")
         self.sub_stmt(s.then)
         if s.else_ is not None:
@@ -680,7 +683,7 @@ class _Checker:
         self.sub_stmt(body)
         self.loops -= 1
 
-    def _for(self, s: A.For) -> None:
+    def visit_For(self, s: A.For) -> None:
         self.push()
         if s.init is not None:
             self.stmt(s.init)
@@ -691,25 +694,25 @@ class _Checker:
         self._loop_body(s.body)
         self.pop()
 
-    def _while(self, s: A.While) -> None:
+    def visit_While(self, s: A.While) -> None:
         self.push()
         self.condition(s.cond, "while-loop")
         self._loop_body(s.body)
         self.pop()
 
-    def _do(self, s: A.DoWhile) -> None:
+    def visit_DoWhile(self, s: A.DoWhile) -> None:
         self._loop_body(s.body)
         self.condition(s.cond, "do-while")
 
-    def _switch(self, s: A.Switch) -> None:
+    def visit_Switch(self, s: A.Switch) -> None:
         t = self.expr(s.expr)
         if not (t.is_integer and t.is_scalar):
             raise _err(f"switch expression must be a scalar integer, not '{t}'", s.expr)
         self.switches.append(set())
-        self._compound(s.body)
+        self.visit_Compound(s.body)
         self.switches.pop()
 
-    def _case(self, s: A.Case) -> None:
+    def visit_Case(self, s: A.Case) -> None:
         if not self.switches:
             raise _err("'case' label outside a switch", s)
         labels = self.switches[-1]
@@ -726,15 +729,15 @@ class _Checker:
             raise _err(f"duplicate case label '{key}'", s)
         labels.add(key)
 
-    def _break(self, s: A.Break) -> None:
+    def visit_Break(self, s: A.Break) -> None:
         if not self.loops and not self.switches:
             raise _err("'break' outside a loop or switch", s)
 
-    def _continue(self, s: A.Continue) -> None:
+    def visit_Continue(self, s: A.Continue) -> None:
         if not self.loops:
             raise _err("'continue' outside a loop", s)
 
-    def _return(self, s: A.Return) -> None:
+    def visit_Return(self, s: A.Return) -> None:
         assert self.current is not None
         ret = self.current.return_type
         if s.expr is None:
@@ -752,24 +755,24 @@ class _Checker:
 
     # ================================================================== expressions
     def expr(self, e: A.Expr) -> Type:
-        t = self.expr_dispatch[type(e)](e)
+        t = self.visit(e)
         e.type = t
         return t
 
-    def _intlit(self, e: A.IntLit) -> Type:
+    def visit_IntLit(self, e: A.IntLit) -> Type:
         if e.text and e.text[-1] in "lL":  # 64-bit literal: 1l, 2ul
             return UINT64 if e.unsigned else INT64
         return UINT if e.unsigned else INT
 
-    def _floatlit(self, e: A.FloatLit) -> Type:
+    def visit_FloatLit(self, e: A.FloatLit) -> Type:
         if e.text and e.text[-2:] in ("hf", "HF"):  # half-float literal
             return FLOAT16
         return DOUBLE if e.double else FLOAT
 
-    def _boollit(self, e: A.BoolLit) -> Type:
+    def visit_BoolLit(self, e: A.BoolLit) -> Type:
         return BOOL
 
-    def _ident(self, e: A.Ident) -> Type:
+    def visit_Ident(self, e: A.Ident) -> Type:
         found = self.lookup(e.name)
         if isinstance(found, Symbol):
             sym = found
@@ -793,18 +796,18 @@ class _Checker:
             self.info.used_globals.add(sym.name)
         return sym.type
 
-    def _sequence(self, e: A.Sequence) -> Type:
+    def visit_Sequence(self, e: A.Sequence) -> Type:
         t = VOID
         for sub in e.exprs:
             t = self.expr(sub)
         return t
 
-    def _bare_init_list(self, e: A.InitList) -> Type:
+    def visit_InitList(self, e: A.InitList) -> Type:
         raise _err("an initializer list '{...}' can only initialize a variable", e,
                    "use a constructor such as vec3(...) or float[3](...)")
 
     # ---------------------------------------------------------------- operators
-    def _unary(self, e: A.Unary) -> Type:
+    def visit_Unary(self, e: A.Unary) -> Type:
         t = self.expr(e.operand)
         op = e.op
         if op in ("+", "-"):
@@ -822,7 +825,7 @@ class _Checker:
             self.check_lvalue(e.operand, op)
         return t
 
-    def _binary(self, e: A.Binary) -> Type:
+    def visit_Binary(self, e: A.Binary) -> Type:
         lt = self.expr(e.left)
         rt = self.expr(e.right)
         return self.binary_type(e.op, lt, rt, e)
@@ -885,7 +888,7 @@ class _Checker:
         raise _err(f"'{op}' cannot be applied to '{lt}' and '{rt}'", node,
                    "the operands need the same size, or one of them must be a scalar")
 
-    def _assign(self, e: A.Assign) -> Type:
+    def visit_Assign(self, e: A.Assign) -> Type:
         tt = self.expr(e.target)
         vt = self.expr(e.value)
         self.check_lvalue(e.target, e.op)
@@ -924,7 +927,7 @@ class _Checker:
                 raise _err(f"the target of {what} is not an l-value", target,
                            "only variables, their fields, swizzles and elements can be assigned")
 
-    def _ternary(self, e: A.Ternary) -> Type:
+    def visit_Ternary(self, e: A.Ternary) -> Type:
         ct = self.expr(e.cond)
         if ct != BOOL:
             raise _err(f"'?:' condition must be a scalar bool, not '{ct}'", e.cond)
@@ -939,7 +942,7 @@ class _Checker:
         raise _err(f"the branches of '?:' have different types: '{a}' and '{b}'", e)
 
     # ---------------------------------------------------------------- postfix
-    def _field(self, e: A.Field) -> Type:
+    def visit_Field(self, e: A.Field) -> Type:
         t = self.expr(e.obj)
         if t.base == "struct" and not t.dims:
             ft = t.field_type(e.name)
@@ -951,7 +954,7 @@ class _Checker:
             return swizzle(t, e.name, e.loc)[0]
         raise _err(f"'{t}' has no member named '{e.name}'", e)
 
-    def _index(self, e: A.Index) -> Type:
+    def visit_Index(self, e: A.Index) -> Type:
         t = self.expr(e.obj)
         it = self.expr(e.index)
         if not (it.is_integer and it.is_scalar):
@@ -970,7 +973,7 @@ class _Checker:
                        f"valid indices are 0 to {bound - 1}" if bound else None)
         return result
 
-    def _length(self, e: A.Length) -> Type:
+    def visit_Length(self, e: A.Length) -> Type:
         t = self.expr(e.obj)
         if not (t.dims or t.is_vector or t.is_matrix):
             raise _err(f"length() cannot be applied to '{t}'", e,
@@ -978,7 +981,7 @@ class _Checker:
         return INT
 
     # ---------------------------------------------------------------- calls
-    def _call(self, e: A.Call) -> Type:
+    def visit_Call(self, e: A.Call) -> Type:
         args = [self.expr(a) for a in e.args]
         if e.array_dims is not None:
             elem = self._named_type(e.name, e)

@@ -62,6 +62,11 @@ class CachedFrame:
     hit_map: Optional[np.ndarray] = None
     payload: Optional[np.ndarray] = None
     cpu_ms: float = float("nan")  # process CPU time over the same span as ms (all threads)
+    #: why the misses missed (``miss_causes=True``): :func:`rrcache.runtime.misses.summarise`
+    miss_causes: Optional[dict] = None
+    #: per pixel the index of its cause in ``rrcache.runtime.misses.MISS_CAUSES`` (-1: a hit or
+    #: not covered; row 0 = top), with ``miss_causes``
+    miss_map: Optional[np.ndarray] = None
 
 
 def _range_remedy(variant) -> str:
@@ -94,8 +99,10 @@ class CachedRenderer:
                  seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
                  ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
                  color_format: str = "rgba32f", threshold: Optional[float] = None,
-                 fast_period: int = DEFAULT_FAST_PERIOD, spread: float = DEFAULT_SPREAD):
+                 fast_period: int = DEFAULT_FAST_PERIOD, spread: float = DEFAULT_SPREAD,
+                 miss_causes: bool = False):
         self.ctx = ctx or get_context()
+        hit_maps = hit_maps or miss_causes
         self.color_format = color_format
         self.variant = variant
         self.session = session
@@ -131,6 +138,14 @@ class CachedRenderer:
                 payload_decode=getattr(variant, "payload_decode", None))
             if window is not None:
                 self.runtime.set_window(window)
+            self._classifier = None
+            if miss_causes:  # diagnostics: each miss's cause (rrcache.runtime.misses)
+                from rrcache.runtime.misses import MissClassifier
+
+                first = variant.passes[variant.pass_names[0]]
+                self._classifier = MissClassifier(self.ctx, self.runtime, first.vertex, variant.filter,
+                                                  self.drawer.add_program)
+                self._scope.own(self._classifier.program)
         except BaseException:
             self._scope.release()
             raise
@@ -213,6 +228,7 @@ class CachedRenderer:
             self.runtime.reset()
             self._warm = True
         hit_box = {} if self.hit_maps else None
+        codes = self._classifier.classify(self.drawer.draw) if self._classifier is not None else None
         with watchdog.frame(f"frame {index} of the cached variant"):
             ctx.finish()
             cpu_start = time.process_time()
@@ -235,7 +251,15 @@ class CachedRenderer:
         else:  # one-pass: a dynamic branch, nothing for a query to count
             hits = misses = None
         payload = self.runtime.read_payload() if self.keep_payload else None
-        return CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload, cpu_ms)
+        frame = CachedFrame(index, image, mask, covered, hits, misses, ms, hit_map, payload, cpu_ms)
+        if codes is not None and hit_map is not None:
+            from rrcache.runtime.misses import causes, summarise
+
+            window = self.runtime.window
+            origin, height = ((window[0], window[1]), window[3]) if window else ((0, 0), self.size[1])
+            frame.miss_map = causes(codes, hit_map, mask)
+            frame.miss_causes = summarise(frame.miss_map, mask, origin, height)
+        return frame
 
     def render_static(self, index: int, repeats: int = 5, between: Optional[Callable[[], None]] = None,
                       stages: Optional[dict] = None) -> float:
@@ -295,6 +319,10 @@ class CachedRenderer:
 
     def release(self) -> None:
         """Release every GL object (safe to call twice)."""
+        classifier = getattr(self, "_classifier", None)
+        if classifier is not None:
+            classifier._release_targets()
+            self._classifier = None
         runtime = getattr(self, "runtime", None)
         if runtime is not None:
             runtime.release()
@@ -321,6 +349,8 @@ class FrameComparison:
     nonfinite: int = 0
     left_out: int = 0
     original_nonfinite: int = 0
+    #: why the misses missed (``compare(..., miss_causes=True)``; rrcache.runtime.misses.summarise)
+    miss_causes: Optional[dict] = None
 
 
 @dataclass
@@ -374,6 +404,17 @@ class Comparison:
     @property
     def ms_per_frame(self) -> float:
         return statistics.median(f.ms for f in self._steady())
+
+    @property
+    def miss_causes(self) -> Optional[dict]:
+        """The steady frames' miss causes added up (None unless measured with ``miss_causes``)."""
+        from rrcache.runtime.misses import add_summaries
+
+        total = None
+        for f in self._steady():
+            if f.miss_causes is not None:
+                total = add_summaries(total, f.miss_causes)
+        return total
 
     @property
     def original_ms_per_frame(self) -> float:
@@ -434,21 +475,23 @@ def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_P
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
             window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f",
             threshold: Optional[float] = None, fast_period: int = DEFAULT_FAST_PERIOD,
-            spread: float = DEFAULT_SPREAD) -> Comparison:
+            spread: float = DEFAULT_SPREAD, miss_causes: bool = False) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
     is called per frame (for progress bars and writing images). ``window``: both render only
     that rectangle of the frame (errors and times are then the window's). ``color_format``: the
     colour target both draw into (:mod:`rrcache.gl.formats`; ``rgba8`` as an application draws,
     the error then being what it displays). ``threshold``, ``fast_period``, ``spread``: the
-    adaptive refresh of a variant compiled for it (:mod:`rrcache.runtime.adaptive`)."""
+    adaptive refresh of a variant compiled for it (:mod:`rrcache.runtime.adaptive`).
+    ``miss_causes``: each frame's misses sorted by cause (:mod:`rrcache.runtime.misses`; it
+    reads hit maps, so the times are not fair)."""
     result = Comparison()
     result.color_format = color_format
     with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
             CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
                            depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window,
                            color_format=color_format, threshold=threshold, fast_period=fast_period,
-                           spread=spread) as cached:
+                           spread=spread, miss_causes=miss_causes) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:
@@ -457,7 +500,7 @@ def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_P
             err, left_out = mean_l2(got.image, ref.image, ref.mask)
             row = FrameComparison(index, float(err), float(psnr(got.image, ref.image)), got.hits, got.misses,
                                   got.covered_pixels, got.ms, ref.ms, nonfinite_count(got.image), int(left_out),
-                                  nonfinite_count(ref.image))
+                                  nonfinite_count(ref.image), got.miss_causes)
             result.frames.append(row)
             result.payload_dtype = cached.payload_dtype
             if cached.payload_note and cached.payload_note not in result.notes:

@@ -56,6 +56,17 @@ _FIELDS = {"position": "positions", "normal": "normals", "texcoord": "texcoords"
            "tangent": "tangents"}
 
 
+def attribute_data(mesh, attr: str, size: int) -> np.ndarray:
+    """The vertex attribute ``attr`` (``position normal texcoord color tangent``) of ``mesh`` as a
+    contiguous float32 N×``size`` array; a mesh without it gets the default value at every vertex
+    (a normal (0, 0, 1), texcoord 0, opaque white, tangent (1, 0, 0, 1))."""
+    n = int(np.asarray(mesh.positions).shape[0])
+    data = getattr(mesh, _FIELDS[attr], None)
+    if data is None:
+        data = np.tile(np.asarray(_DEFAULTS[attr], np.float32), (n, 1))
+    return np.ascontiguousarray(np.asarray(data, np.float32).reshape(n, size))
+
+
 def normal_matrix(model: np.ndarray) -> np.ndarray:
     """The world-space normal matrix (inverse transpose of the model matrix's 3×3 part)."""
     m3 = np.asarray(model, dtype=np.float64)[:3, :3]
@@ -82,6 +93,42 @@ def reprojection_matrix(mvp: np.ndarray, prev_mvp: np.ndarray) -> np.ndarray:
     return np.asarray(prev_mvp, dtype=np.float64) @ inv
 
 
+def frame_builtins(session, index: int, size: tuple[int, int], static: bool = False) -> tuple[dict, list[dict]]:
+    """The built-in uniforms of frame ``index`` at ``size`` (docs/design.md §4) as plain values:
+    the frame's (``u_camera``, ``u_light``, ``u_lightColor``, ``u_resolution``, ``u_time``,
+    ``u_frame``, ``u_viewMatrix``, ``u_projectionMatrix``) and, per object, ``u_modelMatrix``,
+    ``u_modelViewProjectionMatrix``, ``u_normalMatrix``, ``u_prevModelViewProjectionMatrix``
+    (frame ``index - 1``'s; frame 0 and ``static`` use this frame's) and ``u_reprojectionMatrix``,
+    with ``"cull"`` (back faces culled). Matrices are numpy arrays in math convention (row-major;
+    GL takes them transposed). One computation for every renderer: the harness's and the WebGL2
+    page's (:mod:`rrcache.webgl`).
+
+    >>> from rrcache.session import load_session
+    >>> frame, objects = frame_builtins(load_session("sessions/marble.json"), 3, (64, 48))
+    >>> frame["u_frame"], frame["u_resolution"], sorted(objects[0])[:3]
+    (3, (64.0, 48.0), ['cull', 'u_modelMatrix', 'u_modelViewProjectionMatrix'])
+    """
+    w, h = size
+    prev = index if static else max(index - 1, 0)
+    cam, cam_prev = session.camera_at(index), session.camera_at(prev)
+    view, proj = cam.view, cam.projection(w / h)
+    view_proj = proj @ view
+    prev_view_proj = cam_prev.projection(w / h) @ cam_prev.view
+    light = session.light_at(index)
+    frame = {"u_camera": cam.eye, "u_light": light.position, "u_lightColor": light.color,
+             "u_resolution": (float(w), float(h)), "u_time": index / session.fps, "u_frame": index,
+             "u_viewMatrix": view, "u_projectionMatrix": proj}
+    objects = []
+    for obj in session.objects:
+        model = obj.model_matrix(index)
+        mvp, prev_mvp = view_proj @ model, prev_view_proj @ obj.model_matrix(prev)
+        objects.append({"u_modelMatrix": model, "u_modelViewProjectionMatrix": mvp, "u_normalMatrix": normal_matrix(model),
+                        "u_prevModelViewProjectionMatrix": prev_mvp,
+                        "u_reprojectionMatrix": reprojection_matrix(mvp, prev_mvp),
+                        "cull": not getattr(obj, "double_sided", False)})
+    return frame, objects
+
+
 class SceneDrawer:
     """Draws the objects of ``session`` at ``size`` with programs registered by
     :meth:`add_program`. GL objects are owned by ``scope``."""
@@ -101,7 +148,8 @@ class SceneDrawer:
         self._indices: dict[int, moderngl.Buffer] = {}
         self._textures: dict[str, tuple[int, moderngl.Texture]] = {}
         self._frame: Optional[int] = None
-        self._per_object: list = []
+        self._builtins: dict = {}
+        self._objects: list[dict] = []
         self.shadow_map = getattr(session, "shadow_map", None)
         self._shadow = None  # (program, depth texture, framebuffer, vertex arrays), made on first use
         self._light_matrix = np.eye(4)
@@ -132,12 +180,7 @@ class SceneDrawer:
     def _buffer(self, index: int, obj, attr: str, size: int) -> moderngl.Buffer:
         key = (index, attr)
         if key not in self._buffers:
-            mesh = obj.mesh
-            n = int(np.asarray(mesh.positions).shape[0])
-            data = getattr(mesh, _FIELDS[attr], None)
-            if data is None:
-                data = np.tile(np.asarray(_DEFAULTS[attr], np.float32), (n, 1))
-            data = np.ascontiguousarray(np.asarray(data, np.float32).reshape(n, size))
+            data = attribute_data(obj.mesh, attr, size)
             self._buffers[key] = self.scope.own(self.ctx.buffer(data.tobytes()))
         return self._buffers[key]
 
@@ -157,30 +200,21 @@ class SceneDrawer:
     # ------------------------------------------------------------------ frames
     def set_frame(self, index: int, static: bool = False) -> None:
         """Compute the camera, light and per-object matrices of frame ``index`` (and ``index - 1``
-        for reprojection; frame 0 uses itself). ``static``: the previous frame is this frame too
-        (a frame shown again, as when measuring the cache with every pixel hitting)."""
+        for reprojection; frame 0 uses itself) with :func:`frame_builtins`. ``static``: the
+        previous frame is this frame too (a frame shown again, as when measuring the cache with
+        every pixel hitting)."""
         session = self.session
-        w, h = self.size
-        prev = index if static else max(index - 1, 0)
-        cam, cam_prev = session.camera_at(index), session.camera_at(prev)
-        self._view, self._proj = cam.view, cam.projection(w / h)
-        view_proj = self._proj @ self._view
-        prev_view_proj = cam_prev.projection(w / h) @ cam_prev.view
-        self._camera = cam
+        self._builtins, self._objects = frame_builtins(session, index, self.size, static)
+        if self.cull_back_faces is not None:
+            for per_object in self._objects:
+                per_object["cull"] = self.cull_back_faces
         self._light = session.light_at(index)
         self._values = session.uniform_values(index)
         self._frame = index
-        self._per_object = []
         if self.shadow_map is not None:
             light_vp = light_view_projection(self._light.position, self.shadow_map, session, index)
             self._light_matrix = BIAS @ light_vp
             self._light_mvps = [light_vp @ obj.model_matrix(index) for obj in session.objects]
-        for obj in session.objects:
-            model = obj.model_matrix(index)
-            cull = self.cull_back_faces if self.cull_back_faces is not None else not getattr(obj, "double_sided", False)
-            mvp, prev_mvp = view_proj @ model, prev_view_proj @ obj.model_matrix(prev)
-            self._per_object.append((model, mvp, prev_mvp, normal_matrix(model), cull,
-                                     reprojection_matrix(mvp, prev_mvp)))
 
     # ------------------------------------------------------------------ shadow map
     def _shadow_resources(self):
@@ -221,9 +255,8 @@ class SceneDrawer:
         ctx.depth_func = "<"
         ctx.cull_face = "back"
         mvp_uniform = program["rr_lightModelViewProjection"]
-        for vao, mvp, per_object in zip(vaos, self._light_mvps, self._per_object):
-            cull = per_object[4]
-            if cull:
+        for vao, mvp, per_object in zip(vaos, self._light_mvps, self._objects):
+            if per_object["cull"]:
                 ctx.enable(moderngl.CULL_FACE)
             else:
                 ctx.disable(moderngl.CULL_FACE)
@@ -250,17 +283,8 @@ class SceneDrawer:
             raise RuntimeError("SceneDrawer.draw before set_frame")
         ctx = self.ctx
         plan = self._plans[id(program)]
-        w, h = self.size
-        index = self._frame
-        set_builtin = self._set_builtin
-        set_builtin(plan, "u_camera", self._camera.eye)
-        set_builtin(plan, "u_light", self._light.position)
-        set_builtin(plan, "u_lightColor", self._light.color)
-        set_builtin(plan, "u_resolution", (float(w), float(h)))
-        set_builtin(plan, "u_time", index / self.session.fps)
-        set_builtin(plan, "u_frame", index)
-        set_builtin(plan, "u_viewMatrix", self._view)
-        set_builtin(plan, "u_projectionMatrix", self._proj)
+        for name, value in self._builtins.items():
+            self._set_builtin(plan, name, value)
         for name, uniform in plan.session:
             write_uniform(uniform, lookup(self._values, name))
         for name, _uniform, _kind in plan.samplers:
@@ -268,16 +292,14 @@ class SceneDrawer:
             tex.use(location=unit)
         if plan.shadow is not None:
             self._shadow_resources()[1].use(location=SHADOW_UNIT)
-        set_builtin(plan, "u_lightMatrix", self._light_matrix)
+        self._set_builtin(plan, "u_lightMatrix", self._light_matrix)
         ctx.cull_face = "back"
-        for vao, (model, mvp, prev_mvp, nmat, cull, reproject) in zip(self._vaos[id(program)], self._per_object):
-            if cull:
+        for vao, per_object in zip(self._vaos[id(program)], self._objects):
+            if per_object["cull"]:
                 ctx.enable(moderngl.CULL_FACE)
             else:
                 ctx.disable(moderngl.CULL_FACE)
-            set_builtin(plan, "u_modelMatrix", model)
-            set_builtin(plan, "u_modelViewProjectionMatrix", mvp)
-            set_builtin(plan, "u_normalMatrix", nmat)
-            set_builtin(plan, "u_prevModelViewProjectionMatrix", prev_mvp)
-            set_builtin(plan, "u_reprojectionMatrix", reproject)
+            for name, value in per_object.items():
+                if name != "cull":
+                    self._set_builtin(plan, name, value)
             vao.render(moderngl.TRIANGLES)

@@ -48,7 +48,7 @@ def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
                          hint="use a .exr or .png file name")
     # written beside, read back, then renamed: a full disk leaves no empty or truncated image
     # (OpenImageIO's codecs do not always report a failed write)
-    with atomic.temporary_path(path) as tmp:
+    with atomic.via_file(path) as tmp:
         with quiet_stderr():
             ok = out.open(tmp, spec) and out.write_image(pixels)
             message = out.geterror()

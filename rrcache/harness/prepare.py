@@ -190,6 +190,8 @@ def load_user_vertex(vertex, session=None, defines=None, include_dirs=()):
     path = vertex if vertex is not None else getattr(session, "vertex", None)
     if path is None:
         return None
-    from rrcache.harness.user_vertex import load_vertex
+    from rrcache.harness.user_vertex import load_vertex, user_vertex_from_text
 
+    if vertex is None and getattr(session, "vertex_text", None) is not None:
+        return user_vertex_from_text(session.vertex_text, path, defines, include_dirs)  # read, confined, at load
     return load_vertex(path, defines, include_dirs)

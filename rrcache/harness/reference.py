@@ -22,6 +22,7 @@ mask) so that a later run reuses them.
 """
 from __future__ import annotations
 
+import io
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +30,8 @@ from typing import Iterable, Optional
 
 import numpy as np
 
+from rrcache.atomic import write_bytes
+from rrcache.files import read_bytes
 from rrcache.harness.prepare import PreparedShader
 from rrcache.harness.renderer import Renderer
 
@@ -73,8 +76,9 @@ class ReferenceCache:
         image_path, mask_path = stem.with_suffix(".image.npy"), stem.with_suffix(".mask.npy")
         if not (image_path.exists() and mask_path.exists()):
             return None
-        try:
-            image, mask = np.load(image_path), np.load(mask_path)
+        try:  # by rrcache.files' rule, pickles refused: a cache file is data, never code
+            image, mask = (np.load(io.BytesIO(read_bytes(p, limit=None)), allow_pickle=False)
+                           for p in (image_path, mask_path))
         except (OSError, ValueError):
             return None  # a damaged file: render again and overwrite it
         w, h = key[2]
@@ -86,13 +90,11 @@ class ReferenceCache:
         self._memory[key] = frame
         if self.directory is None:
             return
-        self.directory.mkdir(parents=True, exist_ok=True)
         stem = self._file_stem(key)
         for suffix, array in ((".image.npy", frame.image), (".mask.npy", frame.mask)):
-            final = stem.with_suffix(suffix)
-            tmp = final.with_name(final.name + ".tmp.npy")
-            np.save(tmp, array)
-            os.replace(tmp, final)
+            buffer = io.BytesIO()
+            np.save(buffer, array)
+            write_bytes(stem.with_suffix(suffix), buffer.getvalue())
 
     def frames(self, prepared: PreparedShader, session, indices: Iterable[int],
                resolution: Optional[tuple[int, int]] = None) -> list[ReferenceFrame]:

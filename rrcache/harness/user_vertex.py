@@ -44,7 +44,8 @@ import os
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Optional
 
-from rrcache.errors import GLSLError, SourceLoc, UnsupportedShaderError
+from rrcache.errors import SourceLoc, UnsupportedShaderError
+from rrcache.glsl.preprocessor import read_source
 
 #: the uniform the harness sets per object for the previous-frame clip position
 REPROJECTION_UNIFORM = "u_reprojectionMatrix"
@@ -125,18 +126,7 @@ def load_vertex(path: "str | os.PathLike[str]", defines: Optional[Mapping[str, o
                 include_dirs: Iterable[str] = ()) -> UserVertex:
     """Read and prepare the vertex shader file ``path`` (see the module)."""
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as f:
-            data = f.read()
-    except OSError as e:
-        raise GLSLError(f"cannot read vertex shader file '{path}': {e.strerror or e}", None,
-                        "check the path given with --vert or the session's \"vertex\"") from None
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as e:
-        line = data.count(b"\n", 0, e.start) + 1
-        raise GLSLError("the vertex shader file is not valid UTF-8", SourceLoc(path, line, 1),
-                        "save the shader as UTF-8") from None
+    text, _ = read_source(path, "vertex shader file")
     return user_vertex_from_text(text, path, defines, include_dirs)
 
 
@@ -183,7 +173,7 @@ def user_vertex_from_text(text: str, path: str, defines: Optional[Mapping[str, o
     keep = [f"#extension {name} : {behavior}" for name, behavior in pp.extensions
             if name not in _ES_ONLY_EXTENSIONS]
     files = list(pp.files) or [path]
-    digests = file_digests(text, files, path)
+    digests = file_digests(text, files, path, pp.file_hashes)
     h = hashlib.sha256(b"rrcache user vertex 1\0")
     for d in digests:
         h.update(d.encode("ascii") + b"\0")

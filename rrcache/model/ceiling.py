@@ -126,10 +126,11 @@ class Ceiling:
         o, l = self.original_ns_per_pixel, self.cache_ns_per_pixel
         return (f"the shader costs {o:.0f} ns per covered pixel; with every pixel hitting the cache's "
                 f"{self.algorithm} pipeline still costs {l:.0f} ns per covered pixel (its passes, reprojection "
-                f"fetches and render targets, and the shading left after {self.node}) plus "
+                f"fetches and render targets, and the shading left after {self.node}, "
+                f"{self.node_text or 'the costliest node'}) plus "
                 f"{self.limit_fixed_ms:.2f} ms per frame over the geometry against the original's "
                 f"{self.original_fixed_ms:.2f} ms; so at most {self.speedup:.2f}× at "
-                f"{self.pixels:.0f} covered pixels")
+                f"{self.pixels:,.0f} covered pixels")
 
     def changes(self) -> list[str]:
         """What would move the ceiling above ``min_gain``."""

@@ -126,7 +126,9 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
     """Measure ``nodes`` (default :func:`nodes_that_matter`) of ``profile`` at ``periods`` and
     compare with the models' predictions (see the module docstring)."""
     from rrcache.pipeline import variant_for
+    from rrcache.profiles.inputs import check_inputs
 
+    check_inputs(profile)  # what profile.json names is the profiled shader, before anything reads it
     table = profile.table
     settings = profile.settings
     periods = [int(p) for p in periods]

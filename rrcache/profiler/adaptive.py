@@ -58,7 +58,7 @@ class AdaptivePoint:
 
 
 def sweep(work, session, node: str, period: int, thresholds: Sequence[float], frames, timed_frames=None,
-          fast_period: int = DEFAULT_FAST_PERIOD, algorithm: str = "three-pass", filter: str = "bilinear",
+          fast_period: int = DEFAULT_FAST_PERIOD, algorithm: str = "three-pass", filter: Optional[str] = None,
           cache_options: Optional[dict] = None, window=None, resolution=None, timing_format: str = "rgba8",
           repeats: int = 1, on_frame=None) -> list[AdaptivePoint]:
     """Measure node ``node`` with adaptive refresh at each of ``thresholds`` (max age ``period``)

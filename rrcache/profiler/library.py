@@ -17,7 +17,6 @@ process at a time writes a library folder (``library.lock``, as :mod:`rrcache.pr
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import time
 import traceback
@@ -47,10 +46,12 @@ def entry_settings(base: Optional[TrainingSettings], *overrides: dict, where: st
 
 
 def _sha256(path: str) -> Optional[str]:
-    try:
-        with open(path, "rb") as f:
-            return hashlib.sha256(f.read()).hexdigest()
-    except OSError:
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
+    try:  # by rrcache.files' rule: a FIFO or a sparse giant is no shader
+        return read_file(path, budget.source_bytes).sha256
+    except Refused:
         return None
 
 
@@ -79,8 +80,7 @@ def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings) -> tuple
     if (vertex is None) != (prof.vertex is None):
         return "another vertex shader", True
     if vertex is not None:
-        from rrcache.harness.prepare import load_user_vertex
-        from rrcache.pipeline import all_include_dirs
+        from rrcache.pipeline import all_include_dirs, load_user_vertex
 
         user = load_user_vertex(vertex, session, prof.defines, all_include_dirs(entry.include_dirs, session))
         if user.hash != prof.vertex_hash:
@@ -96,9 +96,15 @@ def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings) -> tuple
 def read_rows(folder) -> dict[str, dict]:
     """The rows of ``library.json`` in ``folder`` by name (none when it is missing or unreadable:
     every entry is then checked against its own profile folder)."""
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     path = Path(folder) / LIBRARY_JSON
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        try:
+            data = json.loads(read_file(path, budget.document_bytes).data.decode("utf-8"))
+        except Refused:
+            return {}
         return {row["name"]: row for row in data.get("rows", []) if isinstance(row, dict) and "name" in row}
     except (OSError, ValueError, AttributeError, TypeError, KeyError):
         return {}

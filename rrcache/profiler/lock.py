@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 from typing import Optional
 
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError, printable
 
 LOCK_NAME = "profile.lock"
@@ -39,8 +40,9 @@ class StoreLock:
         :class:`RRCacheError` naming it, or with ``wait`` block until it is free."""
         path = Path(path)
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+            # by rrcache.atomic's rule: a link or a device named profile.lock is refused, not opened
+            with OutputFolder(path.parent) as folder:
+                fd = folder.open_regular(path.name, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as err:
             raise RRCacheError(f"cannot create the lock file {printable(str(path))}: {err.strerror or err}",
                                str(path.parent), hint="choose a writable --out folder") from None

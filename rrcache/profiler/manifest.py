@@ -80,11 +80,16 @@ def read_manifest(path) -> tuple[list[LibraryEntry], dict]:
     docstring)."""
     path = Path(path)
     where = str(path)
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
+
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise RRCacheError("no such manifest", where, hint="give a JSON or TOML file listing shaders and sessions") from None
-    except (OSError, UnicodeDecodeError) as err:
+        text = read_file(path, budget.document_bytes).data.decode("utf-8")
+    except Refused as err:
+        if err.kind == "missing":
+            raise RRCacheError("no such manifest", where, hint="give a JSON or TOML file listing shaders and sessions") from None
+        raise RRCacheError(f"cannot read the manifest: it {err.reason}", where, hint="give a UTF-8 JSON or TOML file") from None
+    except UnicodeDecodeError as err:
         raise RRCacheError(f"cannot read the manifest ({err})", where, hint="give a UTF-8 JSON or TOML file") from None
     if path.suffix.lower() == ".toml":
         data = _toml(text, where)
@@ -137,7 +142,7 @@ def _paths(value, where: str, base: Path) -> list[str]:
         raise RRCacheError("not a path, a glob or a list of them", where, hint='e.g. "shaders/*.glsl"')
     out: list[str] = []
     for item in items:
-        pattern = item if os.path.isabs(item) else str(base / item)
+        pattern = os.path.normpath(item if os.path.isabs(item) else str(base / item))
         if glob.has_magic(item):
             found = sorted(p for p in glob.glob(pattern, recursive=True) if os.path.isfile(p))
             if not found:
@@ -168,7 +173,7 @@ def _entry(item, where: str, base: Path) -> list[LibraryEntry]:
     dirs = item.get("include_dirs", [])
     if not isinstance(dirs, list) or not all(isinstance(d, str) for d in dirs):
         raise RRCacheError("'include_dirs' is not a list of folders", f"{where}.include_dirs", hint='e.g. ["include"]')
-    dirs = tuple(d if os.path.isabs(d) else str(base / d) for d in dirs)
+    dirs = tuple(os.path.normpath(d if os.path.isabs(d) else str(base / d)) for d in dirs)
     vertex = item.get("vertex")
     if vertex is not None:
         vertex = _paths(vertex, f"{where}.vertex", base)

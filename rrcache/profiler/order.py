@@ -31,12 +31,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-#: glslViewer built-in uniforms that change from frame to frame in every session, and those that
-#: follow the camera or the light (they change when it moves)
-_ALWAYS = ("u_time", "u_frame")
-_CAMERA = ("u_camera", "u_viewMatrix", "u_projectionMatrix")
-_LIGHT_POSITION = ("u_light",)
-_LIGHT_COLOR = ("u_lightColor",)
+# what changes between frames (the camera, light and objects' built-ins, keyframed uniforms)
+from rrcache.session.changes import per_frame_uniforms  # noqa: E402,F401  (its home; used here)
 _INPUT = re.compile(r"^\s*(?:(?:flat|smooth|noperspective|centroid|invariant)\s+)*in\s+\w+\s+(\w+)\s*;", re.M)
 
 
@@ -62,42 +58,6 @@ def cost_filter(nodes, min_saving: float) -> tuple[list, dict]:
         else:
             skipped[n.id] = f"saves {n.cost / top:.0%} of the shader's static cost (< {min_saving:.0%})"
     return keep, skipped
-
-
-def per_frame_uniforms(session) -> set[str]:
-    """The uniforms whose value differs between frames of ``session`` (compared at the first,
-    middle and last frames): ``u_time`` and ``u_frame``, the camera's and the light's built-ins
-    when they move or change, and the keyframed session uniforms."""
-    names = set(_ALWAYS)
-    frames = int(getattr(session, "frames", 1))
-    if frames < 2:
-        return names
-    probe = (0, frames // 2, frames - 1)
-
-    def varies(get) -> bool:
-        try:
-            values = [get(f) for f in probe]
-        except (AttributeError, TypeError, ValueError):
-            return True  # unknown: assume it changes
-        return not all(_equal(values[0], v) for v in values[1:])
-
-    if varies(lambda f: session.camera_at(f).eye) or varies(lambda f: session.camera_at(f).target):
-        names.update(_CAMERA)
-    if varies(lambda f: session.light_at(f).position):
-        names.update(_LIGHT_POSITION)
-    if varies(lambda f: session.light_at(f).color):
-        names.update(_LIGHT_COLOR)
-    first = session.uniform_values(0)
-    for name in first:
-        if varies(lambda f: session.uniform_values(f).get(name)):
-            names.add(name)
-    return names
-
-
-def _equal(a, b) -> bool:
-    import numpy as np
-
-    return b is not None and np.array_equal(np.asarray(a), np.asarray(b))
 
 
 def dependency_map(unit) -> dict[str, set[str]]:

@@ -113,6 +113,10 @@ class Plan:
     algorithm_times: Optional[dict] = None
     #: the measured ceiling (:class:`rrcache.model.ceiling.Ceiling` as JSON), once measured
     ceiling: Optional[dict] = None
+    #: the cache filter of the profile (``auto`` settings: :mod:`rrcache.profiler.filters`) and
+    #: what each candidate measured; None in plans made before the choice existed (bilinear)
+    filter: Optional[str] = None
+    filter_times: Optional[dict] = None
     original_cpu_ms: Optional[float] = None
     error_segments: Optional[list] = None
     session_frames: Optional[int] = None
@@ -124,6 +128,7 @@ class Plan:
                 "timing_window": list(self.timing_window) if self.timing_window else None,
                 "original_ms": self.original_ms, "algorithm": self.algorithm,
                 "algorithm_times": self.algorithm_times, "ceiling": self.ceiling,
+                "filter": self.filter, "filter_times": self.filter_times,
                 "original_cpu_ms": self.original_cpu_ms,
                 "error_segments": [list(s) for s in self.error_segments] if self.error_segments else None,
                 "session_frames": self.session_frames, "algorithm_reason": self.algorithm_reason}
@@ -134,9 +139,12 @@ class Plan:
         segments = data.get("error_segments")
         return cls(tuple(int(v) for v in ew) if ew else None, tuple(int(v) for v in tw) if tw else None,
                    float(data.get("original_ms", float("nan"))), data.get("algorithm"),
-                   data.get("algorithm_times"), data.get("ceiling"), data.get("original_cpu_ms"),
-                   [(int(a), int(b)) for a, b in segments] if segments else None, data.get("session_frames"),
-                   data.get("algorithm_reason"))
+                   data.get("algorithm_times"), data.get("ceiling"),
+                   # a plan that chose its algorithm before the filter existed trained bilinear
+                   data.get("filter", "bilinear" if data.get("algorithm") else None), data.get("filter_times"),
+                   original_cpu_ms=data.get("original_cpu_ms"),
+                   error_segments=[(int(a), int(b)) for a, b in segments] if segments else None,
+                   session_frames=data.get("session_frames"), algorithm_reason=data.get("algorithm_reason"))
 
     def error_frames(self, count: int) -> list[int]:
         """The counted frames of the error runs (``count``: ``settings.frames``, the first frames

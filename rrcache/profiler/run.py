@@ -20,9 +20,11 @@ from __future__ import annotations
 import os
 import sqlite3
 import time
+import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
@@ -62,6 +64,25 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
+    # the run's warnings are kept in profile.json (the report shows them) and raised again at
+    # the end for the caller
+    raised: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
+                                include_dirs, wait, vertex, adaptive, caught)
+            finally:
+                raised = list(caught)
+    finally:
+        for w in raised:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return prof
+
+
+def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
+             vertex, adaptive, caught: list) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -98,6 +119,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
                                          window=result.plan.timing_window if result.plan is not None else None)
+            prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
@@ -172,6 +194,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         vertex_hash=work.vertex.hash if work.vertex is not None else None,
         algorithm=(plan.algorithm if plan is not None and plan.algorithm else settings.fixed_algorithm),
         algorithm_times=dict((plan.algorithm_times if plan is not None else None) or {}),
+        filter=(plan.filter if plan is not None and plan.filter else "bilinear"),
         nodes=nodes, defines=dict(work.defines), include_dirs=list(work.include_dirs), plan=plan.to_json() if plan is not None else None,
         untrained=list(result.untrained), budget_stopped=result.budget_stopped,
         mu=float(hit.mu) if hit is not None else None, mu_quality=str(hit.quality) if hit is not None else None,
@@ -332,21 +355,21 @@ def no_node_verdict(work) -> dict:
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots and the report."""
-    out.mkdir(parents=True, exist_ok=True)
     kept = []
-    for sel in prof.selections:
-        folder = out / "optimized" / sel.label
-        if folder.exists():
-            for old in folder.iterdir():
-                if old.is_file():
-                    old.unlink()
-        prof.write_variant(sel, folder, work=work)
-        kept.append(sel.replace(files=str(folder.relative_to(out))))
+    # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
+    # refused, never followed, and the old files of a selection are removed only inside it
+    with OutputFolder(out) as root, root.folder("optimized") as optimized:
+        for sel in prof.selections:
+            with optimized.folder(sel.label) as folder:
+                folder.remove_files()
+                prof.write_variant(sel, folder, work=work)
+            kept.append(sel.replace(files=f"optimized/{sel.label}"))
+        answered = prof.verdict is not None  # stopped before training: nothing to plot, the answer to report
+        if answered:
+            with optimized.folder("original") as folder:
+                prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), folder)
     prof.selections = kept
     prof.path = out
-    answered = prof.verdict is not None  # stopped before training: nothing to plot, the answer to report
-    if answered:
-        prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), out / "optimized" / "original")
     if plots:
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots

@@ -58,6 +58,8 @@ from rrcache.harness.renderer import Renderer
 from rrcache.pipeline import ShaderWork, variant_for
 from rrcache.model.ceiling import Ceiling
 from rrcache.profiler.ceiling import measure_ceiling
+from rrcache.profiler.filters import choose_filter, steps as filter_steps
+from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                     shader_inputs, signature)
 from rrcache.profiler.plan import (Plan, algorithm_by_ceiling, algorithm_by_timing, make_plan as _make_plan,
@@ -382,6 +384,17 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 plan.algorithm = settings.fixed_algorithm
             store.set_plan(plan.to_json())
         algorithm = plan.algorithm
+        if plan.filter is None:
+            if settings.filter == "auto" and order.nodes and len(timing) > 0:
+                meter.grow(filter_steps(settings, timing))
+                plan.filter, plan.filter_times = choose_filter(work, session, settings, order.nodes[0].id, algorithm,
+                                                               timed_original, timing, plan, meter, _timing_run)
+            else:
+                plan.filter = DEFAULT_FILTER if settings.filter == "auto" else settings.filter
+            store.set_plan(plan.to_json())
+        # every variant compiled for this profile from here on (training, validation, the sets,
+        # the selections' files) uses the profile's filter
+        work.filter = plan.filter
 
         refs = []
         if need_refs:

@@ -61,12 +61,14 @@ def load_work(prof, include_dirs=()):
     """The profiled shader loaded again for the profile's session (its defines, include folders
     and vertex shader), checked to be the shader that was profiled; returns ``(work, session)``."""
     from rrcache.pipeline import load_for_session
-    from rrcache.session import load_session
+    from rrcache.profiles.inputs import load_session_of
 
-    session = load_session(prof.session)
+    # what profile.json names is the profiled shader and session, before anything parses them
+    session = load_session_of(prof)
     work = load_for_session(prof.shader, session, prof.defines, list(include_dirs) + list(prof.include_dirs),
                             vertex=prof.vertex)
     check_same_shader(prof, work)
+    work.filter = prof.filter  # the variants compile as the profile trained them
     return work, session
 
 
@@ -111,19 +113,19 @@ def write(prof, sel: Selection, out_dir, work=None) -> list[str]:
     (recording the period and every run-time option); for the original shader only a
     ``manifest.json`` saying so. ``work``: the profiled shader already loaded (else it is loaded
     again and must still have the profiled hash)."""
-    from rrcache import atomic
+    from rrcache.atomic import OutputFolder
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    if not isinstance(out_dir, OutputFolder):  # by rrcache.atomic's rule, into the chosen folder
+        with OutputFolder(out_dir) as folder:
+            return write(prof, sel, folder, work)
     if not sel.parts:
-        path = out / "manifest.json"
-        atomic.write_text(str(path), json.dumps({"rrcache_selection": 1, "node": None, "shader": prof.shader,
-                                                 "note": original_note(prof, sel)}, indent=2) + "\n")
-        return [str(path)]
+        return [out_dir.write_text("manifest.json", json.dumps(
+            {"rrcache_selection": 1, "node": None, "shader": prof.shader, "note": original_note(prof, sel)},
+            indent=2) + "\n")]
     if work is None:
         work, _session = load_work(prof)
     variant, period = variant_of(prof, sel, work)
-    return variant.write(out, period=period, runtime=runtime_options(prof, sel))
+    return variant.write(out_dir, period=period, runtime=runtime_options(prof, sel))
 
 
 def describe_options(prof, sel: Selection) -> str:

@@ -36,10 +36,11 @@ from typing import Optional
 from rrcache.errors import RRCacheError
 from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH,
-                             REFRESH_MODES)
+                             FILTERS, REFRESH_MODES)
 
 #: the cache algorithms a profile may use; ``auto`` measures which is faster on this machine
 ALGORITHM_CHOICES = ("auto",) + tuple(ALGORITHMS)
+FILTER_CHOICES = ("auto",) + tuple(FILTERS)
 #: what ``auto`` stands for when nothing was measured (no node to time)
 DEFAULT_ALGORITHM = "three-pass"
 
@@ -111,6 +112,10 @@ class TrainingSettings:
       largest error seen).
     - ``max_sets``: at most this many sets of several cached nodes, each at its own period, are
       trained after the single nodes (:mod:`rrcache.profiler.sets`); 0 trains none.
+    - ``filter``: the cache's hit test and payload reconstruction; ``auto`` (the default)
+      measures ``bilinear`` against ``plane`` on the first node to train and keeps ``plane``
+      where it was faster at about the same PSNR (:mod:`rrcache.profiler.filters`; the choice is
+      kept in the plan).
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -132,6 +137,9 @@ class TrainingSettings:
     levels: str = "psnr"
     #: the sets of cached nodes (k >= 2) the set stage trains at most (rrcache.profiler.sets); 0: none
     max_sets: int = 3
+    #: the cache's hit test and payload reconstruction: ``auto`` measures ``bilinear`` against
+    #: ``plane`` on the first node (rrcache.profiler.filters), or one of rrcache.runtime.glsl.FILTERS
+    filter: str = "auto"
 
     def cache_options(self) -> dict:
         """The cache's run-time parameters besides the period, as the keyword arguments of
@@ -190,6 +198,8 @@ class TrainingSettings:
             raise _fail("max_sets", f"{self.max_sets!r} is not a count of sets in [0, 64]", "the default is 3; 0 trains none")
         if self.levels not in LEVEL_KINDS:
             raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
+        if self.filter not in FILTER_CHOICES:
+            raise _fail("filter", f"unknown filter {self.filter!r}", f"one of {', '.join(FILTER_CHOICES)}")
         if self.timing_format not in COLOR_FORMATS:
             raise _fail("timing_format", f"unknown colour format {self.timing_format!r}",
                         f"one of {', '.join(COLOR_FORMATS)}")
@@ -259,6 +269,8 @@ class TrainingSettings:
     def key_json(self) -> str:
         """The canonical JSON of the keyed fields (everything but :data:`UNKEYED`)."""
         data = {k: v for k, v in self.to_json().items() if k not in UNKEYED}
+        if data.get("filter") == "auto":  # the default keys as before it existed: older stores resume
+            del data["filter"]
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def key_hash(self) -> str:

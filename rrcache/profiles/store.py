@@ -24,10 +24,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Optional
 
+from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, open_file
 from rrcache.selection import Selection, parts_from_json, parts_to_json
 
 SCHEMA_VERSION = 2
+#: the files SQLite keeps beside the store (write-ahead log, shared memory, rollback journal)
+_SIDE_FILES = ("-wal", "-shm", "-journal")
 #: the store's file name in a profile folder
 STORE_NAME = "profile.sqlite"
 
@@ -310,47 +314,55 @@ class ProfileStore:
         file raise :class:`RRCacheError` naming the file and the problem.
         """
         path = Path(path)
-        if fresh and path.exists():
-            backup = path.with_name(path.name + ".bak")
-            os.replace(path, backup)
-            for suffix in ("-wal", "-shm"):
-                side = path.with_name(path.name + suffix)
-                if side.exists():
-                    os.replace(side, backup.with_name(backup.name + suffix))
-        exists = path.exists() and path.stat().st_size > 0
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if exists:
-            conn = cls._connect_existing(path)
-            store = cls(path, conn)
+        # by rrcache.atomic's rule: the store and SQLite's side files must be regular files (a
+        # link named profile.sqlite is refused, not followed), reached through the folder's
+        # descriptor; --fresh renames only regular files
+        sides = [path.name + suffix for suffix in _SIDE_FILES]
+        with OutputFolder(path.parent) as folder:
+            folder.regular_or_missing(path.name, *sides, path.name + ".bak", *(s + ".bak" for s in sides))
+            if fresh and folder.exists(path.name):
+                backup = path.name + ".bak"
+                folder.rename(path.name, backup)
+                for side in sides:
+                    if folder.exists(side):
+                        folder.rename(side, side.replace(path.name, backup, 1))
+            exists = folder.exists(path.name) and os.stat(path.name, dir_fd=folder.fd).st_size > 0
+            pinned = folder.proc_path(path.name)
+            if exists:
+                conn = cls._connect_existing(path, pinned)
+                store = cls(path, conn)
+                try:
+                    if store._is_empty():
+                        # a run killed while it created the store (its one transaction never
+                        # committed) leaves an SQLite file with no tables: nothing to lose, start it
+                        store._create(key)
+                    else:
+                        store._check(key)
+                except BaseException:
+                    conn.close()
+                    raise
+                return store
             try:
-                if store._is_empty():
-                    # a run killed while it created the store (its one transaction never
-                    # committed) leaves an SQLite file with no tables: nothing to lose, start it
-                    store._create(key)
-                else:
-                    store._check(key)
-            except BaseException:
-                conn.close()
-                raise
-            return store
-        try:
-            conn = sqlite3.connect(str(path), isolation_level=None)
-        except sqlite3.Error as err:
-            raise _refuse(path, f"cannot create the profile store: {err}",
-                          "free disk space or make the folder writable, then run the same command again") from None
+                conn = sqlite3.connect(pinned, isolation_level=None)
+            except sqlite3.Error as err:
+                raise _refuse(path, f"cannot create the profile store: {err}",
+                              "free disk space or make the folder writable, then run the same command again") from None
         store = cls(path, conn)
         store._create(key)
         return store
 
     @staticmethod
-    def _connect_existing(path: Path) -> sqlite3.Connection:
-        with open(path, "rb") as f:
-            header = f.read(16)
+    def _connect_existing(path: Path, pinned: Optional[str] = None) -> sqlite3.Connection:
+        try:
+            with open_file(pinned or path, limit=None) as f:
+                header = os.pread(f.fd, 16, 0)
+        except Refused as err:
+            raise _refuse(path, f"the profile store {err.reason}", _FRESH_HINT) from None
         if header != b"SQLite format 3\x00":
             raise _refuse(path, "not a profile store (not an SQLite file)",
                           "it is damaged or another program's file; " + _FRESH_HINT)
         try:
-            conn = sqlite3.connect(str(path), isolation_level=None)
+            conn = sqlite3.connect(pinned or str(path), isolation_level=None)
             rows = conn.execute("PRAGMA integrity_check").fetchall()
         except sqlite3.DatabaseError as err:
             raise _refuse(path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
@@ -700,7 +712,9 @@ def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     path = Path(path)
     if not path.exists():
         raise _refuse(path, "no profile store here", "run 'rrcache profile' first")
-    conn = ProfileStore._connect_existing(path)
+    with OutputFolder(path.parent, create=False) as folder:
+        folder.regular_or_missing(path.name, *(path.name + suffix for suffix in _SIDE_FILES))
+        conn = ProfileStore._connect_existing(path, folder.proc_path(path.name))
     store = ProfileStore(path, conn)
     try:
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}

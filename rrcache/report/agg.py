@@ -12,3 +12,17 @@ def agg_pyplot():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def save_figure(fig, path) -> str:
+    """Draw ``fig`` into memory in the format of ``path``'s extension and write it to ``path`` by
+    :mod:`rrcache.atomic`'s rule (matplotlib would open the path itself, following any link);
+    returns the path."""
+    import io
+    import os
+
+    from rrcache.atomic import write_bytes
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png")
+    return write_bytes(path, buffer.getvalue())

@@ -56,6 +56,13 @@ td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
 .shots img { display: block; image-rendering: pixelated; border: 1px solid var(--line); }
 .shots figcaption { font-size: 11px; color: var(--muted); max-width: 240px; }
 .plots img { max-width: 100%; border: 1px solid var(--line); background: #fff; margin: 6px 12px 6px 0; }
+/* a level's "Use it" (rrcache.report.next_steps) and the summary's notices */
+.next { border-top: 1px solid var(--line); margin-top: 10px; }
+.next h4 { margin: 8px 0 4px; font-size: 14px; }
+.next table.files td:first-child, .next table.cmds td:first-child { white-space: nowrap; }
+.snippet { background: #f4f5f8; border: 1px solid var(--line); border-radius: 4px; padding: 8px 10px;
+           overflow-x: auto; font-size: 12px; line-height: 1.35; }
+.notices { margin: 8px 0 0; padding-left: 20px; }
 """
 
 JS = r"""

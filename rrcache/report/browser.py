@@ -32,6 +32,10 @@ FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-
          "--disable-component-update", "--disable-sync", "--disable-background-networking",
          "--disable-default-apps", "--disable-extensions", "--disable-breakpad", "--no-default-browser-check",
          "--hide-scrollbars", "--mute-audio", "--remote-allow-origins=*")
+#: with ``webgl=True``: WebGL2 on the CPU (ANGLE over SwiftShader) in place of --disable-gpu, so a
+#: page's WebGL2 renders the same on a machine without a GPU (newer Chromiums no longer fall back
+#: to SwiftShader by themselves)
+WEBGL_FLAGS = ("--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist")
 
 
 def find_chromium() -> Optional[str]:
@@ -46,7 +50,7 @@ class Chromium:
     """One headless Chromium with one page (see the module docstring); use it in a ``with`` block."""
 
     def __init__(self, width: int = 1280, height: int = 900, executable: Optional[str] = None,
-                 timeout: float = 30.0):
+                 timeout: float = 30.0, webgl: bool = False):
         try:
             import websocket
         except ImportError:
@@ -60,8 +64,9 @@ class Chromium:
         self._id = 0
         self._dir = tempfile.mkdtemp(prefix="rrcache-chromium-")
         self._log = tempfile.TemporaryFile()  # Chromium's own messages (a pipe could fill and stall it)
+        flags = tuple(f for f in FLAGS if f != "--disable-gpu") + WEBGL_FLAGS if webgl else FLAGS
         self._proc = subprocess.Popen(
-            [self.executable, *FLAGS, f"--user-data-dir={self._dir}", "--remote-debugging-port=0",
+            [self.executable, *flags, f"--user-data-dir={self._dir}", "--remote-debugging-port=0",
              f"--window-size={width},{height}", "about:blank"],
             stdout=subprocess.DEVNULL, stderr=self._log)
         try:
@@ -143,12 +148,15 @@ class Chromium:
         raise RRCacheError(f"no {method} within {self.timeout} s", "chromium")
 
     # ------------------------------------------------------------------ what a test uses
-    def open(self, path_or_url) -> None:
-        """Load a file (or URL) and wait for its load event."""
+    def open(self, path_or_url, query: str = "") -> None:
+        """Load a file (or URL), with ``query`` (``?size=64x48``) after it, and wait for its load
+        event."""
         url = str(path_or_url)
         if "://" not in url:
             url = Path(url).resolve().as_uri()
+        url += query
         self.url = url
+        self._opened = getattr(self, "_opened", set()) | {url}
         mark = len(self.events)
         self.send("Page.navigate", url=url)
         self.wait_for("Page.loadEventFired", since=mark)
@@ -178,8 +186,10 @@ class Chromium:
             params.update(captureBeyondViewport=True,
                           clip={"x": 0, "y": 0, "width": size["width"], "height": size["height"], "scale": 1})
         data = base64.b64decode(self.send("Page.captureScreenshot", **params)["data"])
+        from rrcache.atomic import write_bytes
+
         path = Path(path)
-        path.write_bytes(data)
+        write_bytes(path, data)
         return path
 
     def errors(self) -> list[str]:
@@ -197,9 +207,9 @@ class Chromium:
         return out
 
     def requests(self) -> list[str]:
-        """URLs the page requested, other than ``data:`` URIs and the page itself."""
+        """URLs the pages requested, other than ``data:`` URIs and the pages opened."""
         urls = [e["params"]["request"]["url"] for e in self.events if e["method"] == "Network.requestWillBeSent"]
-        return [u for u in urls if not u.startswith("data:") and u != getattr(self, "url", None)]
+        return [u for u in urls if not u.startswith("data:") and u not in getattr(self, "_opened", set())]
 
     # ------------------------------------------------------------------ shutting down
     def close(self) -> None:

@@ -14,12 +14,9 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Optional
 
 import numpy as np
-
-from rrcache.errors import RRCacheError
 
 
 def _num(value) -> Optional[float]:
@@ -107,12 +104,9 @@ def node_details(prof, node_id: str) -> dict:
 
 def read_source(prof) -> list[str]:
     """The profiled shader's lines (RRCacheError naming the file when it cannot be read)."""
-    path = Path(prof.shader)
-    try:
-        return path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as err:
-        raise RRCacheError(f"cannot read the profiled shader ({err.strerror})", str(path),
-                           hint="the profile names the shader by its absolute path; put it back there") from None
+    from rrcache.profiles.inputs import shader_source
+
+    return shader_source(prof).splitlines()
 
 
 def source_lines(prof) -> list[dict]:

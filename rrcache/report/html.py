@@ -23,11 +23,17 @@ import time
 from pathlib import Path
 from typing import Optional
 
+from rrcache.atomic import OutputFolder
+from rrcache.budgets import budget
 from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
+from rrcache.jsonable import script_json  # noqa: F401  (the data block; tests import it from here too)
 from rrcache.profiles.document import algorithm_line
+from rrcache.profiles.notices import run_warnings
 from rrcache.report import assets
 from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
 from rrcache.report.images import CAPTIONS, FrameShots, data_uri
+from rrcache.report.next_steps import next_steps_html
 
 REPORT_NAME = "report.html"
 #: the figures of :mod:`rrcache.report.plots` the report shows, with their captions
@@ -40,29 +46,16 @@ def _e(value) -> str:
     return html.escape(str(value), quote=True)
 
 
-#: what the data block's JSON spells as escapes: the HTML parser reads a script's text looking
-#: for ``</script`` and, after ``<!--``, for ``<script`` (the "script data escaped" states), so a
-#: shader comment ``<!--<script>`` left raw made the parser swallow the report's own script
-_SCRIPT_ESCAPES = {ord("<"): "\\u003c", ord(">"): "\\u003e", ord("&"): "\\u0026"}
-
-
-def script_json(data) -> str:
-    """``data`` as JSON safe inside ``<script type="application/json">``: no ``<``, ``>`` or ``&``
-    appears raw (nor any non-ASCII character), so no text from a shader, a file name or a session
-    can end or disable the script element; ``JSON.parse`` reads the escapes back as the same text.
-
-    >>> print(script_json({"text": "<!--<script>a && b</script>"}))
-    {"text":"\\u003c!--\\u003cscript\\u003ea \\u0026\\u0026 b\\u003c/script\\u003e"}
-    """
-    return json.dumps(data, separators=(",", ":"), allow_nan=False).translate(_SCRIPT_ESCAPES)
-
-
 def _f(value, digits: int = 4, suffix: str = "") -> str:
+    """A number in plain units: ``digits`` significant digits, large ones whole with thousands
+    separators (139,730 covered pixels, not 1.39730e+05), only tiny ones in exponent form."""
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
     value = float(value)
-    if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
+    if value != 0 and abs(value) < 1e-4:
         return f"{value:.{max(1, digits - 1)}e}{suffix}"
+    if abs(value) >= 10 ** digits:
+        return f"{value:,.0f}{suffix}"
     return f"{value:.{digits}g}{suffix}"
 
 
@@ -95,7 +88,7 @@ def _summary(prof, timing: dict) -> str:
         (_f(prof.original_ms, 4, " ms"), "original frame time"),
         (_f(prof.mu, 3), "μ (hit rate limit)"),
         (_f(prof.overhead_ms, 3, " ms"), "cache overhead per frame"),
-        (_f(prof.pixels, 6), "covered pixels per frame"),
+        (f"{round(prof.pixels):,}" if prof.pixels else "–", "covered pixels per frame"),
         ((_x(best.measured_speedup) + f" ({best.label})") if best else "–", "best measured speed-up"),
         (_f(prof.training_wall_s, 3, " s"), "training time"),
         (_f(timing["median_ms"], 2, " ms"), f"re-selection (median of {timing['repeats']})"),
@@ -103,7 +96,22 @@ def _summary(prof, timing: dict) -> str:
     if counts:
         cells.append((f"{counts.get('error_runs_computed', 0)} + {counts.get('timing_runs_computed', 0)}",
                       "error + timing runs computed"))
-    return '<div class="summary">' + "".join(f"<div><b>{_e(v)}</b><span>{_e(k)}</span></div>" for v, k in cells) + "</div>"
+    ceiling = prof.measured_ceiling
+    if ceiling is not None:
+        cells.insert(6, (_x(ceiling.speedup), f"ceiling: every pixel hitting ({ceiling.algorithm})"))
+    return ('<div class="summary">' + "".join(f"<div><b>{_e(v)}</b><span>{_e(k)}</span></div>" for v, k in cells)
+            + "</div>" + _warnings(prof))
+
+
+def _warnings(prof) -> str:
+    """The ceiling in words and every warning of the run (rrcache.profiles.notices), under the tiles."""
+    ceiling = prof.measured_ceiling
+    items = [f"<li>ceiling: {_e(ceiling.summary())}</li>"] if ceiling is not None else []
+    warnings = run_warnings(prof)
+    items += [f'<li class="warn">warning: {_e(w)}</li>' for w in warnings]
+    if not warnings:
+        items.append("<li>no warnings: the timings were steady and every level was met as chosen</li>")
+    return f'<ul class="notices">{"".join(items)}</ul>'
 
 
 def _source(prof, lines: list[str]) -> str:
@@ -146,7 +154,7 @@ def _amortized_what(prof, sel) -> str:
             f"λ = {p.blend:g} ({_e(p.history)} history)" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
 
 
-def _multi_selection(sel) -> str:
+def _multi_selection(prof, sel, shots: FrameShots) -> str:
     """A selection of several nodes: what each caches at which period and its figures (its frames
     are not rendered here: the report's images show one cached node or one amortized estimator)."""
     what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
@@ -162,7 +170,8 @@ def _multi_selection(sel) -> str:
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
-            '<p class="muted">several nodes: no frames are shown for this choice</p></div>')
+            '<p class="muted">several nodes: no frames are shown for this choice</p>'
+            f"{next_steps_html(prof, sel, shots.session.resolution)}</div>")
 
 
 def _level(sel) -> str:
@@ -173,7 +182,7 @@ def _level(sel) -> str:
 
 def _selection(prof, sel, shots: FrameShots) -> str:
     if sel.multi:
-        return _multi_selection(sel)
+        return _multi_selection(prof, sel, shots)
     images = shots.selection_images(sel)  # the original, one cached node or one amortized estimator
     amortized = sel.kind == "amortize"
     if amortized:
@@ -223,7 +232,7 @@ def _selection(prof, sel, shots: FrameShots) -> str:
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(node_attr)}" data-kind="{_e(sel.kind)}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
-            f'<div class="shots">{"".join(figures)}</div></div>')
+            f'<div class="shots">{"".join(figures)}</div>{next_steps_html(prof, sel, shots.session.resolution)}</div>')
 
 
 def _answer(prof) -> str:
@@ -290,14 +299,20 @@ def _prediction_errors(prof) -> str:
 
 def _plots(prof) -> str:
     folder = Path(prof.path) if prof.path is not None else None
-    have = {name: folder / name for name, _ in PLOTS if folder is not None and (folder / name).exists()}
+    have = {}
+    for name, _ in PLOTS:  # the folder's plots, read by rrcache.files' rule inside it (a link out is redrawn)
+        if folder is not None:
+            try:
+                have[name] = read_file(folder / name, budget.asset_bytes, [os.path.realpath(folder)]).data
+            except Refused:
+                pass
     with tempfile.TemporaryDirectory() as tmp:
         if len(have) < len(PLOTS) and prof.trained_nodes:
             from rrcache.report.plots import write_plots
 
             for path in write_plots(prof, tmp):
-                have.setdefault(Path(path).name, Path(path))
-        parts = [f'<figure><img alt="{_e(name)}" src="{data_uri(have[name].read_bytes())}">'
+                have.setdefault(Path(path).name, read_file(path, None).data)
+        parts = [f'<figure><img alt="{_e(name)}" src="{data_uri(have[name])}">'
                  f"<figcaption>{_e(caption)}</figcaption></figure>" for name, caption in PLOTS if name in have]
     return '<div class="plots">' + "".join(parts) + "</div>" if parts else "<p>No plots (no trained node).</p>"
 
@@ -402,10 +417,7 @@ def write_report(profile, out_dir, work=None, filename: str = REPORT_NAME) -> Pa
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the report's folder is a file", str(out), hint="give a folder, or --out FILE.html")
-    out.mkdir(parents=True, exist_ok=True)
-    text = report_html(profile, work)
-    path = out / filename
-    tmp = out / (filename + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    return path
+    with OutputFolder(out) as folder:
+        folder.regular_or_missing(filename)  # a device or a link as --out: refused before rendering
+        folder.write_text(filename, report_html(profile, work))
+    return out / filename

@@ -196,12 +196,18 @@ class FrameShots:
         from rrcache.session import load_session
 
         self.profile = profile
-        self.session = load_session(profile.session)
+        if work is None:  # a profile read from its folder: what it names is checked first
+            from rrcache.profiles.inputs import load_session_of
+
+            self.session = load_session_of(profile)
+        else:
+            self.session = load_session(profile.session)
         if work is None:
             from rrcache.pipeline import load_for_session
 
             work = load_for_session(profile.shader, self.session, profile.defines,
                                     getattr(profile, "include_dirs", ()), vertex=profile.vertex)
+            work.filter = getattr(profile, "filter", work.filter)
         self.work = work
         self.size = image_size(self.session.resolution, max_width)
         self._originals: dict = {}

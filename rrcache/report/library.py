@@ -3,8 +3,8 @@ index linking each profile's ``report.html``.
 
 A row is a plain dict (:func:`profile_row` from a finished profile, :func:`failed_row` for one that
 stopped on an error) with the keys of :data:`COLUMNS`; the speed-ups are the measured ones of the
-selections e1..e4 (None where a level was not measured). The verdict is one line: ``cache: best
-2.31× (e3, n12 Δn=34)`` where a selection measured at least the profile's ``min_gain``; ``original:
+selections e1..e4 (None where a level was not measured). The verdict is one line: ``cache: 2.31×
+at e3 (n12 Δn=34)`` where a selection measured at least the profile's ``min_gain``; ``original:
 ...`` with the reason otherwise.
 
 >>> row = failed_row("bad-orbit", "bad.glsl", "orbit.json", "bad.glsl:3:1: syntax error", 0.4)
@@ -34,7 +34,10 @@ def _finite(value) -> Optional[float]:
 def verdict(prof) -> str:
     """The profile's answer in one line (see the module docstring)."""
     if prof.verdict is not None:
-        return f"original: {prof.verdict.get('answer', 'the ceiling is below --min-gain')}"
+        ceiling, gain = _finite(prof.verdict.get("ceiling")), _finite(prof.verdict.get("min_gain"))
+        if ceiling is not None and gain is not None:
+            return f"original: the ceiling {ceiling:.2f}× is below {gain:.2f}×"
+        return "original: the ceiling is below --min-gain"
     measured = [s for s in prof.selections if s.parts and _finite(s.measured_speedup) is not None]
     if not prof.selections:
         return "original: no node could be trained"
@@ -46,7 +49,7 @@ def verdict(prof) -> str:
     best = max(measured, key=lambda s: s.measured_speedup)
     if best.measured_speedup < prof.settings.min_gain:
         return f"original: the best measured was {best.measured_speedup:.2f}× (below {prof.settings.min_gain:.2f}×)"
-    return f"cache: best {best.measured_speedup:.2f}× ({best.label}, {best.describe()})"
+    return f"cache: {best.measured_speedup:.2f}× at {best.label} ({best.describe()})"
 
 
 def profile_row(prof, name: str, folder: str, report: Optional[str], wall_s: Optional[float]) -> dict:

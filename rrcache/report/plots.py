@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rrcache.report.agg import agg_pyplot
+from rrcache.report.agg import agg_pyplot, save_figure
 
 PERIODS = np.arange(1, 51)
 
@@ -126,7 +126,7 @@ def plot_tradeoff(prof, out_dir) -> list[str]:
     fig.tight_layout()
     paths = [str(Path(out_dir) / "tradeoff.png"), str(Path(out_dir) / "tradeoff.svg")]
     for path in paths:
-        fig.savefig(path)
+        save_figure(fig, path)
     plt.close(fig)
     return paths
 
@@ -149,7 +149,7 @@ def plot_hitrate(prof, out_dir) -> list[str]:
     ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
     path = str(Path(out_dir) / "hitrate.png")
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return [path]
 
@@ -179,7 +179,7 @@ def plot_validation(prof, out_dir) -> list[str]:
     b.set_title("time: model against render")
     fig.tight_layout()
     path = str(Path(out_dir) / "validation.png")
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return [path]
 

@@ -59,7 +59,7 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
     original, a validation's against its own): the single-node front, the front with the trained
     sets, the sets (predicted, and trained joined to their prediction, numbered as listed under
     the panel) and the validated selections."""
-    from rrcache.report.agg import agg_pyplot
+    from rrcache.report.agg import agg_pyplot, save_figure
 
     plt = agg_pyplot()
     profiles = list(profiles)
@@ -104,6 +104,6 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
         text = "\n".join(f"{i + 1}: {o.describe()}" for i, o in enumerate(listed))
         ax.text(0.0, -0.13, text, transform=ax.transAxes, fontsize=7, va="top", color="darkorange")
     fig.tight_layout()
-    fig.savefig(str(path))
+    save_figure(fig, path)
     plt.close(fig)
     return [str(path)]

@@ -24,8 +24,9 @@ from typing import Any
 
 from rrcache.budgets import budget
 from rrcache.errors import AssetError, SessionError, printable
+from rrcache.files import OpenedFile, Refused, inside, read_file
 from rrcache.session import procedural, textures as tex
-from rrcache.session.meshes import MeshLoadError, load_mesh_file
+from rrcache.session.meshes import FORMATS, MeshLoadError, confined_resolver, load_mesh_data
 from rrcache.session.model import DEFAULT_FILTER, MeshData, SceneObject, Session, TextureAsset
 from rrcache.session.scene import camera_function, light_function, model_function
 from rrcache.session.uniforms import BUILTIN_UNIFORMS, uniform_function
@@ -93,6 +94,32 @@ def _check_numbers(value: Any, file: str, parts: list) -> None:
             _check_numbers(v, file, parts + [k])
 
 
+def check_size(doc: dict, file: str) -> None:
+    """Refuse a session beyond the budgets before it is validated (validating and building a
+    keyframe or an object takes the schema and the scene builders milliseconds each): more JSON
+    values than ``budget.session_values`` (``--max-session-values``; counted only up to the
+    limit) or more objects than ``budget.session_objects`` (``--max-session-objects``)."""
+    objects = doc.get("objects")
+    if isinstance(objects, list) and len(objects) > budget.session_objects:
+        raise SessionError(f"the session has {len(objects):,} objects, more than the {budget.session_objects:,} "
+                           "rrcache loads", file, "objects",
+                           "merge meshes into fewer objects, or raise the budget with "
+                           "'rrcache --max-session-objects N ...'")
+    count, stack = 0, [doc]
+    while stack:
+        value = stack.pop()
+        count += 1
+        if count > budget.session_values:
+            raise SessionError(f"the session holds more than {budget.session_values:,} JSON values (numbers, "
+                               "strings, lists, objects), the most rrcache loads", file, None,
+                               "thin the keyframes (the camera and objects are interpolated between them), or "
+                               "raise the budget with 'rrcache --max-session-values N ...'")
+        if isinstance(value, dict):
+            stack.extend(value.values())
+        elif isinstance(value, list):
+            stack.extend(value)
+
+
 def check_version(doc: Any, file: str) -> None:
     """The document must be an object with ``"rrcache_session": 1``."""
     if not isinstance(doc, dict):
@@ -108,78 +135,122 @@ def check_version(doc: Any, file: str) -> None:
 
 
 class _Assets:
-    """Resolves asset paths, loads each file once and records the files for the hash."""
+    """Opens the asset files by :mod:`rrcache.files`' rule, loads each once and records what was
+    read for the hash."""
 
     def __init__(self, file: str, confine: bool = True):
         self.file = file
         self.base = os.path.dirname(os.path.abspath(file))
         self.root = os.path.realpath(self.base)
         self.confine = confine
-        self.files: list[tuple[str, str]] = []  # (path as written, resolved)
+        self.files: list[tuple[str, object]] = []  # (path as written, bytes read or the open file)
         self.meshes: dict[str, MeshData] = {}
+        self.images: dict[str, OpenedFile] = {}
         self.image_headers: dict[str, tuple[int, int, int]] = {}
 
-    def resolve(self, written: str, where: str | None = None, what: str = "file") -> str:
-        """The path of ``written`` (relative to the session's folder); with confinement on, it
-        must lie inside the session file's folder tree (symbolic links followed)."""
-        path = os.path.normpath(os.path.join(self.base, os.path.expanduser(written)))
-        if self.confine:
-            real = os.path.realpath(path)
-            if real != self.root and not real.startswith(self.root.rstrip(os.sep) + os.sep):
-                raise AssetError(f"the {what} {printable(written)!r} resolves to {printable(real)}, outside the "
-                                 f"session's folder {printable(self.root)}", self.file, where,
-                                 'paths are confined to the session file\'s folder tree; if you trust the '
-                                 'session, allow others with "allow_outside_paths": true in it or '
-                                 "'rrcache --allow-outside-paths ...'")
-        return path
+    @property
+    def roots(self):
+        return [self.root] if self.confine else None
+
+    def path(self, written: str, where: str | None = None, what: str = "file") -> str:
+        """The path of ``written`` (relative to the session's folder)."""
+        if "\0" in written:
+            raise AssetError(f"the {what} path holds a NUL character, which no file name can", self.file, where,
+                             "write the file's name without control characters")
+        return os.path.normpath(os.path.join(self.base, os.path.expanduser(written)))
+
+    def outside(self, written: str, real: str, where: str | None, what: str) -> AssetError:
+        return AssetError(f"the {what} {printable(written)!r} resolves to {printable(real)}, outside the "
+                          f"session's folder {printable(self.root)}", self.file, where,
+                          'paths are confined to the session file\'s folder tree; if you trust the '
+                          'session, allow others with "allow_outside_paths": true in it or '
+                          "'rrcache --allow-outside-paths ...'")
+
+    def folder(self, written: str, where: str, what: str) -> str:
+        """The real path of the folder ``written`` (confined when confinement is on): callers
+        keep the real path, so a link changed later cannot move what it names."""
+        real = os.path.realpath(self.path(written, where, what))
+        if self.confine and not inside(real, [self.root]):
+            raise self.outside(written, real, where, what)
+        return real
+
+    def text(self, written: str, where: str, what: str, limit: int) -> tuple[str, str]:
+        """(path, text) of a small text file the session names (its vertex shader), read by the rule."""
+        path = self.path(written, where, what)
+        try:
+            got = read_file(path, limit, self.roots)
+        except Refused as err:
+            if err.kind == "outside":
+                raise self.outside(written, err.real, where, what) from None
+            said = (f"cannot find the {what} {printable(path)}" if err.kind == "missing"
+                    else f"cannot read the {what} {printable(path)}: it {err.reason}")
+            raise AssetError(said, self.file, where, err.hint or "the path is relative to the session file's folder") from None
+        self.files.append((written, got.data))
+        try:
+            return path, got.data.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            raise AssetError(f"the {what} {printable(path)} is not UTF-8 text", self.file, where) from None
 
     def mesh(self, written: str, where: str) -> tuple[MeshData, str]:
-        path = self.resolve(written, where, "mesh")
+        path = self.path(written, where, "mesh")
         if path not in self.meshes:
+            ext = os.path.splitext(path)[1].lower()
             try:
-                self.meshes[path] = load_mesh_file(path)
+                if ext not in FORMATS:
+                    load_mesh_data(b"", ext)  # the unsupported-format error, before any file is read
+                got = read_file(path, budget.asset_bytes, self.roots,
+                                limit_hint="raise it with 'rrcache --max-asset-bytes N ...'")
+                self.meshes[path] = load_mesh_data(got.data, ext, confined_resolver(os.path.dirname(path), self.roots))
+            except Refused as err:
+                if err.kind == "outside":
+                    raise self.outside(written, err.real, where, "mesh") from None
+                raise AssetError(f"{'mesh file not found' if err.kind == 'missing' else 'the mesh file ' + err.reason}: "
+                                 f"{printable(path)}", self.file, where,
+                                 err.hint or "mesh paths are relative to the session file's folder") from None
             except MeshLoadError as e:
-                raise AssetError(f"{e}: {path}", self.file, where,
+                raise AssetError(f"{e}: {printable(path)}", self.file, where,
                                  "mesh paths are relative to the session file's folder") from None
-            self.files.append((written, path))
+            self.files.append((written, got.data))
         return self.meshes[path], path
 
     def image(self, written: str, where: str):
         """The image's header (width, height, channels) and path; its pixels are decoded later,
-        by :meth:`decode`, when a shader samples it."""
-        path = self.resolve(written, where, "image")
+        by :meth:`decode`, from the file opened now."""
+        path = self.path(written, where, "image")
         try:
-            header = tex.read_header(path)
+            opened = self.images.get(path) or tex.open_image_file(path, self.roots)
+            header = tex.read_header(opened)
+        except Refused as err:  # confinement: the opened file lies outside
+            raise self.outside(written, err.real, where, "image") from None
         except tex.ImageLoadError as e:
             raise AssetError(f"{e}: {printable(path)}", self.file, where,
-                             "image paths are relative to the session file's folder") from None
-        self.files.append((written, path))
+                             e.hint or "image paths are relative to the session file's folder") from None
+        self.images[path] = opened
+        self.files.append((written, opened))
         self.image_headers[path] = header
         return header, path
 
     def decode(self, path: str, where: str):
         try:
-            return tex.read_image(path)
+            return tex.read_image(self.images[path])
         except tex.ImageLoadError as e:
             raise AssetError(f"{e}: {printable(path)}", self.file, where,
-                             "image paths are relative to the session file's folder") from None
+                             e.hint or "image paths are relative to the session file's folder") from None
 
     def digest(self, doc: dict) -> str:
+        """sha256 over the canonical JSON and the bytes of every asset, as they were read (an
+        image through the descriptor it was opened with): no path is opened again."""
         h = hashlib.sha256(f"rrcache-session-1 loader-{LOADER_VERSION}\0".encode())
         h.update(json.dumps(doc, sort_keys=True, separators=(",", ":"), ensure_ascii=False).encode())
-        for written, path in self.files:
-            try:
-                with open(path, "rb") as f:
-                    data = f.read()
-            except OSError as e:
-                raise AssetError(f"cannot read {path}: {e.strerror}", self.file, None) from None
+        for written, content in self.files:
+            data = content if isinstance(content, bytes) else content.read(budget.asset_bytes)
             h.update(f"\0{written}\0{len(data)}\0".encode())
             h.update(data)
         return h.hexdigest()
 
 
 def _objects(doc: dict, file: str, assets: _Assets) -> list[SceneObject]:
-    objects, used = [], set()
+    objects, used, suffixes, shapes = [], set(), {}, {}
     for i, spec in enumerate(doc["objects"]):
         base = ["objects", i]
         if "mesh" in spec:
@@ -187,16 +258,20 @@ def _objects(doc: dict, file: str, assets: _Assets) -> list[SceneObject]:
             default_name = os.path.splitext(os.path.basename(spec["mesh"]))[0] or f"object{i}"
         else:
             proc = spec["procedural"]
-            mesh = procedural.make_mesh(proc, file, json_path(base + ["procedural"]))
+            shape = json.dumps(proc, sort_keys=True)  # the same shape twice: one mesh, built once
+            if shape not in shapes:
+                shapes[shape] = procedural.make_mesh(proc, file, json_path(base + ["procedural"]))
+            mesh = shapes[shape]
             source, default_name = f"procedural:{proc['type']}", proc["type"]
         if "name" in spec:
             name = spec["name"]
             if name in used:
                 raise SessionError(f"another object is already named {name!r}", file, json_path(base + ["name"]))
         else:
-            name, n = default_name, 2
+            name, n = default_name, suffixes.get(default_name, 2)
             while name in used:
                 name, n = f"{default_name}_{n}", n + 1
+            suffixes[default_name] = n  # the next free suffix: naming n objects stays linear
         used.add(name)
         objects.append(SceneObject(name, mesh, model_function(spec.get("keyframes", []), file, i), source,
                                    bool(spec.get("double_sided", False))))
@@ -291,17 +366,21 @@ def load_session(path: str | os.PathLike) -> Session:
     """
     file = os.fspath(path)
     try:
-        with open(file, "rb") as f:
-            raw = f.read()
-    except OSError as e:
-        raise SessionError(f"cannot read the session file: {e.strerror}", file, None,
-                           "check the path; a relative one starts from the current folder") from None
+        raw = read_file(file, budget.document_bytes).data
+    except Refused as err:
+        if err.kind == "size":
+            raise SessionError(f"the session file {err.reason}", file, None,
+                               "raise the budget with 'rrcache --max-document-bytes N ...'") from None
+        raise SessionError(f"cannot read the session file: {'not found' if err.kind == 'missing' else 'it ' + err.reason}",
+                           file, None, "check the path; a relative one starts from the current folder"
+                           if err.kind == "missing" else err.hint) from None
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
         raise SessionError(f"the session file is not UTF-8 text (byte {e.start})", file, None) from None
     doc = parse_json(text, file)
     check_version(doc, file)
+    check_size(doc, file)
     _check_numbers(doc, file, [])
     validate_document(doc, file)
     allow_outside = bool(doc.get("allow_outside_paths", False)) or budget.allow_outside_paths
@@ -311,18 +390,15 @@ def load_session(path: str | os.PathLike) -> Session:
     objects = _objects(doc, file, assets)
     uniforms = _uniforms(doc, file)
     textures = _textures(doc, file, assets)
-    vertex = None
+    vertex = vertex_text = None
     if "vertex" in doc:
-        vertex = assets.resolve(doc["vertex"], "vertex", "vertex shader")
-        if not os.path.isfile(vertex):
-            raise AssetError(f"cannot find the vertex shader {printable(vertex)}", file, "vertex",
-                             "the path is relative to the session file's folder")
+        vertex, vertex_text = assets.text(doc["vertex"], "vertex", "vertex shader", budget.source_bytes)
     include_dirs = []
     for k, written in enumerate(doc.get("include_dirs", [])):
         where = json_path(["include_dirs", k])
-        folder = assets.resolve(written, where, "include folder")
+        folder = assets.folder(written, where, "include folder")
         if not os.path.isdir(folder):
-            raise AssetError(f"include folder not found: {printable(folder)}", file, where,
+            raise AssetError(f"include folder not found: {printable(assets.path(written, where))}", file, where,
                              "include folders are relative to the session file's folder")
         include_dirs.append(folder)
     return Session(
@@ -331,5 +407,5 @@ def load_session(path: str | os.PathLike) -> Session:
         hash=assets.digest(doc), name=doc.get("name", ""), description=doc.get("description", ""),
         background=tuple(float(c) for c in doc.get("background", (0.0, 0.0, 0.0, 0.0))), document=doc,
         include_dirs=tuple(include_dirs),
-        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex,
+        _camera=camera, _light=light, _uniforms=uniforms, vertex=vertex, vertex_text=vertex_text,
         notes=[f"{path}: {note}" for path, mesh in assets.meshes.items() for note in mesh.notes])

@@ -127,24 +127,81 @@ def _attributes(mesh) -> dict:
     return out
 
 
-def load_mesh_file(path: str) -> MeshData:
-    """Load one mesh file into MeshData; raise MeshLoadError with a reason on failure."""
-    import trimesh
+class _ConfinedResolver:
+    """trimesh's resolver for the files a mesh names (an OBJ's material library, a glTF's
+    buffers): each read by :mod:`rrcache.files`' rule, inside ``roots`` (None: anywhere) and the
+    asset budget; a refused one reads as missing, as trimesh expects."""
+
+    def __init__(self, folder: str, roots):
+        self.parent, self.roots = folder, roots
+
+    def get(self, name: str) -> bytes:
+        from rrcache.budgets import budget
+        from rrcache.files import Refused, read_file
+
+        path = os.path.normpath(os.path.join(self.parent, str(name)))
+        try:
+            return read_file(path, budget.asset_bytes, self.roots).data
+        except Refused as err:
+            raise FileNotFoundError(f"{name}: {err.reason}") from None
+
+    def __getitem__(self, name: str) -> bytes:
+        return self.get(name)
+
+    def namespaced(self, namespace: str) -> "_ConfinedResolver":
+        return _ConfinedResolver(os.path.join(self.parent, namespace), self.roots)
+
+    def keys(self):
+        return []
+
+    def write(self, name, data):
+        raise OSError("rrcache writes nothing beside a mesh")
+
+
+def confined_resolver(folder: str, roots=None) -> _ConfinedResolver:
+    """The resolver of the files a mesh in ``folder`` names (see :class:`_ConfinedResolver`)."""
+    return _ConfinedResolver(folder, roots)
+
+
+def load_mesh_file(path: str, roots=None) -> MeshData:
+    """Load one mesh file into MeshData, read by :mod:`rrcache.files`' rule (a regular file
+    within ``rrcache --max-asset-bytes``; inside ``roots`` when given); raise MeshLoadError with a
+    reason on failure."""
+    from rrcache.budgets import budget
+    from rrcache.files import Refused, read_file
 
     ext = os.path.splitext(path)[1].lower()
     if ext not in FORMATS:
         raise MeshLoadError(f"unsupported mesh format {ext or '(none)'!r}; use one of {', '.join(FORMATS)}")
-    if not os.path.isfile(path):
-        raise MeshLoadError("mesh file not found")
+    try:
+        data = read_file(path, budget.asset_bytes, roots,
+                         limit_hint="raise it with 'rrcache --max-asset-bytes N ...'").data
+    except Refused as err:
+        raise MeshLoadError("mesh file not found" if err.kind == "missing" else f"the mesh file {err.reason}")
+    return load_mesh_data(data, ext, confined_resolver(os.path.dirname(path), roots))
+
+
+def load_mesh_data(data: bytes, ext: str, resolver=None) -> MeshData:
+    """The mesh held in ``data`` (the bytes of a file of format ``ext``); the files it names
+    (materials, buffers) come through ``resolver``. Raises MeshLoadError."""
+    import io
+
+    import trimesh
+
+    if ext not in FORMATS:
+        raise MeshLoadError(f"unsupported mesh format {ext or '(none)'!r}; use one of {', '.join(FORMATS)}")
+    check_header(data, ext)
     with _quiet_trimesh() as (records, caught):
         try:
-            loaded = trimesh.load(path, process=False)
+            loaded = trimesh.load(io.BytesIO(data), file_type=ext.lstrip("."), process=False, resolver=resolver)
             parts = [_attributes(p) for p in _parts(loaded)]
         except ImportError as exc:
             raise _missing_package(exc) from None
         except Exception as exc:  # trimesh raises many types on a corrupt file
             first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
             raise MeshLoadError(f"cannot read mesh: {type(exc).__name__}" + (f": {first}" if first else "")) from None
+    for p in parts:
+        _check_part(p, data, ext)
     for record in records:
         inner = record.exc_info[1] if record.exc_info else None
         if isinstance(inner, ImportError) and not parts:
@@ -180,3 +237,85 @@ def load_mesh_file(path: str) -> MeshData:
                     texcoords=None if texcoords is None else texcoords.astype(np.float32),
                     colors=None if colors is None else colors.astype(np.float32), tangents=tangents,
                     notes=tuple(notes))
+
+
+def _check_part(part: dict, data: bytes, ext: str) -> None:
+    """A loaded part has three coordinates per vertex and triangles that index its vertices
+    (an OBJ line ``v 0 0`` gave trimesh two-coordinate vertices)."""
+    v, f = part["positions"], part["indices"]
+    if v.ndim != 2 or v.shape[1] != 3:
+        where = ""
+        if ext == ".obj":
+            for number, line in enumerate(data.decode("utf-8", "replace").splitlines(), 1):
+                words = line.split()
+                if words and words[0] == "v" and len(words) < 4:
+                    where = f" (line {number}: 'v' with {len(words) - 1} coordinate{'s' if len(words) != 2 else ''})"
+                    break
+        raise MeshLoadError(f"the vertices have {v.shape[1] if v.ndim == 2 else 0} coordinates, a mesh needs 3 "
+                            f"(x y z){where}")
+    if f.ndim != 2 or f.shape[1] != 3 or (f.size and (f.min() < 0 or f.max() >= len(v))):
+        raise MeshLoadError("the faces are not triangles of the file's vertices")
+
+
+#: the fewest bytes one value takes in a binary PLY (by type name), and in ASCII (a digit and a
+#: separator)
+_PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2, "uint16": 2,
+              "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}
+_ASCII_VALUE = 2
+
+
+def check_header(data: bytes, ext: str) -> None:
+    """Refuse a PLY or OFF whose header declares more vertices and faces than the file's bytes
+    can hold (a few hundred bytes claiming 10⁹ vertices), before any array is made for them.
+
+    >>> check_header(b"OFF\\n1000000000 1 0\\n0 0 0\\n", ".off")
+    Traceback (most recent call last):
+    ...
+    rrcache.session.meshes.MeshLoadError: the OFF header declares 1,000,000,000 vertices and 1 faces, which need at least 6,000,000,008 bytes; the file has 25
+    """
+    if ext == ".ply":
+        _check_ply(data)
+    elif ext == ".off":
+        _check_off(data)
+
+
+def _claim(what: str, counts: dict, need: int, have: int) -> None:
+    if need > have:
+        said = " and ".join(f"{n:,} {name}" for name, n in counts.items())
+        raise MeshLoadError(f"the {what} header declares {said}, which need at least {need:,} bytes; "
+                            f"the file has {have:,}")
+
+
+def _check_ply(data: bytes) -> None:
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        return  # trimesh says what is wrong with it
+    body = len(data) - data.find(b"\n", end) - 1
+    binary, elements = True, []
+    for line in data[:end].decode("ascii", "replace").splitlines():
+        words = line.split()
+        if len(words) >= 2 and words[0] == "format":
+            binary = words[1] != "ascii"
+        elif len(words) >= 3 and words[0] == "element" and words[2].isdigit():
+            elements.append([words[1], int(words[2]), 0])
+        elif len(words) >= 3 and words[0] == "property" and elements:
+            if words[1] == "list" and len(words) >= 4:  # at least the count of each list
+                elements[-1][2] += _PLY_SIZES.get(words[2], 1) if binary else _ASCII_VALUE
+            else:
+                elements[-1][2] += _PLY_SIZES.get(words[1], 1) if binary else _ASCII_VALUE
+    need = sum(count * size for _, count, size in elements)
+    plural = {"vertex": "vertices", "face": "faces"}
+    _claim("PLY", {plural.get(name, f"'{name}' elements"): count for name, count, _ in elements}, need, body)
+
+
+def _check_off(data: bytes) -> None:
+    words = data[:4096].split()
+    if not words or not words[0].endswith(b"OFF"):
+        return
+    numbers = [w for w in words[1:4] if w.isdigit()]
+    if len(numbers) < 2:
+        return
+    vertices, faces = int(numbers[0]), int(numbers[1])
+    # "x y z\n" and "3 a b c\n": three and four values of at least two bytes each
+    _claim("OFF", {"vertices": vertices, "faces": faces}, vertices * 3 * _ASCII_VALUE + faces * 4 * _ASCII_VALUE,
+           len(data))

@@ -219,6 +219,8 @@ class Session:
     document: dict = field(default_factory=dict, repr=False)
     #: the user's vertex shader file (``"vertex"``, resolved), or None for a generated one
     vertex: str | None = None
+    #: that file's text, read (by :mod:`rrcache.files`' rule, confined) when the session loaded
+    vertex_text: str | None = field(default=None, repr=False)
     #: what loading the session's assets had to say that is not an error (one line each)
     notes: list = field(default_factory=list)
     #: the session's "include_dirs", resolved against its folder (after the command line's -I)

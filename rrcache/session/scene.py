@@ -65,6 +65,20 @@ def _check_view(eye, target, up, file: str, where: str) -> None:
                            "give an 'up' that is not along eye→target")
 
 
+def _first_bad_view(eyes: np.ndarray, targets: np.ndarray, ups: np.ndarray):
+    """The index of the first view (rows of n×3 arrays) :func:`_check_view` refuses, or None: the
+    same tests for every keyframe at once (one keyframe at a time took a millisecond each)."""
+    with np.errstate(all="ignore"):
+        big = np.max(np.abs(np.concatenate([eyes, targets, ups], axis=1)), axis=1)
+        f = targets - eyes
+        scale = np.maximum(1.0, np.maximum(np.abs(eyes).max(axis=1), np.abs(targets).max(axis=1)))
+        fn, un = np.linalg.norm(f, axis=1), np.linalg.norm(ups, axis=1)
+        cross = np.linalg.norm(np.cross(f / fn[:, None], ups / un[:, None]), axis=1)
+        ok = (big <= MAX_COORDINATE) & (fn > 1e-9 * scale) & (un != 0.0) & (cross >= 1e-6)
+    bad = np.flatnonzero(~ok)
+    return int(bad[0]) if len(bad) else None
+
+
 def camera_function(cam: dict, file: str) -> Callable[[int], Camera]:
     """frame → Camera; ``fov`` 45, ``near`` 0.1, ``far`` 100 and ``up`` [0, 1, 0] by default."""
     fov, near, far = float(cam.get("fov", 45.0)), float(cam.get("near", 0.1)), float(cam.get("far", 100.0))
@@ -80,9 +94,10 @@ def camera_function(cam: dict, file: str) -> Callable[[int], Camera]:
     check_sorted(kfs, file, ["camera", "keyframes"])
     eye, target = channel(kfs, "eye", [0.0, 0.0, 1.0]), channel(kfs, "target", [0.0, 0.0, 0.0])
     up = channel(kfs, "up", up0)
-    for k, kf in enumerate(kfs):
-        f = kf["frame"]
-        _check_view(eye.at(f), target.at(f), up.at(f), file, json_path(["camera", "keyframes", k]))
+    views = [np.array([track.at(kf["frame"]) for kf in kfs], dtype=np.float64) for track in (eye, target, up)]
+    k = _first_bad_view(*views)
+    if k is not None:
+        _check_view(views[0][k], views[1][k], views[2][k], file, json_path(["camera", "keyframes", k]))
     return lambda frame: Camera(eye.at(frame), target.at(frame), up.at(frame), fov, near, far)
 
 

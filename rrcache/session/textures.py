@@ -16,31 +16,54 @@ one of the cross layouts glslViewer (and cmft, CubeMapGen) read (see :func:`spli
 """
 from __future__ import annotations
 
-import os
 
 import numpy as np
 
 from rrcache.budgets import budget
 from rrcache.errors import printable
+from rrcache.files import OpenedFile, Refused, open_file
 from rrcache.stdio import quiet_stderr
 
 
 class ImageLoadError(Exception):
-    """Raised by the readers; the loader turns it into an AssetError with the JSON path."""
+    """Raised by the readers; the loader turns it into an AssetError with the JSON path (and
+    ``hint``, when the reader has one)."""
+
+    def __init__(self, message: str, hint=None):
+        super().__init__(message)
+        self.hint = hint
 
 
 def _clean(text: str) -> str:
     return printable(" ".join(str(text).split()))[:300]
 
 
-def _open(path: str):
-    """An open ImageInput for ``path`` and its spec, the size checked against the pixel budget."""
+def open_image_file(path: str, roots=None) -> OpenedFile:
+    """The image file ``path`` opened by :mod:`rrcache.files`' rule (a regular file within
+    ``rrcache --max-asset-bytes``, inside ``roots`` when given); ImageLoadError saying what it is
+    otherwise (a FIFO or a device as such, not as "not found")."""
+    try:
+        return open_file(path, budget.asset_bytes, roots, limit_hint="raise it with 'rrcache --max-asset-bytes N ...'")
+    except Refused as err:
+        if err.kind == "missing":
+            raise ImageLoadError("image file not found" if "NUL" not in err.reason else err.reason) from None
+        if err.kind == "outside":
+            raise
+        raise ImageLoadError(f"the image file {err.reason}", err.hint) from None
+
+
+def _open(source: "str | OpenedFile"):
+    """An open ImageInput for ``source`` (a path, or a file opened by :func:`open_image_file`,
+    read through its descriptor) and its spec, the size checked against the pixel budget."""
     import OpenImageIO as oiio
 
-    if not os.path.isfile(path):
-        raise ImageLoadError("image file not found")
-    with quiet_stderr():
-        inp = oiio.ImageInput.open(path)
+    opened = source if isinstance(source, OpenedFile) else open_image_file(source)
+    try:
+        with quiet_stderr():
+            inp = oiio.ImageInput.open(opened.library_path)
+    finally:
+        if opened is not source:
+            opened.close()
     if inp is None:
         raise ImageLoadError(f"cannot read image: {_clean(oiio.geterror()) or 'unknown format'}")
     spec = inp.spec()
@@ -57,7 +80,7 @@ def _open(path: str):
     return inp, spec
 
 
-def read_header(path: str) -> tuple[int, int, int]:
+def read_header(path: "str | OpenedFile") -> tuple[int, int, int]:
     """(width, height, channels) of the image ``path`` from its header, nothing decoded; raises
     :class:`ImageLoadError` for a missing or unreadable file or one beyond the pixel budget."""
     inp, spec = _open(path)
@@ -65,7 +88,7 @@ def read_header(path: str) -> tuple[int, int, int]:
     return int(spec.width), int(spec.height), int(spec.nchannels)
 
 
-def read_image(path: str) -> np.ndarray:
+def read_image(path: "str | OpenedFile") -> np.ndarray:
     """Decode the first subimage of ``path`` into float32 H×W×C (row 0 = top row)."""
     import OpenImageIO as oiio
 

@@ -1,0 +1,52 @@
+"""A Dask scheduler and workers started as separate processes on localhost ports, as a farm runs
+them (``dask scheduler`` on one machine, ``dask worker ADDRESS`` on each of the others)."""
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+
+@contextlib.contextmanager
+def local_farm(folder, workers: int = 2, env=None):
+    """Start a scheduler and ``workers`` worker processes (one thread each) whose files are in
+    ``folder``; yield the scheduler's address; stop them all (by their process ids)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ, **(env or {}))
+    file = folder / "scheduler.json"
+    logs, procs = [], []
+
+    def spawn(name, args):
+        log = open(folder / f"{name}.log", "w")
+        logs.append(log)
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", *args], stdout=log, stderr=subprocess.STDOUT,
+                                      env=env, start_new_session=True))
+
+    try:
+        spawn("scheduler", ["scheduler", "--host", "127.0.0.1", "--port", "0", "--dashboard-address", ":0",
+                            "--scheduler-file", str(file)])
+        deadline = time.time() + 60
+        while not file.exists() and time.time() < deadline:
+            assert procs[0].poll() is None, (folder / "scheduler.log").read_text()
+            time.sleep(0.1)
+        address = json.loads(file.read_text())["address"]
+        for i in range(workers):
+            spawn(f"worker{i}", ["worker", address, "--nthreads", "1", "--nworkers", "1", "--host", "127.0.0.1",
+                                 "--name", f"farm-{i}", "--no-dashboard"])
+        yield address
+    finally:
+        for proc in reversed(procs):
+            if proc.poll() is None:
+                os.killpg(proc.pid, signal.SIGTERM)
+        for proc in reversed(procs):
+            try:
+                proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+        for log in logs:
+            log.close()
