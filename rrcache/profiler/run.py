@@ -72,7 +72,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             warnings.simplefilter("always")
             try:
                 prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught)
+                                include_dirs, wait, vertex, adaptive, caught, max_flip)
             finally:
                 raised = list(caught)
     finally:
@@ -82,7 +82,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
 
 def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list) -> Profile:
+             vertex, adaptive, caught: list, max_flip: Optional[float] = None) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
