@@ -92,6 +92,9 @@ def supervise(argv: list[str], timeout_s: float) -> int:
         child = subprocess.Popen([sys.executable, "-m", "rrcache", *argv], env=env, pass_fds=(write_fd,))
     finally:
         os.close(write_fd)
+    # a SIGTERM sent to this process is passed on: the child stops as it would itself (its message,
+    # its store marked interrupted) and its exit code is this one's
+    old_term = signal.signal(signal.SIGTERM, lambda signum, frame: child.send_signal(signal.SIGTERM))
     running: Optional[tuple[float, int, str]] = None
     buffer = b""
     try:
@@ -125,3 +128,4 @@ def supervise(argv: list[str], timeout_s: float) -> int:
     finally:
         os.close(read_fd)
         signal.signal(signal.SIGINT, old_int)
+        signal.signal(signal.SIGTERM, old_term)

@@ -82,6 +82,7 @@ def test_render_node_says_its_algorithm(demo, capsys):
     main(["render", str(demo.path), "--node", sel.node, "--frames", "3", "--json"])
     captured = capsys.readouterr()
     assert json.loads(captured.out)["algorithm"] == demo.algorithm
+    assert json.loads(captured.out)["filter"] == demo.filter  # the profile's cache filter too
     assert f"{demo.algorithm} (the profile's choice" in captured.err
 
 

@@ -50,8 +50,12 @@ def test_cli_reports_one_located_error_without_traceback(path, capsys):
     assert message.split("'")[0].strip().lower()[:20] in err_lines[0].lower()
 
 
-def test_debug_flag_shows_the_traceback():
+def test_debug_flag_shows_the_traceback(capsys):
+    """--debug adds the traceback and keeps the error's exit code (2, not the interpreter's 1)."""
     path = HERE / "malformed" / "01_missing_semicolon.frag"
-    from rrcache.errors import ParseError
-    with pytest.raises(ParseError):
+    with pytest.raises(SystemExit) as done:
         main(["--debug", "nodes", str(path)])
+    err = capsys.readouterr().err
+    assert done.value.code == 2
+    assert "Traceback (most recent call last)" in err and "ParseError" in err
+    assert err.strip().splitlines()[-1].startswith("rrcache: error: ") and "01_missing_semicolon.frag:4:5" in err

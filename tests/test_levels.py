@@ -83,7 +83,7 @@ def _table_text(prof, rows) -> str:
     shown = copy.copy(prof)
     shown.selections = rows
     console = Console(record=True, width=220)
-    console.print(_table(shown))
+    _table(shown).print(console)
     return console.export_text()
 
 

@@ -141,3 +141,21 @@ def test_panning_brings_surfaces_in_from_outside_the_screen(gl_ctx, tmp_path):
         assert columns.min() >= SIZE[0] - 4 and outside[:, -1][frame.mask[:, -1]].all()
         share = frame.miss_causes["blocks"]["outside"] / frame.miss_causes["covered_blocks"]
         assert 0 < share < 0.5
+
+
+def test_plane_with_the_depth_packed_in_the_payload_hits_alike(gl_ctx, tmp_path):
+    """``instance(..., filter="plane", pack_depth=True)``: the texel test reads the payload's
+    channel instead of the inverse-depth texture, and hits the same pixels with the same colours."""
+    from rrcache.compiler import instance
+
+    session, work, _node = _load(tmp_path, "packed", ball_moves=True)
+    node = [n for n in work.table.nodes if n.type in ("float", "vec2", "vec3")][-1]  # a free channel
+    runs = []
+    for packed in (False, True):
+        variant = instance(work.table, node.id, "three-pass", "plane", "f4", work.vertex, pack_depth=packed)
+        assert (variant.depth_channel is not None) == packed
+        with CachedRenderer(variant, session, work.prepared, SIZE, period=NEVER, hit_maps=True) as cached:
+            runs.append([cached.render_frame(i) for i in range(4)])
+    for plain, packed in list(zip(*runs))[1:]:  # frame 0 has no cache
+        assert (plain.hit_map == packed.hit_map).all() and plain.hits > 0
+        assert np.abs(plain.image - packed.image).max() <= 2e-4

@@ -89,7 +89,7 @@ def test_widget_events_from_another_thread_run_on_the_gl_thread(executed):
     import threading
 
     from rrcache.profiles import load_profile
-    from rrcache.report.explore import Explorer
+    from rrcache.explorer import Explorer
 
     folder, _, _ = executed
     prof = load_profile(folder / "demo.rrprofile")

@@ -27,6 +27,7 @@ from rrcache.profiler import profile
 from rrcache.profiles import TrainingSettings, load_profile, read_store, select
 from rrcache.profiles.document import algorithm_line
 from rrcache.selection import CachedNode, Selection
+from rrcache.choice import write as choice_write
 
 from scene_files import SETTINGS, write_scene
 
@@ -112,7 +113,7 @@ def test_auto_algorithm_keeps_the_faster_variant(trained):
     # this tiny scene's selections are all the original (its variants cost more than it), so
     # write a trained node's variant the way selections are written
     node = prof.trained_nodes[0].id
-    prof.write_variant(Selection((CachedNode(node, 13),)), folder / "chosen")
+    choice_write(prof, Selection((CachedNode(node, 13),)), folder / "chosen")
     manifest = json.loads((folder / "chosen" / "manifest.json").read_text())
     assert manifest["algorithm"] == prof.algorithm and manifest["period"] == 13  # what it runs with
     assert manifest["runtime"] == {"block": 4, "refresh": "random", "depth_epsilon": 1e-3}

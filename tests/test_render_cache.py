@@ -29,7 +29,7 @@ from rrcache.alternatives.render_cache.sampling import (blocks_to_pixels, dither
                                                         predicted_requests, scaled)
 from rrcache.alternatives.render_cache.tune import compare
 from rrcache.errors import RRCacheError
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer
 from rrcache.session import load_session
 from rrcache.session.camera import look_at, perspective

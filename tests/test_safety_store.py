@@ -15,7 +15,7 @@ import pytest
 
 from rrcache.errors import RRCacheError
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
-from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, StoreKey, TimingFrame
+from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, StoreKey, TimingFrame, read_store
 from safety_cli import QUICK_PROFILE, env, one_error_line, rrcache, write_case
 
 AREA = "safety: one store, one writer; stored rows checked"
@@ -96,7 +96,7 @@ def test_wait_takes_the_lock_when_the_holder_ends(tmp_path, stability_case):
 def _store(tmp_path):
     store = ProfileStore.open(tmp_path / "profile.sqlite", KEY)
     store.begin_run()
-    store.add_error_run(ErrorRun("n3", 8, 0.01, 40.0, 0.8, 80, 20, 100, 6, 0.5),
+    store.add_error_run(ErrorRun("n3", 8, 0.01, 40.0, 0.8, 80, 20, 100, 1, 0.5),
                         [ErrorFrame(1, 0.01, 40.0, 80, 20, 100)])
     store.add_timing_run("n3", 8, [TimingFrame(1, 80, 20, 1.5, 2.0)], 0.2)
     store.add_reference_timing([(1, 2.0, 100)])
@@ -122,7 +122,12 @@ def test_tampered_rows_are_refused(tmp_path, stability_case, name):
     with sqlite3.connect(tmp_path / "profile.sqlite") as conn:
         conn.execute(sql)
     case = stability_case(f"stored row: {name}", AREA, sql)
-    store = ProfileStore.open(tmp_path / "profile.sqlite", KEY)
+    # a run resuming on the store refuses it when it opens it (every row checked)...
+    with pytest.raises(RRCacheError) as at_open:
+        ProfileStore.open(tmp_path / "profile.sqlite", KEY)
+    assert expected in str(at_open.value) and "--fresh" in str(at_open.value)
+    # ...and a reader of the rows (a report, a test) refuses the row it reads
+    store = read_store(tmp_path / "profile.sqlite")
     try:
         with pytest.raises(RRCacheError) as info:
             if reader == "error_frames":

@@ -176,3 +176,45 @@ def test_a_sum_without_weights_is_ordered_by_measured_scores(gl_ctx):
     texts = [n.text for n in _partial_sums(reordered)]
     assert any("the 4 that measured the least" in t for t in texts)
     assert any(t.endswith("the static part (without u_light)") for t in texts)
+
+
+def test_a_profile_measures_the_order_when_asked_and_keeps_it(tmp_path):
+    """``TrainingSettings(measure_terms=True)``: the scores are measured before training, kept in
+    the store (a resumed profile reuses them) and in profile.json, and the profile's node ids are
+    those of the ordered program: loading the shader with its scores finds the same texts."""
+    from rrcache.profiler import profile
+    from rrcache.profiles import TrainingSettings, load_profile
+    from rrcache.profiles.choice import load_work
+
+    settings = TrainingSettings(periods=(2,), timing_periods=(2,), timing_frames=2, frames=3,
+                                resolution=(32, 32), validate=False, budget_s=1e-6, min_gain=0, max_sets=0,
+                                filter="bilinear", measure_terms=True)
+    prof = profile(CORPUS / "many_lights_loop.glsl", CORPUS / "many_lights_loop.json", tmp_path / "out",
+                   settings, plots=False)
+    (key, scores), = prof.term_scores.items()
+    assert len(scores) == 8
+    reread = load_profile(tmp_path / "out")
+    assert reread.term_scores == prof.term_scores
+    work, _session = load_work(reread)
+    texts = {n.id: n.text for n in work.table.nodes}
+    assert all(texts.get(n.id) == n.text for n in reread.nodes)
+    assert any("measured the least" in t for t in texts.values())
+    again = profile(CORPUS / "many_lights_loop.glsl", CORPUS / "many_lights_loop.json", tmp_path / "out",
+                    settings, plots=False)
+    assert again.term_scores == prof.term_scores
+
+
+def test_a_static_part_written_in_one_expression_is_named():
+    """The chess shader keeps the king's occlusion apart (``aoStatic * aoKing``): the static
+    part's node is named as such (rrcache.analysis.static_parts), without a session it is not."""
+    from rrcache.glsl.frontend import load_shader
+    from rrcache.analysis import cacheable_nodes
+
+    root = Path(__file__).resolve().parents[1]
+    session = load_session(root / "sessions" / "chess.json")
+    work = load_for_session(root / "shaders" / "ambient_occlusion.glsl", session)
+    named = [n.text for n in work.table.nodes if "the static part" in n.text]
+    assert named == ["1.0 - clamp(OCCLUSION_GAIN * staticOcclusion(receiver, N), 0.0, 1.0), "
+                     "the static part of aoStatic * aoKing (without u_kingOffset)"]
+    bare = cacheable_nodes(load_shader(root / "shaders" / "ambient_occlusion.glsl"))
+    assert not any("static part" in n.text for n in bare.nodes)

@@ -60,7 +60,7 @@ def render_row(row: dict) -> tuple[np.ndarray, float, int]:
     from rrcache.harness.renderer import Renderer
     from rrcache.pipeline import variant_for_selection
     from rrcache.profiles import load_profile
-    from rrcache.profiles.choice import load_work
+    from rrcache.choice import load_work
 
     prof = load_profile(row["profile"])
     sel = next(s for s in list(prof.measured) + list(prof.selections) if json.dumps(s.key) == row["key"])

@@ -91,6 +91,7 @@ from rrcache.analysis.cost import CACHE_LOOKUP_COST, loop_trips, op_cost
 from rrcache.analysis.loops import Constants, global_scalars
 from rrcache.analysis.pipeline import analyse
 from rrcache.analysis.source_text import attach_source_text
+from rrcache.analysis.static_parts import name_static_parts
 from rrcache.analysis.sums import name_partial_sums
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
 
@@ -247,6 +248,7 @@ def cacheable_nodes(shader, *, max_iterations: int = DEFAULT_MAX_ITERATIONS,
         if not analysed:  # the text as written, and the file, of nodes from inlined code
             attach_source_text(table, shader.unit)
         name_partial_sums(table, target.unit, moving, scores)
+        name_static_parts(table, target.unit, moving)
         return table
 
 

@@ -192,19 +192,21 @@ def run(shader_path: str, session_path: str, node_id: str, periods=(8, 16, 32), 
         progress: Optional[Callable[[str, int, int], None]] = None, blocks=(1, 2, 4), repeats: int = 3,
         limit_algorithm: str = "three-pass", color_format: str = DEFAULT_TIMING_FORMAT, vertex: Optional[str] = None,
         include_dirs=(), filters=(), misses: bool = False, limit_filter: str = DEFAULT_FILTER,
-        algorithms=("three-pass", "two-pass", "one-pass"), base_filter: str = DEFAULT_FILTER) -> CacheBench:
+        algorithms=("three-pass", "two-pass", "one-pass"), base_filter: str = DEFAULT_FILTER,
+        term_scores=None) -> CacheBench:
     """Run the benchmark; ``frames`` consecutive frames from ``start`` per configuration
     (``periods=()`` or ``blocks=()`` leave those rows out); the limit is that of
     ``limit_algorithm`` and ``limit_filter``; every render draws into a ``color_format`` colour
     target (the errors are then those of that format). ``base_filter``: the filter of every row
-    but the filters' own (a profile's). ``algorithms``: those compared at the
+    but the filters' own (a profile's); ``term_scores``: a profile's measured order of sums (its node
+    ids refer to it). ``algorithms``: those compared at the
     compared period (the ones the node allows). ``filters``: the filters timed at the
     compared period; ``misses``: each of them (bilinear when none) measured again with the misses
     sorted by cause. ``progress(message, done, total)`` after each step. ``vertex``: the user's
     vertex shader (None: the session's, else generated)."""
     step = {"done": 0}
     session = load_session(session_path)
-    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex)
+    work = load_for_session(shader_path, session, include_dirs=include_dirs, vertex=vertex, term_scores=term_scores)
     entry = work.node(node_id)
     indices = range(start, min(start + frames, session.frames))
     size = resolution or session.resolution

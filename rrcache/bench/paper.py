@@ -467,6 +467,8 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
         warnings.simplefilter("always")
         prof = profile(scene.shader, session_path, folder, training, progress=on_event, plots=settings.plots)
     result.notes += [f"profile: {w.message}" for w in caught]
+    if prof.term_scores:  # the profile measured the order of its sums: its node ids refer to it
+        work = load_for_session(scene.shader, session, term_scores=prof.term_scores)
     work.filter = prof.filter  # the selections compile with the profile's filter
     result.filter = prof.filter
     result.filter_times = (prof.plan or {}).get("filter_times")
@@ -501,12 +503,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     if medium.label != MEDIUM:
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
-    if medium.kind != "cache":  # an amortized estimator or several nodes: the algorithms and limit are one node's
-        what = ("amortized sampling" if medium.kind == "amortize" else "several cached nodes" if medium.multi
-                else f"a selection of kind {medium.kind}")
+    if not medium.choice.one_node:  # an amortized estimator, several nodes: the algorithms and limit are one node's
         if medium.multi:  # the all-hit limit of the set (the algorithms and the misses are one node's)
             _set_limit(prof, work, session, frames, medium, result, progress)
-        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({what}): the "
+        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({medium.choice.title}): the "
                             "algorithms and the miss breakdown are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:
             result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)
@@ -518,6 +518,7 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     bench = cache_bench.run(scene.shader, session_path, medium.node, periods=(), compare_period=int(medium.period),
                             frames=len(frames), blocks=(), repeats=1, limit_algorithm=prof.algorithm,
                             base_filter=prof.filter, limit_filter=prof.filter, misses=True,
+                            term_scores=prof.term_scores,
                             progress=lambda msg, done, total: _say(progress, f"algorithms: {msg}", done, total))
     result.misses = [asdict(m) for m in bench.misses]
     result.algorithms = [MethodRow(r.algorithm, f"Δn={r.period}, k={r.block}", r.speedup, r.mean_error, _cap(r.psnr),

@@ -111,7 +111,7 @@ def run(bench_out, scenes=("chess",), labels=("e3",), frames: Optional[int] = No
                                 else (scene["shader"], scene["session"]))
         prof = load_profile(scene["profile"])
         session = load_session(session_path)
-        work = load_for_session(shader, session)
+        work = load_for_session(shader, session, term_scores=prof.term_scores)
         work.filter = prof.filter
         indices = list(range(session.frames if frames is None else min(frames, session.frames)))
         for sel_doc in scene["selections"]:

@@ -292,7 +292,7 @@ def mask_cost(scene, out, densities=(0.01, 0.03, 0.1, 0.3), blocks=(1, 2, 4), re
     """The renderer's frame through sample masks against the whole frame (see the module docstring)."""
     from rrcache.alternatives.render_cache.sampling import blocks_to_pixels, grid_size
     from rrcache.alternatives.render_cache.shading import SampleShader
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -330,7 +330,7 @@ def zbuffer_cost(scene, out, tiles=(16, 32, 64), repeats: int = 9, frames: int =
     """The z-buffer of a real point cache, untiled and tiled (see the module docstring)."""
     from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
     from rrcache.alternatives.render_cache.projection import zbuffer
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -403,7 +403,7 @@ def projection_cost(scene, out, repeats: int = 9, frames: int = 8, samples: floa
     from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.gl.resources import GLScope
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -548,7 +548,7 @@ def filters_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float =
     from rrcache.alternatives.render_cache.filters import depth_cull, reconstruct
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.gl.resources import GLScope
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -653,7 +653,7 @@ def sweep(scene, out, configs: list, shares, frames: int = 40) -> dict:
     """Each config at each share beside the original (see the module docstring)."""
     from rrcache.alternatives.render_cache import RenderCacheSettings
     from rrcache.alternatives.render_cache.tune import compare
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.harness.renderer import Renderer
     from rrcache.session import load_session
 

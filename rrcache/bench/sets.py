@@ -3,7 +3,7 @@
 ``python -m rrcache.bench.sets PROFILE SHADER SESSION --pairs 4 --out result.json`` loads a
 trained profile, predicts every pair of its trained nodes at the period pair the rule finds best
 against the single-node front (improving or not) and measures the ``--pairs`` best of them, plus any ``--set
-n1:4,n2:50``, exactly as the profiler's set stage trains a set (:class:`rrcache.profiler.sets._Runner`:
+n1:4,n2:50``, exactly as the profiler's set stage trains a set (:func:`rrcache.profiler.sets.train_set`:
 the error over the training frames in the error window, the time on the timing frames each
 beside the original). It prints and writes predicted against measured error and time, and with
 ``--plot`` draws the single-node front, the front with the measured sets and the profile's
@@ -38,7 +38,9 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
     """Predict and measure (see the module docstring); returns the JSON-able result."""
     from rrcache.model.sets import SetOption, _pair_grids, _SingleFront, set_prediction
     from rrcache.pipeline import load_for_session
-    from rrcache.profiler.sets import _Runner, feeds, layout_for
+    from rrcache.harness.execute import Bench, LocalExecutor
+    from rrcache.profiler.jobs import Meter
+    from rrcache.profiler.sets import feeds, layout_for, train_set
     from rrcache.profiles import load_profile
     from rrcache.session import load_session
 
@@ -62,12 +64,12 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
         rows = [table.node_ids.index(n) for n in nodes]
         err, ms = set_prediction(table, rows, periods, relation, layout)
         chosen.append(SetOption(nodes, periods, layout, err, ms, None, 0.0))
-    runner = _Runner(prof, work, session, prof.settings, None)
+    executor = LocalExecutor(Bench(work, session))
     rows_out = []
     try:
         for o in chosen:
             start = clock()
-            runner.train(o)
+            train_set(prof, prof.settings, session, o, executor, Meter(None))
             idx = [table.node_ids.index(n) for n in o.nodes]
             nested = [(o.nodes[a], o.nodes[b]) for a in range(len(idx)) for b in range(len(idx))
                       if (idx[a], idx[b]) in relation]
@@ -81,7 +83,7 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
                   f"measured {o.trained_error:.4f} {prof.original_ms / o.trained_ms:.2f}×  (gain {o.gain:.2f}, "
                   f"feeds {nested})", flush=True)
     finally:
-        runner.release()
+        executor.close()
     return {"profile": str(profile_dir), "original_ms": prof.original_ms, "layout": layout,
             "algorithm": prof.algorithm, "sets": rows_out,
             "selections": [s.to_json() for s in prof.selections]}

@@ -12,10 +12,12 @@ import importlib
 import math
 import os
 import sys
+import traceback
 
 import click
 
 from rrcache import watchdog
+from rrcache.cli import interrupt
 from rrcache.budgets import MAX_READ_BYTES, budget, reset_budget
 from rrcache.errors import RRCacheError, printable
 
@@ -111,11 +113,31 @@ def _environment_error(err: OSError) -> None:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
     hint = {errno.ENOSPC: "free disk space and run the command again",
+            errno.EBADF: "run it with its output open (a closing '>&-' leaves it none), or redirect it to a file",
             errno.EROFS: "write to a folder on a writable file system (--out)",
             errno.EACCES: "choose a folder you can write to (--out)",
             errno.EPIPE: "the reader of the output went away"}.get(err.errno, "check the path and the disk")
     click.echo(f"rrcache: error: {printable(str(where))}: {printable(err.strerror or str(err))} (hint: {hint})", err=True)
     sys.exit(2)
+
+
+class _ClosedOutput:
+    """``sys.stdout`` when the process started without descriptor 1: the first write is an
+    ``OSError`` the command line reports in one line (exit 2) after the work is done and saved."""
+
+    encoding = "utf-8"
+
+    def write(self, text):
+        raise OSError(errno.EBADF, "standard output is closed", "output")
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return False
+
+    def fileno(self):
+        raise OSError(errno.EBADF, "standard output is closed", "output")
 
 
 _ARGV = None  # the arguments main() was given (for the frame watchdog's child process)
@@ -126,12 +148,15 @@ def main(argv=None):
     global _ARGV
     _ARGV = list(argv) if argv is not None else None
     debug = "--debug" in (argv if argv is not None else sys.argv[1:])
+    interrupt.install()
+    if sys.stdout is None:  # started with its standard output closed ('>&-')
+        sys.stdout = _ClosedOutput()
     try:
         cli.main(args=argv, prog_name="rrcache", standalone_mode=False)
         sys.stdout.flush()  # a full or closed output fails here, while we can still say so
     except RRCacheError as err:
-        if debug:
-            raise
+        if debug:  # the traceback, then the same line and the same exit code as without --debug
+            traceback.print_exc()
         click.echo(f"rrcache: error: {printable(str(err))}", err=True)
         sys.exit(2)
     except click.exceptions.Abort:
@@ -149,13 +174,13 @@ def main(argv=None):
         click.echo(f"rrcache: error: {printable(err.format_message())}{hint}", err=True)
         sys.exit(err.exit_code)
     except KeyboardInterrupt:
-        click.echo("rrcache: interrupted", err=True)
-        sys.exit(130)
+        click.echo(f"rrcache: {interrupt.word()}", err=True)
+        sys.exit(interrupt.exit_code())
     except SystemExit:
         raise
     except OSError as err:  # the machine's side: a full disk, a read-only folder, a closed pipe
         if debug:
-            raise
+            traceback.print_exc()
         _environment_error(err)
     except Exception as err:  # an internal error: say so plainly, traceback only with --debug
         if debug:

@@ -17,6 +17,7 @@ import sys
 import click
 from rich.console import Console
 
+from rrcache.cli import interrupt
 from rrcache.cli.progress import Reporter, quiet_option
 
 
@@ -46,9 +47,9 @@ def command(quick, scenes, out_dir, as_json, quiet):
         with reporter:
             result = run(chosen, QUICK if quick else FULL, out_dir, reporter.update, on_scene=finished)
     except KeyboardInterrupt:
-        err.print(f"rrcache: interrupted; finished scenes are in {out_dir}/bench.json and the profiles resume",
+        err.print(f"rrcache: {interrupt.word()}; finished scenes are in {out_dir}/bench.json and the profiles resume",
                   highlight=False)
-        sys.exit(130)
+        sys.exit(interrupt.exit_code())
     if as_json:
         click.echo(json.dumps(result.to_json(), ensure_ascii=False))
     else:

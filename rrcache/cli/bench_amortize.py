@@ -18,6 +18,7 @@ import click
 from rich.console import Console
 
 from rrcache.cli.options import parse_defines, resolution_option as _resolution
+from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.runtime.glsl import FILTERS
 from rrcache.selection import AMORTIZE_PAYLOADS
 
@@ -48,24 +49,28 @@ from rrcache.selection import AMORTIZE_PAYLOADS
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
 @click.option("--images", type=click.Path(file_okay=False), default=None, help="Write comparison PNGs here.")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
+@quiet_option
 def command(shader, session, estimator, samples, blend, history, filter_, phase, payload, algorithm, reference, also, frames,
-            repeats, error_every, resolution, images, as_json):
+            repeats, error_every, resolution, images, as_json, quiet):
     """Measure amortized sampling of one estimator of SHADER over SESSION."""
     from rrcache.bench.amortize import run, write_images
 
     err = Console(stderr=True)
     ref_defines = parse_defines(reference)
     kept = {}
+    done = {"n": 0}
 
-    def on_frame(repeat, index, original, amortized, ref):
-        if repeat == 0:
-            err.print(f"[dim]frame {index}: {original.ms:.1f} / {amortized.ms:.1f} ms[/dim]")
-            if images and index == frames - 1:
+    with Reporter(err, quiet=quiet) as reporter:
+        def on_frame(repeat, index, original, amortized, ref):
+            done["n"] += 1
+            reporter.update(f"[{repeat + 1}/{repeats}] {estimator} amortized beside the original", done["n"],
+                            frames * repeats)
+            if repeat == 0 and images and index == frames - 1:
                 kept.update(original=original.image, amortized=amortized.image)
 
-    result = run(shader, session, estimator, samples, blend, ref_defines, frames=frames, repeats=repeats,
-                 error_every=error_every, algorithm=algorithm, phase=phase, history=history, filter=filter_,
-                 payload=payload, resolution=resolution, on_frame=on_frame)
+        result = run(shader, session, estimator, samples, blend, ref_defines, frames=frames, repeats=repeats,
+                     error_every=error_every, algorithm=algorithm, phase=phase, history=history, filter=filter_,
+                     payload=payload, resolution=resolution, on_frame=on_frame)
     summary = result.summary()
     if images:
         os.makedirs(images, exist_ok=True)

@@ -19,6 +19,7 @@ import json
 import click
 from rich.console import Console
 
+from rrcache.budgets import MAX_PERIOD, check_period
 from rrcache.cli.options import include_dirs_option, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
@@ -29,8 +30,10 @@ from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT
 @click.argument("session", type=click.Path(dir_okay=False))
 @click.option("--node", required=True, metavar="ID", help="The node to cache (see `rrcache nodes --session`).")
 @click.option("--periods", default="8,16,32", show_default=True, help="Refresh periods to compare.")
-@click.option("--compare-period", default=16, show_default=True, help="Δn for the algorithm and block comparisons.")
-@click.option("--frames", default=60, show_default=True, help="Consecutive frames per configuration.")
+@click.option("--compare-period", default=16, show_default=True, type=click.IntRange(1, MAX_PERIOD),
+              help="Δn for the algorithm and block comparisons.")
+@click.option("--frames", default=60, show_default=True, type=click.IntRange(1, 100_000),
+              help="Consecutive frames per configuration.")
 @click.option("--repeats", default=3, show_default=True, type=click.IntRange(1, 50),
               help="Measurements of each configuration (rows show the median and the range).")
 @click.option("--resolution", callback=_resolution, default=None, metavar="WxH")
@@ -68,6 +71,9 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
         period_list = [int(p) for p in periods.split(",") if p.strip()]
     except ValueError:
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
+    if not period_list:
+        raise click.BadParameter("give at least one refresh period", param_hint="--periods")
+    period_list = [check_period(p, "--periods") for p in period_list]
     format_list = [f.strip() for f in formats.split(",") if f.strip()]
     bad = [f for f in format_list if f not in COLOR_FORMATS]
     if bad or not format_list:

@@ -6,7 +6,7 @@
 
 ``rrcache instance PROFILE --level eN`` writes exactly the files of the profile's
 ``optimized/eN`` (the level's choice with its algorithm, period and every cache option;
-:mod:`rrcache.profiles.choice`). With a PROFILE and ``--node``, the algorithm defaults to the
+:mod:`rrcache.choice`). With a PROFILE and ``--node``, the algorithm defaults to the
 profile's; with a SHADER, to three-pass (the command says which it used).
 
 ``rrcache instance SHADER --estimator e1 --samples 4 --lambda 0.6 --out DIR`` writes an
@@ -33,6 +33,7 @@ from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse
 from rrcache.cli.sources import describe_selection, refuse_with_level, resolve
 from rrcache.runtime import ALGORITHMS, DEFAULT_FILTER, DEFAULT_PERIOD, FILTERS
 from rrcache.selection import AMORTIZE_PAYLOADS
+from rrcache.choice import write as choice_write
 
 #: what --target writes: GLSL 3.30 core files, or WebGL2 (GLSL ES 3.00 and a page)
 TARGETS = ("glsl", "webgl2")
@@ -60,7 +61,9 @@ _LEVEL_OWNS = {"node": "--node", "estimator": "--estimator", "samples": "--sampl
               help="Refresh period Δn; with several --node, one per node in the same order (or one for all).")
 @click.option("--algorithm", type=click.Choice(ALGORITHMS), default=None,
               help="Cache algorithm (default: the profile's with a PROFILE, else three-pass).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True)
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=None,
+              help=f"The cache's hit test and payload reconstruction (default: the profile's with a PROFILE, else "
+                   f"{DEFAULT_FILTER}).")
 @click.option("--payload", type=click.Choice(AMORTIZE_PAYLOADS), default="f4", show_default=True,
               help="32- or 16-bit floats; u8 (with --estimator and --history slots): 8 bits by the range of "
                    "the estimator's terms.")
@@ -101,6 +104,8 @@ def command(ctx, shader, level, node, estimator, samples, blend, history, period
     else:
         why = "--algorithm"
     check_adaptive(adaptive, node, algorithm)
+    if filter_ is None:
+        filter_ = getattr(prof, "filter", None) or DEFAULT_FILTER
     loaded = load_session(source.session) if source.session else None
     if target == "webgl2" and loaded is None:
         raise click.UsageError("--target webgl2 needs --session SESSION (the scene the page draws)")
@@ -144,7 +149,10 @@ def command(ctx, shader, level, node, estimator, samples, blend, history, period
 
 
 def _write(variant, out_dir, target, session, work, period, runtime) -> list:
-    """Write ``variant`` for ``target``: the GLSL files, or the WebGL2 page and its passes."""
+    """Write ``variant`` for ``target``: the GLSL files, or the WebGL2 page and its passes; each
+    pass is compiled and linked by the driver first (:func:`_compile`), so nothing is written
+    for a variant the driver refuses."""
+    _compile(variant)
     if target == "webgl2":
         from rrcache.webgl import write_page
 
@@ -152,13 +160,29 @@ def _write(variant, out_dir, target, session, work, period, runtime) -> list:
     return variant.write(out_dir, period=period, runtime=runtime)
 
 
+def _compile(variant) -> None:
+    """Compile and link every pass of ``variant`` with this machine's driver and release the
+    programs: a refused pass is the driver's one-line error naming the node and the pass (exit 2,
+    nothing written). Without OpenGL here the files are written unchecked, and the command says so."""
+    from rrcache.errors import GLError
+    from rrcache.gl.context import get_context
+
+    try:
+        ctx = get_context()
+    except GLError as err:
+        click.echo(f"note: the passes were not compiled here (no OpenGL: {err.message})", err=True)
+        return
+    for program in variant.build_programs(ctx).values():
+        program.release()
+
+
 def _write_level(prof, level, include_dirs, out_dir, target) -> None:
     """``instance PROFILE --level eN``: the level's choice, as the profile wrote optimized/eN."""
-    from rrcache.profiles import choice
+    from rrcache import choice
 
     sel = choice.level(prof, level)
     if not sel.parts:
-        written = prof.write_variant(sel, out_dir)
+        written = choice_write(prof, sel, out_dir)
         click.echo(f"{sel.label} keeps the original shader ({choice.original_note(prof, sel)}):")
     else:
         work, session = choice.load_work(prof, include_dirs)

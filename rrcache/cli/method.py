@@ -65,7 +65,7 @@ def render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_j
     """The render cache at ``samples`` beside the original: table and summary (or JSON)."""
     from rrcache.alternatives.render_cache import RenderCacheSettings
     from rrcache.alternatives.render_cache.tune import compare
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.pipeline import all_include_dirs
 
     settings = RenderCacheSettings(samples=DEFAULT_SAMPLES if samples is None else samples).checked()

@@ -22,10 +22,12 @@ import warnings
 import click
 from rich.console import Console
 
+from rrcache.cli import interrupt
 from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
+from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK, UNRELIABLE_NOISE
 from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
@@ -95,6 +97,9 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--filter", "filter_", type=click.Choice(FILTER_CHOICES), default="auto", show_default=True,
               help="The cache's hit test and payload reconstruction: auto measures bilinear against plane on "
                    "the first node and keeps plane where faster at about the same PSNR (docs/misses.md).")
+@click.option("--measure-terms", is_flag=True,
+              help="Before training, order the terms of sums whose weights do not fold by what caching each "
+                   "alone costs in error (docs/sums.md).")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=None, callback=_seconds,
               help=f"Seconds of node training; no new node is started once spent (default: {TrainingSettings.budget_s:g}).")
 @click.option("--min-saving", type=click.FloatRange(min=0, max=1, max_open=True), default=None,
@@ -127,17 +132,22 @@ def _fmt(value, spec=".3g", none="–"):
 @click.option("--max-flip", type=click.FloatRange(min=0, min_open=True), default=None, metavar="F",
               help="Add a level 'flip': the fastest choice measured at mean FLIP <= F against the original "
                    "(docs/levels.md).")
+@click.option("--clock", type=click.Choice(sorted(CLOCKS)), default=DEFAULT_CLOCK, show_default=True,
+              help="The frame clock of every timed run: wall = wall time around glFinish (the only one that "
+                   "means anything on a software rasterizer); gl-timer = GL timer queries (real GPUs). "
+                   "Recorded in the profile.")
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, filter_, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, max_sets, defines, adaptive, max_flip, quiet, vert, include_dirs):
+            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
+            wait, max_sets, defines, adaptive, clock, max_flip, quiet, vert, include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
-                  validate=not no_validate, validation_frames=validation_frames, levels=levels)
+                  measure_terms=measure_terms,
+                  validate=not no_validate, validation_frames=validation_frames, levels=levels, clock=clock)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),
                         ("max_sets", max_sets)):
@@ -162,7 +172,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
     except KeyboardInterrupt:
         _interrupted(out, err_console)
-        sys.exit(130)
+        sys.exit(interrupt.exit_code())
     console = Console()
     if not console.is_terminal:  # a pipe, a file: whole lines, never wrapped or cut
         console = Console(soft_wrap=True)
@@ -174,7 +184,7 @@ def _interrupted(out, err_console) -> None:
 
     from rrcache.profiles.store import read_store
 
-    err_console.print("rrcache: interrupted; the run in flight was dropped", highlight=False)
+    err_console.print(f"rrcache: {interrupt.word()}; the run in flight was dropped", highlight=False)
     path = Path(out) / STORE_NAME
     try:
         with read_store(path) as store:
@@ -370,17 +380,7 @@ def _table(prof) -> TextTable:
                           "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
                           "FLIP meas.", "level met")])
     for s in prof.selections:
-        if s.multi:  # several nodes, each at its own period
-            node = " + ".join(f"{p.node}: {p.text or prof.node(p.node).text}" for p in s.parts)
-            period = "/".join(str(p) for p in s.periods)
-        elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
-            part = s.parts[0]
-            slots = " slots" if part.history == "slots" else ""
-            node, period = (f"{part.estimator} m={part.samples}/{prof.estimator(part.estimator).samples} "
-                            f"λ={part.blend:g}{slots}: {part.text or ''}"), "–"
-        else:
-            node = "(original)" if s.node is None else f"{s.node}: {s.text}"
-            period = _fmt(s.period, "d")
+        node, period = s.choice.cells(s, prof) if s.parts else ("(original)", "–")
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),

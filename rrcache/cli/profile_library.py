@@ -24,6 +24,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
+from rrcache.cli import interrupt
 from rrcache.cli.profile import _periods, _seconds
 from rrcache.cli.progress import Reporter, quiet_option
 from rrcache.profiles.settings import ALGORITHM_CHOICES, LEVEL_KINDS, TrainingSettings
@@ -87,9 +88,9 @@ def command(manifest, shaders, sessions, out_dir, budget, frames, periods, timin
             for w in caught:
                 err_console.print(f"warning: {w.message}", highlight=False, markup=False)
     if interrupted:
-        err_console.print(f"rrcache: interrupted; the summary so far is in {Path(out_dir) / 'index.html'}; "
+        err_console.print(f"rrcache: {interrupt.word()}; the summary so far is in {Path(out_dir) / 'index.html'}; "
                           "run the same command again to resume", highlight=False)
-        sys.exit(130)
+        sys.exit(interrupt.exit_code())
     console = Console()
     if not console.is_terminal:
         console = Console(width=140)

@@ -60,7 +60,7 @@ from rrcache.jsonable import finite_json
 from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import frame_indices, render
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
@@ -100,8 +100,9 @@ _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm
               help=f"Refresh block size k in pixels (default: the profile's, else {DEFAULT_BLOCK}).")
 @click.option("--refresh", type=click.Choice(REFRESH_MODES), default=None,
               help=f"Refresh pattern (default: the profile's, else {DEFAULT_REFRESH}).")
-@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=DEFAULT_FILTER, show_default=True,
-              help="Payload reconstruction filter.")
+@click.option("--filter", "filter_", type=click.Choice(FILTERS), default=None,
+              help=f"The cache's hit test and payload reconstruction (default: the profile's with a PROFILE, else "
+                   f"{DEFAULT_FILTER}).")
 @click.option("--payload", type=click.Choice(["f4", "f2"]), default="f4", show_default=True,
               help="Cache precision: 32- or 16-bit float.")
 @click.option("--depth-epsilon", type=float, default=None,
@@ -148,7 +149,7 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                      err_console, quiet)
         return
     if level is not None:
-        from rrcache.profiles import choice
+        from rrcache import choice
 
         sel = choice.level(prof, level)
         if not sel.parts:
@@ -184,6 +185,8 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                "depth_epsilon": depth_epsilon if depth_epsilon is not None else (
                    settings.depth_epsilon if settings else DEFAULT_DEPTH_EPSILON)}
     options.update(adaptive_kwargs({"threshold": adaptive, "fast_period": fast_period, "spread": spread}))
+    if filter_ is None:
+        filter_ = getattr(prof, "filter", None) or DEFAULT_FILTER
     from rrcache.pipeline import load_for_session, variant_for, variant_for_nodes
 
     work = load_for_session(source.shader, loaded, source.defines, source.include_dirs, vertex=source.vertex)
@@ -196,8 +199,8 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
         variant = variant_for_nodes(work, list(node), algorithm, filter_, payload)
         run_period = periods
     what = " + ".join(f"{n} ({e.type}, line {e.line}: {e.text}) at Δn={p}" for n, e, p in zip(node, entries, periods))
-    said = (f"{algorithm} ({why}), refresh block {options['block']}, {options['refresh']} refresh, depth "
-            f"tolerance {options['depth_epsilon']:g}"
+    said = (f"{algorithm} ({why}), {filter_} filter, refresh block {options['block']}, {options['refresh']} "
+            f"refresh, depth tolerance {options['depth_epsilon']:g}"
             + (f", adaptive threshold {adaptive:g} (fast period {fast_period})" if adaptive is not None else ""))
     setup = dict(algorithm=algorithm, period=run_period if len(node) > 1 else periods[0], options=options,
                  said=said, filter=filter_)

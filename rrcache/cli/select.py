@@ -60,27 +60,18 @@ def command(profile_path, max_error, min_psnr, max_flip, as_json, out_dir, inclu
         prof.select(max_error)  # the threshold's own checks (a located error for a bad one)
     answer = choose(prof, min_psnr=min_psnr, max_error=max_error, max_flip=max_flip)
     choice = answer.selection
-    written = prof.write_variant(choice, out_dir) if out_dir else []
+    written = choice_write(prof, choice, out_dir) if out_dir else []
     level = (f"error {max_error:g}" if max_error is not None else f"PSNR ≥ {min_psnr:g} dB" if min_psnr is not None
              else f"mean FLIP ≤ {max_flip:g}")
     if as_json:
         click.echo(json.dumps(finite_json(_json(prof, choice, answer))))
         return
-    if choice.kind == "amortize":
-        part = choice.parts[0]
-        click.echo(f"amortize {part.estimator} ({part.text}): {part.samples} of "
-                   f"{prof.estimator(part.estimator).samples} terms per frame, {_history(part)}, λ = {part.blend:g}: "
-                   f"{_figures(choice)}")
-    elif choice.multi:
-        texts = "; ".join(prof.node(n).text for n in choice.nodes)
-        click.echo(f"cache {choice.describe()} ({texts}): {_figures(choice)}")
-    elif choice.node is None:
+    if not choice.parts:
         reason = (prof.verdict["answer"] if prof.verdict is not None else
                   answer.warnings[0] if answer.warnings else f"nothing is predicted faster within {level}")
         click.echo(f"the original shader: {reason} ({choice.predicted_ms:.3f} ms per frame)")
     else:
-        text = prof.node(choice.node).text
-        click.echo(f"cache {choice.node} ({text}) every Δn = {int(choice.period)} frames: {_figures(choice)}")
+        click.echo(f"{choice.choice.sentence(choice, prof)}: {_figures(choice)}")
     if choice.parts and answer.note:
         click.echo(f"({answer.note})")
     said = 1 if not choice.parts and prof.verdict is None and answer.warnings else 0  # the reason above
@@ -113,16 +104,9 @@ def _figures(choice) -> str:
 
 
 def _json(prof, choice, answer) -> dict:
-    """The --json record (see the module docstring)."""
-    if choice.kind == "amortize":  # amortized sampling: the estimator, m and λ
-        part = choice.parts[0]
-        data = {"node": None, "period": None, "kind": "amortize", "estimator": part.estimator,
-                "samples": part.samples, "of": prof.estimator(part.estimator).samples, "blend": part.blend,
-                "history": part.history, "phase": part.phase, "filter": part.filter, "payload": part.payload}
-    elif choice.multi:  # several nodes: "n12+n40" and one period each
-        data = {"node": "+".join(choice.nodes), "period": list(choice.periods), "nodes": list(choice.nodes)}
-    else:
-        data = {"node": choice.node, "period": None if choice.period is None else int(choice.period)}
+    """The --json record (see the module docstring): what is chosen as its kind of choice says it
+    (rrcache.kinds; the original: node null), its predicted and measured figures, and which."""
+    data = dict(choice.choice.summary(choice, prof) if choice.parts else {"node": None, "period": None})
     data.update({"predicted_error": float(choice.predicted_error), "predicted_ms": float(choice.predicted_ms),
                  "predicted_speedup": float(choice.predicted_speedup),
                  "predicted_speedup_range": list(choice.predicted_speedup_range),
@@ -136,9 +120,5 @@ def _json(prof, choice, answer) -> dict:
     return data
 
 
-def _history(part) -> str:
-    """How the amortized choice keeps its history, in words."""
-    if part.history == "slots":
-        return ("slots history (the N/m subset sums kept apart, each blended with its own"
-                + (", in 8 bits by the terms' range)" if part.payload == "u8" else ")"))
-    return "blend history (one running estimate)"
+from rrcache.kinds.amortize import history_words as _history  # noqa: E402,F401 (the words, the kind's)
+from rrcache.choice import write as choice_write

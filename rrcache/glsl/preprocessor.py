@@ -212,7 +212,13 @@ _DYNAMIC = frozenset({"__LINE__", "__FILE__", "__VERSION__"})
 _VERSIONS = (100, 110, 120, 130, 140, 150, 300, 310, 320, 330, 400, 410, 420, 430, 440, 450, 460)
 _ES_VERSIONS = (100, 300, 310, 320)
 _BEHAVIORS = ("require", "enable", "warn", "disable")
-_MAX_EXPANSION = 2_000_000
+#: the tokens macro expansion may produce: at least :data:`_MIN_EXPANSION`, else
+#: :data:`_EXPANSION_PER_BYTE` per byte of source read, and never more than twice the analysis
+#: budget's syntax nodes (more tokens than that would be refused by it after parsing anyway). A
+#: macro bomb (``#define D(x) x x`` nested 24 deep: 2^25 tokens) from a few hundred bytes is refused
+#: after 200,000 tokens, not after two million (seconds and half a gigabyte)
+_MIN_EXPANSION = 200_000
+_EXPANSION_PER_BYTE = 5
 _MAX_NESTING = 120
 _MAX_INCLUDE_DEPTH = 64
 
@@ -890,6 +896,8 @@ class _Preprocessor:
                 out.append(t)
                 continue
             if m.params is None:
+                if self.produced + len(m.body) > self._expansion_limit():
+                    self._too_large(t)
                 body = self._subst(m, None, t.hide | {name}, t, depth)
             else:
                 if not stack or not stack[-1].is_punct("("):
@@ -898,12 +906,22 @@ class _Preprocessor:
                 args, rparen = self._collect_args(stack, t, m)
                 body = self._subst(m, args, (t.hide & rparen.hide) | {name}, t, depth)
             self.produced += len(body) + 1
-            if self.produced > _MAX_EXPANSION:
-                raise _err("macro expansion too large", t.loc,
-                           "look for macros that multiply their arguments")
+            if self.produced > self._expansion_limit():
+                self._too_large(t)
             body.reverse()
             stack.extend(body)
         return out
+
+    def _expansion_limit(self) -> int:
+        from rrcache.budgets import budget
+
+        return min(2 * budget.analysis_nodes, max(_MIN_EXPANSION, _EXPANSION_PER_BYTE * self.source_bytes))
+
+    def _too_large(self, use: _Tok):
+        raise _err(f"macro expansion too large: more than {self._expansion_limit():,} tokens from "
+                   f"{self.source_bytes:,} bytes of source", use.loc,
+                   "look for macros that multiply their arguments (a larger analysis budget, "
+                   "'rrcache --max-ast-nodes N', allows more for a large shader)")
 
     def _dynamic(self, t: _Tok) -> _Tok:
         if t.text == "__LINE__":
@@ -981,6 +999,8 @@ class _Preprocessor:
                         if depth >= _MAX_NESTING:
                             raise _err("macro calls nested too deeply", use.loc)
                         expanded[k] = self._expand(args[k], depth + 1)
+                    if self.produced + len(res) + len(expanded[k]) > self._expansion_limit():
+                        self._too_large(use)  # before a body that large is made
                     res.extend(expanded[k])
                 i += 1
                 continue

@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import statistics
 
-from rrcache.harness.cached import CachedRenderer, compare
+from rrcache.gl.formats import ERROR_FORMAT
+from rrcache.runs import RunSpec
+from rrcache.runtime.spec import VariantSpec
 
 #: the filters ``auto`` chooses between, the default first
 CANDIDATES = ("bilinear", "plane")
@@ -30,28 +32,33 @@ PSNR_SLACK_DB = 0.5
 ERROR_FRAMES = 16
 
 
-def choose_filter(work, session, settings, node_id: str, algorithm: str, original, timing: list, plan,
-                  meter, timing_run) -> tuple[str, dict]:
+def choose_filter(settings, node_id: str, algorithm: str, shapes, executor, meter=None) -> tuple[str, dict]:
     """Measure the :data:`CANDIDATES` on ``node_id`` and return ``(filter, {filter: {"time": the
-    median time as a fraction of the original's, "psnr": dB}})`` (module docstring).
-    ``original`` is the timed original renderer; ``timing_run`` the profiler's timing run."""
+    median time as a fraction of the original's, "psnr": dB}})`` (module docstring), as
+    :class:`~rrcache.runs.RunSpec` runs on ``executor`` (``shapes``: the profile's
+    :class:`~rrcache.profiler.jobs.RunShapes`; ``meter`` counts the progress)."""
     period = settings.timing_periods[len(settings.timing_periods) // 2]
     error_period = settings.periods[len(settings.periods) // 2]
-    frames = list(range(min(ERROR_FRAMES, settings.frames)))
-    full = tuple(int(v) for v in session.resolution)
-    measured: dict = {}
+    frames = tuple(range(min(ERROR_FRAMES, settings.frames)))
+    runs = []
     for filter_ in CANDIDATES:
-        variant = _variant(work, node_id, algorithm, filter_)
-        with CachedRenderer(variant, session, work.prepared, full, period=period, window=plan.timing_window,
-                            color_format=settings.timing_format, **settings.cache_options()) as cached:
-            timed = timing_run(cached, original, f"{node_id} {filter_}", period, timing, meter)
-        error = compare(variant, session, work.prepared, frames, period=error_period,
-                        resolution=settings.resolution, window=plan.error_window,
-                        on_frame=lambda *_a, f=filter_: meter.step("filter", f"{node_id} {f}"),
-                        **settings.cache_options())
-        measured[filter_] = {"time": float(statistics.median(t.ms / t.original_ms for t in timed if t.original_ms > 0)),
-                             "psnr": float(error.psnr), "period": int(error_period)}
-    return pick(measured), measured
+        spec = VariantSpec("cache", (node_id,), algorithm, filter_, **settings.cache_options())
+        runs.append(shapes.run("timing", spec.with_runtime(periods=(period,)), ("filter", filter_),
+                               f"{node_id} {filter_}"))
+        # the error as the error runs measure it, beside the original frame by frame
+        runs.append(RunSpec("compare", spec.with_runtime(periods=(error_period,)), frames, shapes.resolution,
+                            shapes.error_window, ERROR_FORMAT, shapes.clock, ("filter", filter_), f"{node_id} {filter_}"))
+    if meter is not None:
+        meter.grow(sum(r.cost for r in runs))
+    measured: dict = {}
+    on_frame = meter.on_frame("filter") if meter is not None else None
+    for result in executor.run(runs, on_frame=on_frame):  # in any order
+        entry = measured.setdefault(result.spec.key[1], {})
+        if result.spec.measure == "timing":
+            entry["time"] = float(statistics.median(r.ms / r.original_ms for r in result.frames if r.original_ms > 0))
+        else:
+            entry["psnr"], entry["period"] = float(result.steady_psnr), int(error_period)
+    return pick(measured), {f: measured[f] for f in CANDIDATES}
 
 
 def pick(measured: dict) -> str:
@@ -66,14 +73,3 @@ def pick(measured: dict) -> str:
     if other["time"] < base["time"] and other["psnr"] >= base["psnr"] - PSNR_SLACK_DB:
         return "plane"
     return "bilinear"
-
-
-def steps(settings, timing: list) -> int:
-    """The progress steps :func:`choose_filter` takes."""
-    return len(CANDIDATES) * (3 * len(timing) + min(ERROR_FRAMES, settings.frames))
-
-
-def _variant(work, node_id, algorithm, filter_):
-    from rrcache.pipeline import variant_for
-
-    return variant_for(work, node_id, algorithm, filter=filter_)

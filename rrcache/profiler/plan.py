@@ -63,6 +63,7 @@ from typing import Optional
 import numpy as np
 
 from rrcache.gl.window import Window
+from rrcache.harness.segments import WARMUP_PERIODS, run_order, warmup_frames  # noqa: F401 (the plan's rule)
 
 #: the original's time inside the error window, per frame (wall clock: the earlier rule, kept for
 #: :func:`fraction_for`'s callers)
@@ -77,10 +78,6 @@ ERROR_TARGET_CPU_MS = 100.0
 TIMING_TARGET_CPU_MS = 400.0
 #: the default number of error frames: a session of up to this many is covered whole
 DEFAULT_ERROR_FRAMES = 150
-#: refresh periods of warm-up before a later segment: after one period every block has been
-#: refreshed, but values resampled across block edges from before it still differ by 2–6% of the
-#: error (the tiny test scene at Δn = 4, 8, 16); after two, by less than 0.1%
-WARMUP_PERIODS = 2
 #: the fewest counted frames of one segment of a session covered in segments, and the most segments
 MIN_SEGMENT = 16
 MAX_SEGMENTS = 4
@@ -217,64 +214,6 @@ def error_segments(session_frames: int, count: int, max_period: int) -> list[tup
     length = count // k
     starts = [int(round(x)) for x in np.linspace(0, n - length, k)] if k > 1 else [0]
     return [(s, length) for s in starts]
-
-
-def warmup_frames(start: int, period: int) -> list[int]:
-    """The frames rendered, not counted, before a segment starting at ``start`` so that the cache
-    at ``start`` holds what a run from frame 0 holds there: the :data:`WARMUP_PERIODS` × ``period``
-    frames before it (from frame 0 when there are fewer), none for a segment at frame 0.
-
-    >>> warmup_frames(100, 2), warmup_frames(3, 10), warmup_frames(0, 10)
-    ([96, 97, 98, 99], [0, 1, 2], [])
-    """
-    return list(range(max(0, int(start) - WARMUP_PERIODS * max(1, int(period))), int(start)))
-
-
-def segments_of(indices) -> list[list[int]]:
-    """``indices`` split into runs of consecutive frames.
-
-    >>> segments_of([0, 1, 2, 10, 11])
-    [[0, 1, 2], [10, 11]]
-    """
-    out: list[list[int]] = []
-    for i in indices:
-        if out and i == out[-1][-1] + 1:
-            out[-1].append(i)
-        else:
-            out.append([i])
-    return out
-
-
-def run_order(indices, warmup: int) -> list[list[tuple[int, bool]]]:
-    """The frames an error run renders to compare ``indices`` (the references' frames): per
-    segment of consecutive ones (each after a reset of the cache), its warm-up frames
-    (:func:`warmup_frames` for a refresh period or settling time ``warmup``; ``False``: rendered,
-    not compared) and then its own frames (``True``). A run over frames 0..N−1 is one segment
-    without warm-up, as before segments.
-
-    >>> run_order([0, 1, 2, 6, 7], 1)
-    [[(0, True), (1, True), (2, True)], [(4, False), (5, False), (6, True), (7, True)]]
-    """
-    return [[(i, False) for i in warmup_frames(seg[0], warmup)] + [(i, True) for i in seg]
-            for seg in segments_of(indices)]
-
-
-def restart(cached, frame: int) -> None:
-    """Empty the cache of ``cached`` (a :class:`~rrcache.harness.cached.CachedRenderer`) before
-    rendering session frame ``frame`` first, with the runtime's clock at ``frame``: the refresh
-    schedule (and an amortized variant's phase) depends on the clock, which a run from frame 0
-    has at ``frame`` there."""
-    cached.reset()
-    cached.runtime.clock = int(frame)
-
-
-def rendered_frames(indices, warmup: int) -> int:
-    """How many frames :func:`run_order` renders (for progress totals).
-
-    >>> rendered_frames([0, 1, 2, 6, 7], 1)
-    7
-    """
-    return sum(len(seg) for seg in run_order(indices, warmup))
 
 
 #: the least relative noise assumed of a timing (a quiet machine's frame-to-frame noise)

@@ -24,8 +24,10 @@ import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache import kinds
 from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -35,6 +37,7 @@ from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
 from rrcache.selection import Selection
+from rrcache.choice import write as choice_write
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -49,7 +52,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None, max_flip: Optional[float] = None) -> Profile:
+            vertex=None, adaptive=None, executor=None, max_flip: Optional[float] = None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -59,8 +62,12 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`). ``max_flip``: a fifth level, ``flip``, of mean
-    FLIP at most this (:func:`rrcache.profiler.validate.flip_level`; docs/levels.md).
+    same level (:mod:`rrcache.profiler.adaptive`). ``executor``: a callable ``(work, session) ->
+    executor`` making what runs the training's :class:`~rrcache.runs.RunSpec` s (its
+    ``run(specs, on_frame=None)`` yields a :class:`~rrcache.runs.RunResult` per spec, in any order;
+    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`).
+    ``max_flip``: a fifth level, ``flip``, of mean FLIP at most this
+    (:func:`rrcache.profiler.validate.flip_level`; docs/levels.md).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -71,8 +78,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught, max_flip)
+                prof = _profile(shader_path, session_path, out_dir, settings, caught, defines=defines,
+                                progress=progress, fresh=fresh, plots=plots, include_dirs=include_dirs, wait=wait,
+                                vertex=vertex, adaptive=adaptive, executor=executor, max_flip=max_flip)
             finally:
                 raised = list(caught)
     finally:
@@ -81,8 +89,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     return prof
 
 
-def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list, max_flip: Optional[float] = None) -> Profile:
+def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defines, progress, fresh, plots,
+             include_dirs, wait, vertex, adaptive, executor, max_flip: Optional[float] = None) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -102,25 +110,45 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
     try:
         store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
         started = time.time()
+        compiled = sum(kinds.compile_counts().values())
+        make_executor, runner = executor, None
         try:
             store.begin_run()
-            if work.table.nodes:
-                result, verdict = train(work, session, resolved, store, progress), None
-            else:  # nothing a cache can hold: the answer is the original, why, and its frame time
+            verdict = None
+            if not work.table.nodes:  # nothing a cache can hold: the answer is the original, why, its frame time
                 result, verdict = _original_only(work, session, resolved), no_node_verdict(work)
+                runner = None
+            else:
+                if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
+                    from rrcache.profiler.terms import scores_for
+
+                    scores = scores_for(work, session, store, progress)
+                    if scores:
+                        work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
+                                                term_scores=scores)
+                # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+                # the original's reference frames rendered once
+                runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
+                result = train(work, session, resolved, store, progress, executor=runner)
             prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out, verdict)
-            prof.sets = _sets(prof, work, session, resolved, store, progress)
-            # amortized sampling: the estimators' models, on the same front as the nodes
-            from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress)
+            prof.term_scores = dict(work.term_scores)
+            if runner is not None:
+                prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
+                # amortized sampling: the estimators' models, on the same front as the nodes
+                from rrcache.profiler.amortize import train_estimators
+                prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
+                runner.close()  # validation renders side by side with its own renderers
             prof.selections = _selections(prof, work, session, resolved, result, store, progress, max_flip)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
-                                         window=result.plan.timing_window if result.plan is not None else None)
+                                         window=result.plan.timing_window if result.plan is not None else None,
+                                         store=store, executor=runner)
             prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
+            # how many variants this invocation compiled (each at most once: the compile cache)
+            prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
             prof.write(out)
@@ -130,6 +158,9 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
         except BaseException:
             _end_quietly(store, "failed")
             raise
+        finally:
+            if runner is not None:
+                runner.close()
         store.close()
     finally:
         lock.release()
@@ -209,12 +240,12 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     return prof
 
 
-def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+def _sets(prof: Profile, work, session, settings, store, progress, executor=None) -> list:
     """The sets of several cached nodes predicted to improve the front, the few picked trained
     (:mod:`rrcache.profiler.sets`)."""
     from rrcache.profiler.sets import train_sets
 
-    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets, executor=executor)
 
 
 def _psnr_offset(store, settings, result: TrainingResult) -> float:
@@ -354,7 +385,8 @@ def no_node_verdict(work) -> dict:
 
 
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
-    """The shader files of each selection, then (with ``plots``) the plots and the report."""
+    """The shader files of each selection, then (with ``plots``) the plots, the report's frames
+    (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
     kept = []
     # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
     # refused, never followed, and the old files of a selection are removed only inside it
@@ -362,18 +394,20 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         for sel in prof.selections:
             with optimized.folder(sel.label) as folder:
                 folder.remove_files()
-                prof.write_variant(sel, folder, work=work)
+                choice_write(prof, sel, folder, work=work)
             kept.append(sel.replace(files=f"optimized/{sel.label}"))
         answered = prof.verdict is not None  # stopped before training: nothing to plot, the answer to report
         if answered:
             with optimized.folder("original") as folder:
-                prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), folder)
+                choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), folder)
     prof.selections = kept
     prof.path = out
     if plots:
+        from rrcache.profiler.frames import write_frames
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
         if not answered:
             prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_report(prof, out, work=work)
+            write_frames(prof, out, work)
+        write_report(prof, out)

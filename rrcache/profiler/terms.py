@@ -69,3 +69,24 @@ def measure_terms(work, session, frames: Optional[Sequence[int]] = None, resolut
                 progress(f"terms: {key} {label}", done, total)
         out[key] = scores
     return out
+
+
+def scores_for(work, session, store, progress=None) -> dict:
+    """The term scores of ``work`` for a profile: the ones its store kept (a resumed profile keeps
+    its node ids), else measured now (:func:`measure_terms`) and kept."""
+    import json
+
+    kept = store.meta().get("term_scores")
+    if kept is not None:
+        return json.loads(kept)
+    from rrcache.session.changes import per_frame_uniforms
+
+    def say(detail, done, total):
+        if progress is not None:
+            from rrcache.profiler.train import ProgressEvent
+
+            progress(ProgressEvent("terms", done, total, detail))
+
+    scores = measure_terms(work, session, moving=sorted(per_frame_uniforms(session)), progress=say)
+    store.set_meta("term_scores", json.dumps(scores))
+    return scores

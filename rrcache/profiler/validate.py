@@ -192,7 +192,7 @@ class Validator:
             start = (len(self.frames) - len(self.short)) * repeat // max(1, REPEATS - 1)
             stretch = self.frames[start:start + len(self.short)]
             runs.append(compare(variant, self.session, self.work.prepared, stretch,
-                                color_format=self.settings.timing_format,
+                                color_format=self.settings.timing_format, clock=self.settings.clock,
                                 on_frame=lambda *a, r=repeat: self._step(f"{what} timing [{r + 1}/{REPEATS}]"),
                                 **common))
         speedups = tuple(r.speedup for r in runs)

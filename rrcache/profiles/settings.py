@@ -35,6 +35,7 @@ from typing import Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.gl.formats import COLOR_FORMATS
+from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH,
                              FILTERS, REFRESH_MODES)
 
@@ -112,10 +113,17 @@ class TrainingSettings:
       largest error seen).
     - ``max_sets``: at most this many sets of several cached nodes, each at its own period, are
       trained after the single nodes (:mod:`rrcache.profiler.sets`); 0 trains none.
+    - ``clock``: the frame clock of every timed run (:data:`rrcache.harness.timing.CLOCKS`):
+      ``wall`` (the default; wall time around ``ctx.finish()``) or ``gl-timer`` (GL timer
+      queries, for real GPUs). Keyed (another clock measures other times), except at its
+      default, so stores trained before the clock was recorded keep their key.
     - ``filter``: the cache's hit test and payload reconstruction; ``auto`` (the default)
       measures ``bilinear`` against ``plane`` on the first node to train and keeps ``plane``
       where it was faster at about the same PSNR (:mod:`rrcache.profiler.filters`; the choice is
       kept in the plan).
+    - ``measure_terms``: before training, order the terms of every sum whose weights do not fold
+      by what caching each alone costs in error (:mod:`rrcache.profiler.terms`, kept in the
+      store and in ``Profile.term_scores``); off by default.
     """
 
     periods: tuple[int, ...] = DEFAULT_PERIODS
@@ -137,9 +145,14 @@ class TrainingSettings:
     levels: str = "psnr"
     #: the sets of cached nodes (k >= 2) the set stage trains at most (rrcache.profiler.sets); 0: none
     max_sets: int = 3
+    #: the frame clock of the timed runs (rrcache.harness.timing.CLOCKS)
+    clock: str = DEFAULT_CLOCK
     #: the cache's hit test and payload reconstruction: ``auto`` measures ``bilinear`` against
     #: ``plane`` on the first node (rrcache.profiler.filters), or one of rrcache.runtime.glsl.FILTERS
     filter: str = "auto"
+    #: order the terms of sums whose weights do not fold by a short measurement of each term
+    #: (rrcache.profiler.terms) before training; node ids then refer to that order
+    measure_terms: bool = False
 
     def cache_options(self) -> dict:
         """The cache's run-time parameters besides the period, as the keyword arguments of
@@ -198,6 +211,8 @@ class TrainingSettings:
             raise _fail("max_sets", f"{self.max_sets!r} is not a count of sets in [0, 64]", "the default is 3; 0 trains none")
         if self.levels not in LEVEL_KINDS:
             raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
+        if self.clock not in CLOCKS:
+            raise _fail("clock", f"unknown frame clock {self.clock!r}", f"one of {', '.join(sorted(CLOCKS))}")
         if self.filter not in FILTER_CHOICES:
             raise _fail("filter", f"unknown filter {self.filter!r}", f"one of {', '.join(FILTER_CHOICES)}")
         if self.timing_format not in COLOR_FORMATS:
@@ -269,8 +284,12 @@ class TrainingSettings:
     def key_json(self) -> str:
         """The canonical JSON of the keyed fields (everything but :data:`UNKEYED`)."""
         data = {k: v for k, v in self.to_json().items() if k not in UNKEYED}
+        if data.get("clock") == DEFAULT_CLOCK:  # as stores written before the clock was a setting
+            del data["clock"]
         if data.get("filter") == "auto":  # the default keys as before it existed: older stores resume
             del data["filter"]
+        if not data.get("measure_terms"):
+            data.pop("measure_terms", None)
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
     def key_hash(self) -> str:

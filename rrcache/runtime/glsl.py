@@ -46,7 +46,9 @@ import re
 from typing import Optional
 
 from rrcache.runtime.refresh import REFRESH_GLSL
-from rrcache.selection import FILTERS  # the names; a selection record names one
+
+#: the cache's reconstruction filters (their GLSL below), named by selections and variant specs
+FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge", "plane")
 
 # Names the runtime binds. Kept in one place so the compiler and the runtime agree.
 PREV_PAYLOAD = "rr_prevPayload"
@@ -201,7 +203,34 @@ vec4 rr_previous() {
 #: every texel with the depth *here* at twice the tolerance, which takes the board for the piece
 #: and misses a surface seen at a grazing angle. Three more texel fetches than ``bilinear`` per
 #: reprojected pixel.
-_PLANE = """
+#: the texel test of ``plane``, shared with the miss classifier (rrcache.runtime.misses): which of
+#: the four texels around ``p`` (this fragment's place in the previous frame's texels) hold the
+#: surface whose inverse depth is ``expected`` here, with screen-space derivatives ``dpx``,
+#: ``dpy`` (of ``p``) and ``de`` (of ``expected``): 1 or 0 per texel; ``base`` the lower-left
+#: texel and ``weights`` the four bilinear weights
+PLANE_TEXELS = """
+vec4 rr_planeTexels(vec2 p, float expected, vec2 dpx, vec2 dpy, vec2 de, float tolerance,
+                    out ivec2 base, out vec4 weights) {
+    // the gradient g of the inverse depth over previous-frame texels: g . dpx = de.x, g . dpy = de.y
+    float det = dpx.x * dpy.y - dpx.y * dpy.x;
+    vec2 g = abs(det) > 1e-6 * (dot(dpx, dpx) + dot(dpy, dpy))
+        ? vec2(dpy.y * de.x - dpx.y * de.y, dpx.x * de.y - dpy.x * de.x) / det : vec2(0.0);
+    base = ivec2(floor(p));
+    vec2 f = p - vec2(base);
+    ivec2 hi = textureSize(rr_prevInvDepth, 0) - 1;
+    ivec2 t0 = clamp(base, ivec2(0), hi);
+    ivec2 t1 = clamp(base + ivec2(1, 0), ivec2(0), hi);
+    ivec2 t2 = clamp(base + ivec2(0, 1), ivec2(0), hi);
+    ivec2 t3 = clamp(base + ivec2(1, 1), ivec2(0), hi);
+    vec4 d = vec4(texelFetch(rr_prevInvDepth, t0, 0).r, texelFetch(rr_prevInvDepth, t1, 0).r,
+                  texelFetch(rr_prevInvDepth, t2, 0).r, texelFetch(rr_prevInvDepth, t3, 0).r);
+    vec4 e = expected + vec4(dot(g, vec2(t0) - p), dot(g, vec2(t1) - p), dot(g, vec2(t2) - p), dot(g, vec2(t3) - p));
+    weights = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    return vec4(lessThanEqual(abs(d - e), vec4(tolerance)));
+}
+"""
+
+_PLANE = PLANE_TEXELS + """
 vec4 rr_edgeWeights;
 ivec2 rr_edgeBase;
 bool rr_edgeFull;
@@ -216,26 +245,11 @@ bool rr_hit() {
     if (!rr_valid || rr_prevClip.w <= 0.0) return false;
     rr_uv = (p + 0.5) / vec2(size);
     if (any(lessThan(rr_uv, vec2(0.0))) || any(greaterThan(rr_uv, vec2(1.0)))) return false;
-    float tolerance = rr_depthEpsilon * expected;
-    // the gradient g of the inverse depth over previous-frame texels: g . dpx = de.x, g . dpy = de.y
-    float det = dpx.x * dpy.y - dpx.y * dpy.x;
-    vec2 g = abs(det) > 1e-6 * (dot(dpx, dpx) + dot(dpy, dpy))
-        ? vec2(dpy.y * de.x - dpx.y * de.y, dpx.x * de.y - dpy.x * de.x) / det : vec2(0.0);
-    rr_edgeBase = ivec2(floor(p));
-    vec2 f = p - vec2(rr_edgeBase);
-    ivec2 hi = size - 1;
-    ivec2 t0 = clamp(rr_edgeBase, ivec2(0), hi);
-    ivec2 t1 = clamp(rr_edgeBase + ivec2(1, 0), ivec2(0), hi);
-    ivec2 t2 = clamp(rr_edgeBase + ivec2(0, 1), ivec2(0), hi);
-    ivec2 t3 = clamp(rr_edgeBase + ivec2(1, 1), ivec2(0), hi);
-    vec4 d = vec4(texelFetch(rr_prevInvDepth, t0, 0).r, texelFetch(rr_prevInvDepth, t1, 0).r,
-                  texelFetch(rr_prevInvDepth, t2, 0).r, texelFetch(rr_prevInvDepth, t3, 0).r);
-    vec4 e = expected + vec4(dot(g, vec2(t0) - p), dot(g, vec2(t1) - p), dot(g, vec2(t2) - p), dot(g, vec2(t3) - p));
-    vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    vec4 ok = vec4(lessThanEqual(abs(d - e), vec4(tolerance)));
+    vec4 weights;
+    vec4 ok = rr_planeTexels(p, expected, dpx, dpy, de, rr_depthEpsilon * expected, rr_edgeBase, weights);
     rr_edgeFull = all(greaterThan(ok, vec4(0.5)));
     if (rr_edgeFull) return true;
-    rr_edgeWeights = w * ok;
+    rr_edgeWeights = weights * ok;
     float total = dot(rr_edgeWeights, vec4(1.0));
     // a sample point this surface's texels carry (next to) no weight at is another surface's
     if (total < 0.01) return false;
@@ -286,12 +300,18 @@ def lookup_glsl(filter: str = "bilinear", depth_channel: Optional[int] = None) -
     else:
         text = _COMMON + {"nearest": _NEAREST, "bilinear": _BILINEAR, "catmull-rom": _CATMULL_ROM,
                           "catmull-rom-y": _CATMULL_ROM_Y}[filter]
-    if depth_channel is not None:  # every read of the inverse depth reads the payload's channel
-        text = text.replace("uniform sampler2D rr_prevInvDepth;\n", "")
-        text = re.sub(r"(texture|texelFetch)\(rr_prevInvDepth, ([^;]*?)\)\.r\b",
-                      lambda m: f"{m.group(1)}(rr_prevPayload, {m.group(2)}).{_CHANNELS[depth_channel]}", text)
-        text = text.replace("textureSize(rr_prevInvDepth, 0)", "textureSize(rr_prevPayload, 0)")
-    return text
+    return packed_depth(text, depth_channel)  # every read of the inverse depth: the payload's channel
+
+
+def packed_depth(text: str, depth_channel: Optional[int]) -> str:
+    """``text`` with every read of ``rr_prevInvDepth`` reading the payload's channel
+    ``depth_channel`` instead (None: unchanged)."""
+    if depth_channel is None:
+        return text
+    text = text.replace("uniform sampler2D rr_prevInvDepth;\n", "")
+    text = re.sub(r"(texture|texelFetch)\(rr_prevInvDepth, ([^;]*?)\)\.r\b",
+                  lambda m: f"{m.group(1)}(rr_prevPayload, {m.group(2)}).{_CHANNELS[depth_channel]}", text)
+    return text.replace("textureSize(rr_prevInvDepth, 0)", "textureSize(rr_prevPayload, 0)")
 
 
 def current_glsl() -> str:

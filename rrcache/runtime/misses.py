@@ -53,19 +53,15 @@ _PASSED = (1, 6)
 _CLASSIFIER_MAIN = """
 layout(location = 0) out vec4 rr_missCause;
 
-float rr_missDepth(ivec2 t) {
-    return texelFetch(DEPTH_TEXTURE, t, 0).CHANNEL;
-}
-
 void main() {
     // codes: 1 a hit (the whole bilinear footprint), 6 a hit on this surface's texels alone
     // (edge, plane), 2 the band (a miss, but a texel with some bilinear weight holds this
     // surface), 3 a disocclusion, 4 outside the screen or behind the camera, 5 nothing cached
     float code;
     // this fragment's place and inverse depth in the previous frame's texels, and their
-    // derivatives (taken here, in uniform control flow), to predict the inverse depth of this
-    // surface at the texels around it (see the plane filter in rrcache.runtime.glsl)
-    ivec2 size = textureSize(DEPTH_TEXTURE, 0);
+    // derivatives (taken here, in uniform control flow), to tell which texels hold this surface
+    // (the plane filter's test, rrcache.runtime.glsl.PLANE_TEXELS)
+    ivec2 size = textureSize(rr_prevInvDepth, 0);
     vec2 p = (rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5) * vec2(size) - 0.5;
     float expected = 1.0 / rr_prevClip.w;
     vec2 dpx = dFdx(p);
@@ -81,45 +77,30 @@ void main() {
         if (rr_prevClip.w <= 0.0 || any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
             code = 4.0;
         } else {
-            ivec2 hi = size - 1;
-            float det = dpx.x * dpy.y - dpx.y * dpy.x;
-            vec2 g = abs(det) > 1e-6 * (dot(dpx, dpx) + dot(dpy, dpy))
-                ? vec2(dpy.y * de.x - dpx.y * de.y, dpx.x * de.y - dpy.x * de.x) / det : vec2(0.0);
-            ivec2 b = ivec2(floor(p));
-            vec2 f = p - vec2(b);
-            ivec2 t0 = clamp(b, ivec2(0), hi);
-            ivec2 t1 = clamp(b + ivec2(1, 0), ivec2(0), hi);
-            ivec2 t2 = clamp(b + ivec2(0, 1), ivec2(0), hi);
-            ivec2 t3 = clamp(b + ivec2(1, 1), ivec2(0), hi);
-            vec4 d = vec4(rr_missDepth(t0), rr_missDepth(t1), rr_missDepth(t2), rr_missDepth(t3));
-            vec4 e = expected + vec4(dot(g, vec2(t0) - p), dot(g, vec2(t1) - p), dot(g, vec2(t2) - p),
-                                     dot(g, vec2(t3) - p));
-            vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-            vec4 ok = vec4(lessThanEqual(abs(d - e), vec4(rr_depthEpsilon * expected)));
-            code = dot(w * ok, vec4(1.0)) >= 0.01 ? 2.0 : 3.0;
+            ivec2 base;
+            vec4 weights;
+            vec4 ok = rr_planeTexels(p, expected, dpx, dpy, de, rr_depthEpsilon * expected, base, weights);
+            code = dot(weights * ok, vec4(1.0)) >= 0.01 ? 2.0 : 3.0;
         }
     }
     rr_missCause = vec4(code, 0.0, 0.0, 1.0);
 }
 """
 
-_CHANNELS = "xyzw"
-
-
 def classifier_glsl(filter: str = "bilinear", depth_channel: Optional[int] = None) -> str:
     """The classifier's fragment shader: the hit test of ``filter`` (the variant's, from
     :func:`rrcache.runtime.glsl.lookup_glsl`) and, where it fails, the geometric cause.
 
-    >>> "texelFetch(rr_prevPayload, t, 0).y" in classifier_glsl("bilinear", 1)
+    >>> "texelFetch(rr_prevPayload, t0, 0).y" in classifier_glsl("bilinear", 1)
     True
     """
-    from rrcache.runtime.glsl import lookup_glsl
+    from rrcache.runtime.glsl import PLANE_TEXELS, lookup_glsl, packed_depth
 
     one_sided = "!rr_edgeFull" if filter in ONE_SIDED_FILTERS else "false"
-    texture, channel = ("rr_prevInvDepth", "r") if depth_channel is None else ("rr_prevPayload", _CHANNELS[depth_channel])
-    main = (_CLASSIFIER_MAIN.replace("DEPTH_TEXTURE", texture).replace("CHANNEL", channel)
-            .replace("ONE_SIDED", one_sided))
-    return "#version 330 core\n" + lookup_glsl(filter, depth_channel) + main
+    lookup = lookup_glsl(filter, depth_channel)
+    texels = "" if "rr_planeTexels(" in lookup else packed_depth(PLANE_TEXELS, depth_channel)
+    main = packed_depth(_CLASSIFIER_MAIN.replace("ONE_SIDED", one_sided), depth_channel)
+    return "#version 330 core\n" + lookup + texels + main
 
 
 #: the filters whose hit test accepts a pixel on some texels of its surface (``rr_edgeFull``)
@@ -133,7 +114,7 @@ class MissClassifier:
     whatever draws the scene (the harness's drawer) and returns nothing useful."""
 
     def __init__(self, ctx: moderngl.Context, runtime, vertex: str, filter: str = "bilinear", add_program=None):
-        if hasattr(runtime, "read_payloads"):
+        if len(runtime.node_components) > 1:
             raise ValueError("the miss breakdown is for one cached node (not several)")
         self.ctx = ctx
         self.runtime = runtime

@@ -33,7 +33,7 @@ from rrcache.runtime.refresh import REFRESH_GLSL
 #: names of the one-node runtime that each node has its own copy of
 PER_NODE = ("rr_prevPayload", "rr_prevInvDepth", "rr_curPayload", "rr_period", "rr_refreshPhase",
             "rr_seed", "rr_refreshScale", "rr_hit", "rr_blockRank", "rr_refreshNow", "rr_previous", "rr_current",
-            "rr_outPayload", "rr_outInvDepth", "rr_edgeWeights", "rr_edgeBase", "rr_edgeFull")
+            "rr_outPayload", "rr_outInvDepth", "rr_edgeWeights", "rr_edgeBase", "rr_edgeFull", "rr_planeTexels")
 
 _PER_NODE_RE = re.compile(r"\b(" + "|".join(PER_NODE) + r")\b")
 

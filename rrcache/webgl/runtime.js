@@ -196,6 +196,8 @@
     gl.texParameteri(target, gl.TEXTURE_WRAP_S, t.kind === "cube" ? gl.CLAMP_TO_EDGE : wrap);
     gl.texParameteri(target, gl.TEXTURE_WRAP_T, t.kind === "cube" ? gl.CLAMP_TO_EDGE : wrap);
     textures[name] = {texture: tex, target: target, unit: unit++};
+    var error = gl.getError();
+    if (error !== gl.NO_ERROR) fail("texture " + name + " (" + t.width + "×" + t.height + ", " + t.format + ") could not be set up: GL error 0x" + error.toString(16));
   });
 
   // ------------------------------------------------------------------ targets

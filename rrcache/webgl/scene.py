@@ -23,7 +23,7 @@ import numpy as np
 
 from rrcache.errors import RRCacheError, SessionError
 from rrcache.harness.drawer import attribute_data, frame_builtins
-from rrcache.harness.vertex import ATTRIBUTES
+from rrcache.compiler.vertex import ATTRIBUTES
 
 #: the largest page the target writes (meshes and textures, before base64), bytes
 MAX_BYTES = 96 * 2 ** 20
@@ -97,6 +97,12 @@ def _textures(session, names) -> tuple[dict, int]:
             if data.ndim == 3:
                 data = data[..., None]
             _, h, w, c = data.shape
+        if c < 4:  # RGBA everywhere: WebGL2 makes mipmaps of every RGBA format (not of RGB8, RGB32F ...);
+            # the missing channels read as GL reads them from a narrower texture: 0, 0, alpha 1
+            pad = np.zeros(data.shape[:-1] + (4 - c,), np.float32)
+            pad[..., -1] = 1.0
+            data = np.concatenate([np.asarray(data, np.float32), pad], axis=-1)
+            c = 4
         fmt, stored = _texture_format(data)
         total += stored.nbytes
         out[name] = {"kind": kind, "width": int(w), "height": int(h), "channels": int(c), "format": fmt,
@@ -122,7 +128,7 @@ def bake(session, prepared, size: tuple[int, int], frames: Optional[int] = None)
     from rrcache.gl.program import build_program
     from rrcache.gl.uniforms import encode_uniform
     from rrcache.harness.bindings import lookup, plan_bindings
-    from rrcache.harness.vertex import vertex_for
+    from rrcache.compiler.vertex import vertex_for
 
     if getattr(session, "shadow_map", None) is not None:
         raise SessionError("the session's light has a shadow map, which the WebGL2 page does not render",

@@ -1,7 +1,7 @@
 // A glossy filter the way shader authors write one: a 3x3 kernel of texture samples around a
 // perturbed coordinate, weighted by a const table (a binomial kernel, centre heaviest), through a
-// helper. The kernel's partial sums are reordered by weight (the corners first, the centre
-// last), so "all but the centre" is a node.
+// helper that takes the sampler. The kernel's partial sums are reordered by weight (the corners
+// first, the centre last), so "all but the centre" is a node.
 #version 330
 in vec2 v_texcoord;
 in vec3 v_normal;
@@ -16,8 +16,8 @@ const float KERNEL[9] = float[](1.0, 2.0, 1.0,
                                 1.0, 2.0, 1.0);
 const float SPREAD = 0.02;
 
-vec3 tap(vec2 uv, vec2 offset) {
-    return textureLod(u_checker, uv + offset * SPREAD, 0.0).rgb;
+vec3 tap(sampler2D tex, vec2 uv, vec2 offset) {
+    return textureLod(tex, uv + offset * SPREAD, 0.0).rgb;
 }
 
 void main() {
@@ -28,7 +28,7 @@ void main() {
     for (int y = 0; y < TAPS; ++y) {
         for (int x = 0; x < TAPS; ++x) {
             float w = KERNEL[y * TAPS + x];
-            sum += w * tap(uv, vec2(x - 1, y - 1));
+            sum += w * tap(u_checker, uv, vec2(x - 1, y - 1));
             total += w;
         }
     }

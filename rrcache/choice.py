@@ -1,5 +1,6 @@
 """A profile's choice at one level, exactly as the profile made it: the one place that turns a
-level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with.
+level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with. (It sits
+above the pipeline and the profile's data: the document, :mod:`rrcache.profiles`, compiles nothing.)
 
 The profile's ``optimized/eN`` folders, ``rrcache instance PROFILE --level eN``,
 ``rrcache render PROFILE --level eN``, ``rrcache select --out`` and the report's "what to do
@@ -20,8 +21,9 @@ import json
 from pathlib import Path
 from typing import Optional
 
+from rrcache import kinds
 from rrcache.errors import RRCacheError
-from rrcache.selection import AdaptiveNode, Selection
+from rrcache.selection import Selection
 
 
 def level(prof, label: str) -> Selection:
@@ -43,11 +45,14 @@ def algorithm_of(prof, sel: Selection) -> str:
 
 
 def adaptive_kwargs(sel: Selection) -> dict:
-    """The runtime's adaptive-refresh arguments of ``sel`` (empty unless its part is adaptive)."""
-    if len(sel.parts) == 1 and isinstance(sel.parts[0], AdaptiveNode):
-        p = sel.parts[0]
-        return {"threshold": float(p.threshold), "fast_period": int(p.fast_period), "spread": float(p.spread)}
-    return {}
+    """The runtime's adaptive-refresh arguments of ``sel`` (empty unless its variant spec has a
+    threshold: :func:`rrcache.kinds.spec_for`)."""
+    if not sel.parts:
+        return {}
+    spec = kinds.spec_for(sel)
+    if spec.threshold is None:
+        return {}
+    return {"threshold": float(spec.threshold), "fast_period": int(spec.fast_period), "spread": float(spec.spread)}
 
 
 def runtime_options(prof, sel: Selection) -> dict:
@@ -66,7 +71,7 @@ def load_work(prof, include_dirs=()):
     # what profile.json names is the profiled shader and session, before anything parses them
     session = load_session_of(prof)
     work = load_for_session(prof.shader, session, prof.defines, list(include_dirs) + list(prof.include_dirs),
-                            vertex=prof.vertex)
+                            vertex=prof.vertex, term_scores=prof.term_scores)
     check_same_shader(prof, work)
     work.filter = prof.filter  # the variants compile as the profile trained them
     return work, session
@@ -98,7 +103,7 @@ def variant_of(prof, sel: Selection, work):
     (:func:`rrcache.pipeline.variant_for_selection`); the original shader has none (an error)."""
     from rrcache.pipeline import variant_for_selection
 
-    return variant_for_selection(work, sel.replace(algorithm=algorithm_of(prof, sel)))
+    return variant_for_selection(work, sel.replace(algorithm=algorithm_of(prof, sel)), **prof.settings.cache_options())
 
 
 def original_note(prof, sel: Selection) -> str:
@@ -130,8 +135,8 @@ def write(prof, sel: Selection, out_dir, work=None) -> list[str]:
 
 def describe_options(prof, sel: Selection) -> str:
     """The cache's options for ``sel`` in words: 'two-pass (the profile's choice: auto measured
-    two-pass 0.377, three-pass 0.41 of the original's time), refresh block 4, random refresh,
-    depth tolerance 0.001'."""
+    two-pass 0.377, three-pass 0.41 of the original's time), bilinear filter, refresh block 4,
+    random refresh, depth tolerance 0.001'."""
     algorithm = algorithm_of(prof, sel)
     times = prof.algorithm_times or {}
     if sel.algorithm and sel.algorithm != prof.algorithm:
@@ -142,7 +147,9 @@ def describe_options(prof, sel: Selection) -> str:
     else:
         why = "the profile's"
     opts = runtime_options(prof, sel)
-    text = (f"{algorithm} ({why}), refresh block {opts['block']}, {opts['refresh']} refresh, "
+    part = sel.parts[0] if sel.parts else None
+    filter_ = getattr(part, "filter", None) or getattr(prof, "filter", None) or "bilinear"
+    text = (f"{algorithm} ({why}), {filter_} filter, refresh block {opts['block']}, {opts['refresh']} refresh, "
             f"depth tolerance {opts['depth_epsilon']:g}")
     if "threshold" in opts:
         text += (f", adaptive refresh: threshold {opts['threshold']:g}, fast period {opts['fast_period']}, "
