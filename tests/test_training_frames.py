@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rrcache.profiler.plan import (MIN_ERROR_FRACTION, Plan, error_fraction, error_segments, restart, run_order,
-                                   warmup_frames)
+from rrcache.harness.segments import restart, run_order, warmup_frames
+from rrcache.profiler.plan import MIN_ERROR_FRACTION, Plan, error_fraction, error_segments
 from test_profile import write_scene
 
 
