@@ -601,8 +601,12 @@ def filter_line(prof: Profile) -> str:
 
 
 def algorithm_line(prof: Profile) -> str:
-    """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
-    0.377, three-pass 0.41 of the original's time)'."""
+    """The profile's algorithm, and with ``auto`` how it was decided: 'two-pass (auto, from the
+    ceiling: two-pass 1.47× against three-pass 0.85× ...)', or what a timing measured
+    ('two-pass (auto: two-pass 0.377, three-pass 0.41 of the original's time)')."""
+    reason = (prof.plan or {}).get("algorithm_reason")
+    if prof.settings.algorithm == "auto" and reason:
+        return f"{prof.algorithm} (auto, from {reason})"
     times = prof.algorithm_times or {}
     if prof.settings.algorithm != "auto" or not times:
         return prof.algorithm
