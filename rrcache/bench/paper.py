@@ -375,8 +375,9 @@ def render_cache_row(work, session, frames, search, target, settings, progress, 
     found = tune_samples(work.prepared, session, search, target, base, rel_tol=settings.tolerance,
                          max_steps=settings.max_steps, progress=step)
     final = compare(work.prepared, session, frames, replace(base, samples=found.value), on_frame=on_frame)
-    row = MethodRow(RENDER_CACHE, f"{found.value:.2%} of the pixels per frame ({final.budget} pixels, "
-                                  f"{base.block}×{base.block} blocks, {base.points_per_pixel:g} points per pixel)",
+    chosen = replace(base, samples=found.value)
+    row = MethodRow(RENDER_CACHE, f"{chosen.describe().split(': ', 1)[1]} ({final.budget} pixels), a cache of "
+                                  f"{base.points_per_pixel:g}× the pixels",
                     final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
                     final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                     [list(s) for s in found.steps])

@@ -25,6 +25,14 @@ import numpy as np
 from rrcache import atomic
 
 
+def _json(path) -> dict:
+    """A JSON file this tool was given, read by rrcache.files' rule."""
+    from rrcache.budgets import budget
+    from rrcache.files import read_bytes
+
+    return json.loads(read_bytes(path, budget.document_bytes))
+
+
 def _parse_set(text: str) -> tuple[list[str], list[int]]:
     nodes, periods = [], []
     for item in text.split(","):
@@ -151,11 +159,11 @@ def plot(profile_dirs: list, measured: list, levels_json: list, path, titles=Non
     for folder, bench, lev in zip(profile_dirs, measured, levels_json):
         prof = load_profile(folder)
         known = {o.key for o in prof.sets if o.trained}
-        extra = [SetOption.from_json(r) for r in json.load(open(bench))["sets"]] if bench else []
+        extra = [SetOption.from_json(r) for r in _json(bench)["sets"]] if bench else []
         extra = [o for o in extra if o.key not in known]
         taken = {o.key for o in extra}  # a measured set replaces its untrained prediction
         prof.sets = [o for o in prof.sets if o.key not in taken] + extra
-        rows = json.load(open(lev))["levels"] if lev else []
+        rows = _json(lev)["levels"] if lev else []
         prof.selections = [_read_dataclass(Selection, r[side], "", lev) for r in rows for side in ("single", "with_sets")
                            if side == "single" or r["changed"]]
         profiles.append(prof)
@@ -184,7 +192,7 @@ def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measureme
                    a.plot))
         return
     if a.levels:
-        extra = json.load(open(a.extra))["sets"] if a.extra else []
+        extra = _json(a.extra)["sets"] if a.extra else []
         result = levels(a.profile, a.shader, a.session, a.validation_frames, extra)
         for row in result["levels"]:
             for side in ("single", "with_sets"):

@@ -23,8 +23,10 @@ import click
 from rich.console import Console
 
 from rrcache.cli import interrupt
-from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
+from rrcache.cli.options import (cluster_options, include_dirs_option, parse_defines, resolution_option as _resolution,
+                                 vert_option)
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.cluster import maybe_cluster
 from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
 from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK, UNRELIABLE_NOISE
@@ -136,12 +138,14 @@ def _fmt(value, spec=".3g", none="–"):
               help="The frame clock of every timed run: wall = wall time around glFinish (the only one that "
                    "means anything on a software rasterizer); gl-timer = GL timer queries (real GPUs). "
                    "Recorded in the profile.")
+@cluster_options
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, max_sets, defines, adaptive, clock, max_flip, quiet, vert, include_dirs):
+            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain,
+            timing_format, levels, wait, max_sets, defines, adaptive, clock, workers, scheduler, max_flip, quiet, vert,
+            include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
@@ -164,9 +168,10 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         with Reporter(err_console, quiet=quiet) as reporter, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
-                               vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive,
-                               max_flip=max_flip)
+                with maybe_cluster(workers, scheduler, announce=reporter.line) as cluster:
+                    prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
+                                   vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive,
+                                   executor=cluster, max_flip=max_flip)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)

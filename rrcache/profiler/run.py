@@ -65,8 +65,11 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     same level (:mod:`rrcache.profiler.adaptive`). ``executor``: a callable ``(work, session) ->
     executor`` making what runs the training's :class:`~rrcache.runs.RunSpec` s (its
     ``run(specs, on_frame=None)`` yields a :class:`~rrcache.runs.RunResult` per spec, in any order;
-    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`).
-    ``max_flip``: a fifth level, ``flip``, of mean FLIP at most this
+    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`). A
+    factory with a ``capacity`` (runs made at once: a Dask cluster's workers,
+    :class:`rrcache.cluster.client.Cluster`) buys a larger default plan
+    (:mod:`rrcache.profiler.capacity`); an executor with a ``record(capacity)`` has it kept in
+    ``Profile.cluster``. ``max_flip``: a fifth level, ``flip``, of mean FLIP at most this
     (:func:`rrcache.profiler.validate.flip_level`; docs/levels.md).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
@@ -97,7 +100,15 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
 
     session = load_session(session_path)
     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
-    resolved = (settings or TrainingSettings()).resolved(session)
+    settings = settings or TrainingSettings()
+    capacity = None
+    if executor is not None and getattr(executor, "capacity", None):
+        # an executor that makes several runs at once buys a larger default plan: more training
+        # frames and more nodes (rrcache.profiler.capacity)
+        from rrcache.profiler.capacity import scaled
+
+        settings, capacity = scaled(settings, session, int(executor.capacity))
+    resolved = settings.resolved(session)
     from rrcache.profiler.amortize import estimator_table
 
     estimator_table(work)  # a malformed '#pragma rrcache estimator': said before anything is trained
@@ -151,6 +162,8 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
             prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
+            if hasattr(runner, "record"):  # where the runs were made (a Dask cluster's workers)
+                prof.cluster = runner.record(capacity)
             prof.write(out)
         except KeyboardInterrupt:
             _end_quietly(store, "interrupted")

@@ -200,6 +200,9 @@ class Profile:
     #: texture it could not decode ...), in order; :func:`rrcache.profiles.notices.run_warnings`
     #: adds the ones its measurements imply
     warnings: list[str] = field(default_factory=list)
+    #: the Dask cluster the runs were made on (rrcache.cluster.executor.DaskExecutor.record: workers, hosts,
+    #: what their capacity bought, the hosts of the timed runs); None: made in one process
+    cluster: Optional[dict] = None
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):

@@ -165,10 +165,11 @@ def _multi_selection(prof, sel, note: str = "several nodes: no frames are shown 
 
 def _session_size(prof) -> tuple:
     """The session's resolution, read from its file (the training's when it cannot be read)."""
+    from rrcache.profiles.inputs import session_document
+
     try:
-        with open(prof.session, encoding="utf-8") as f:
-            return tuple(int(v) for v in json.load(f)["resolution"])
-    except (OSError, ValueError, KeyError, TypeError):
+        return tuple(int(v) for v in session_document(prof)["resolution"])
+    except (RRCacheError, ValueError, KeyError, TypeError):
         return tuple(prof.settings.resolution or (0, 0))
 
 

@@ -12,11 +12,16 @@ from __future__ import annotations
 import base64
 import io
 import json
+import os
 from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
+
+from rrcache.budgets import budget
+from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
 
 #: the widest image the report and the notebooks render (pixels)
 MAX_WIDTH = 320
@@ -135,6 +140,8 @@ class ChoiceImages:
     description: Optional[str] = None
     #: image name -> its PNG file (from a profile folder: :func:`read_frames`)
     files: dict = field(default_factory=dict)
+    #: image name -> the PNG bytes read from that file (by :mod:`rrcache.files`' rule)
+    blobs: dict = field(default_factory=dict)
 
     @property
     def cached(self) -> bool:
@@ -153,8 +160,8 @@ class ChoiceImages:
     def png(self, name: str) -> bytes:
         """One image as PNG bytes (``KeyError`` for an image this choice does not have): its file
         as written, or the array encoded."""
-        if name in self.files:
-            return Path(self.files[name]).read_bytes()
+        if name in self.blobs:
+            return self.blobs[name]
         return png_bytes(self.arrays[name])
 
     def to_json(self, files: dict) -> dict:
@@ -167,18 +174,21 @@ class ChoiceImages:
 
     @classmethod
     def from_json(cls, record: dict, folder) -> "ChoiceImages":
-        """The images of a ``frames.json`` record, their PNG files in ``folder``."""
+        """The images of a ``frames.json`` record, their PNG files in ``folder``, each read by
+        :mod:`rrcache.files`' rule inside the profile folder (``frames.json`` may have been
+        edited: a file it names elsewhere, or through a link out, is refused, never read)."""
         from PIL import Image
 
         files = {name: Path(folder) / rel for name, rel in record.get("images", {}).items()}
-        arrays = {}
+        arrays, blobs = {}, {}
         for name, path in files.items():
-            with Image.open(path) as im:
+            blobs[name] = _folder_file(folder, path, budget.asset_bytes)
+            with Image.open(io.BytesIO(blobs[name])) as im:
                 arrays[name] = np.asarray(im.convert("RGB"), dtype=np.float32) / 255.0
         out = cls(record.get("node"), record.get("period"), int(record["frame"]), tuple(record["size"]), arrays,
                   float(record.get("error") or 0.0), record.get("hit_rate"), record.get("error_scale"),
                   [tuple(r) for r in record.get("payload_ranges", [])], None, dict(record.get("captions", {})),
-                  record.get("what"), files)
+                  record.get("what"), files, blobs)
         out.was_cached = bool(record.get("cached"))
         return out
 
@@ -196,6 +206,17 @@ class ChoiceImages:
         return base
 
 
+def _folder_file(folder, path, limit: int) -> bytes:
+    """The bytes of ``path``, a file of the profile folder ``folder``, read by :mod:`rrcache.files`'
+    rule confined to that folder; a refusal is an :class:`RRCacheError` naming the file."""
+    try:
+        return read_file(path, limit, [os.path.realpath(folder)]).data
+    except Refused as err:
+        said = f"resolves to {err.real}, outside the profile's folder" if err.kind == "outside" else err.reason
+        raise RRCacheError(f"a frame file of the profile {said}; nothing of it was read", str(path),
+                           hint="frames/frames.json was damaged or edited; run 'rrcache profile' again") from None
+
+
 #: where the profiler keeps the report's frames in a profile folder, and their record
 FRAMES_DIR = "frames"
 FRAMES_JSON = "frames.json"
@@ -207,5 +228,5 @@ def read_frames(folder) -> dict:
     path = Path(folder) / FRAMES_DIR / FRAMES_JSON
     if not path.exists():
         return {}
-    data = json.loads(path.read_text(encoding="utf-8"))
+    data = json.loads(_folder_file(folder, path, budget.document_bytes))
     return {label: ChoiceImages.from_json(record, Path(folder)) for label, record in data.get("selections", {}).items()}

@@ -54,7 +54,7 @@ from rrcache.alternatives.render_cache.points import BACKGROUND, STATIC, PointCa
 from rrcache.alternatives.render_cache.projection import Projector, screen_matrix, zbuffer
 from rrcache.alternatives.render_cache.sampling import (block_priority, blocks_to_pixels, dither, grid_size,
                                                         hilbert_order, predicted_requests)
-from rrcache.alternatives.render_cache.settings import RenderCacheSettings
+from rrcache.kinds.render_cache import RenderCacheSettings
 from rrcache.alternatives.render_cache.shading import SampleShader
 from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.gl.resources import GLScope
