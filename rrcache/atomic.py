@@ -38,7 +38,7 @@ import tempfile
 from typing import Iterator, Optional
 
 from rrcache.errors import RRCacheError, printable
-from rrcache.files import kind_of, read_bytes
+from rrcache.files import Descriptor, kind_of, read_bytes
 
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _DIRECTORY = getattr(os, "O_DIRECTORY", 0)
@@ -57,7 +57,7 @@ def _check_name(name: str) -> str:
     return name
 
 
-class OutputFolder:
+class OutputFolder(Descriptor):
     """A folder rrcache writes into, opened once (see the module docstring). ``path`` is the
     folder as the user named it (for messages); :meth:`folder` opens a subfolder without following
     links; :meth:`write_bytes`/:meth:`write_text` write a file by the rule. Close it (or use a
@@ -212,22 +212,6 @@ class OutputFolder:
         the plain path where ``/proc`` is missing."""
         through = f"/proc/self/fd/{self.fd}"
         return os.path.join(through, name) if os.path.isdir(through) else self.join(name)
-
-    # ------------------------------------------------------------------ closing
-    def close(self) -> None:
-        if getattr(self, "fd", -1) >= 0:
-            with contextlib.suppress(OSError):
-                os.close(self.fd)
-            self.fd = -1
-
-    def __enter__(self) -> "OutputFolder":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-    def __del__(self) -> None:
-        self.close()
 
 
 def _split(path: "str | os.PathLike[str]") -> tuple[str, str]:

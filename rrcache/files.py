@@ -100,7 +100,29 @@ def _size_words(n: int) -> str:
     return f"{n:,} bytes"
 
 
-class OpenedFile:
+class Descriptor:
+    """An open file descriptor ``fd`` that closes once (``close()``, a ``with`` block, or when
+    collected); -1 once closed."""
+
+    fd = -1
+
+    def close(self) -> None:
+        if self.fd >= 0:
+            with contextlib.suppress(OSError):
+                os.close(self.fd)
+            self.fd = -1
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        self.close()
+
+
+class OpenedFile(Descriptor):
     """A regular file opened by the rule and kept open (a texture decoded later, by a library
     that reads by name: :attr:`library_path` reaches this very file through the descriptor).
     ``sha256`` is computed from the descriptor once. Close it (or let it be collected)."""
@@ -131,21 +153,6 @@ class OpenedFile:
                 offset += len(chunk)
             self._sha256 = h.hexdigest()
         return self._sha256
-
-    def close(self) -> None:
-        if getattr(self, "fd", -1) >= 0:
-            with contextlib.suppress(OSError):
-                os.close(self.fd)
-            self.fd = -1
-
-    def __enter__(self) -> "OpenedFile":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-    def __del__(self) -> None:
-        self.close()
 
 
 def open_file(path: "str | os.PathLike[str]", limit: Optional[int], roots: Optional[Iterable[str]] = None,

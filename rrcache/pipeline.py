@@ -2,7 +2,7 @@
 shares.
 
 A shader is loaded with the ``MODEL_VERTEX_*`` defines of the session's meshes (plus the user's
-``-D`` defines; :func:`rrcache.harness.prepare.load_for_meshes`, the one place that does it),
+``-D`` defines; :func:`rrcache.compiler.prepared.load_for_meshes`, the one place that does it),
 prepared for the harness (core GLSL with a line map) and analysed (the cacheable nodes).
 :func:`load_for_session` does the three once (the preparation when first asked for);
 :func:`variant_for` compiles the variant of one node, and :func:`variant_for_selection` turns a
@@ -30,12 +30,14 @@ from typing import Mapping, Optional
 
 from rrcache.analysis import cacheable_nodes
 from rrcache.analysis.unroll import DEFAULT_MAX_ITERATIONS
-from rrcache.compiler import Variant, instance, instance_nodes
+from rrcache import kinds
+from rrcache.compiler import Variant
+from rrcache.compiler.prepared import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
 from rrcache.errors import RRCacheError
 from rrcache.glsl.frontend import Shader
-from rrcache.harness.prepare import PreparedShader, combined_hash, load_for_meshes, load_user_vertex, prepare
 from rrcache.runtime.cache import DEFAULT_FILTER
-from rrcache.selection import AdaptiveNode, AmortizedLoop, CachedNode, Selection
+from rrcache.runtime.spec import VariantSpec
+from rrcache.selection import Selection
 from rrcache.session.changes import per_frame_uniforms
 
 
@@ -51,11 +53,13 @@ class ShaderWork:
     vertex: object = None
     #: the command line's include folders (absolute; the session's own are in the session)
     include_dirs: tuple = ()
+    #: the unroll limit the table was analysed with (part of the compile cache's key)
+    max_unroll: int = DEFAULT_MAX_ITERATIONS
     #: the cache filter every variant of this work compiles with unless told otherwise (a
     #: profile's: ``Profile.filter``, chosen by rrcache.profiler.filters)
     filter: str = DEFAULT_FILTER
     #: the measured order of its sums (rrcache.profiler.terms; node ids refer to the program it
-    #: ordered); empty: none measured
+    #: ordered; part of the compile cache's key); empty: none measured
     term_scores: dict = field(default_factory=dict)
 
     @cached_property
@@ -96,7 +100,7 @@ def load_for_session(shader_path, session=None, defines: Optional[Mapping[str, s
     moving = sorted(per_frame_uniforms(session)) if session is not None else ()
     table = cacheable_nodes(shader, max_iterations=max_unroll, moving=moving, scores=term_scores or None)
     return ShaderWork(shader, table, all_defines, user, tuple(os.path.abspath(d) for d in include_dirs or ()),
-                      term_scores=dict(term_scores or {}))
+                      max_unroll=int(max_unroll), term_scores=dict(term_scores or {}))
 
 
 def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
@@ -106,49 +110,70 @@ def all_include_dirs(include_dirs=(), session=None) -> tuple[str, ...]:
 
 def variant_for(work: ShaderWork, node_id: str, algorithm: str = "three-pass", filter: Optional[str] = None,
                 payload_dtype: str = "f4", adaptive: bool = False) -> Variant:
-    """Compile the variant of ``work`` caching ``node_id`` (an id such as ``n42``;
-    ``adaptive``: refreshed by :mod:`rrcache.runtime.adaptive`'s rule; ``filter``: the work's
-    when not given)."""
-    return instance(work.table, node_id, algorithm, filter or work.filter, payload_dtype, work.vertex,
-                    adaptive=adaptive)
+    """The variant of ``work`` caching ``node_id`` (an id such as ``n42``; ``adaptive``: refreshed
+    by :mod:`rrcache.runtime.adaptive`'s rule; ``filter``: the work's when not given), compiled
+    once (:func:`rrcache.kinds.compile`)."""
+    spec = VariantSpec("adaptive" if adaptive else "cache", (node_id,), algorithm, filter or work.filter, payload_dtype)
+    return kinds.compile(work, spec)
 
 
 def variant_for_nodes(work: ShaderWork, node_ids, algorithm: str = "three-pass", filter: Optional[str] = None,
                       payload_dtype: str = "f4") -> Variant:
-    """Compile the variant of ``work`` caching every node of ``node_ids`` (two or more; one:
+    """The variant of ``work`` caching every node of ``node_ids`` (two or more; one:
     :func:`variant_for`), each with its own payload and period
-    (:func:`rrcache.compiler.instance_nodes`)."""
+    (:func:`rrcache.compiler.instance_nodes`), compiled once."""
     node_ids = list(node_ids)
     if len(node_ids) == 1:
         return variant_for(work, node_ids[0], algorithm, filter, payload_dtype)
-    return instance_nodes(work.table, node_ids, algorithm, filter or work.filter, payload_dtype, work.vertex)
+    return kinds.compile(work, VariantSpec("nodes", tuple(node_ids), algorithm, filter or work.filter, payload_dtype))
 
 
-def variant_for_selection(work: ShaderWork, selection: Selection) -> tuple[Variant, int]:
+def variant_for_selection(work: ShaderWork, selection: Selection, **runtime) -> tuple[Variant, object]:
     """The compiled variant of ``selection`` (with its ``algorithm``; three-pass when it names
-    none) and the refresh period it runs with (for several nodes, a list of periods in the
-    order of the parts): where each kind of choice becomes code. The
-    original shader (no part) has no variant: RRCacheError."""
-    algorithm = selection.algorithm or "three-pass"
-    if len(selection.parts) == 1 and isinstance(selection.parts[0], CachedNode):
-        part = selection.parts[0]
-        return variant_for(work, part.node, algorithm), int(part.period)
-    if len(selection.parts) == 1 and isinstance(selection.parts[0], AdaptiveNode):
-        # the runtime takes the threshold, fast period and spread from the part
-        # (rrcache.profiles.choice.adaptive_kwargs)
-        part = selection.parts[0]
-        return variant_for(work, part.node, algorithm, adaptive=True), int(part.period)
-    if selection.multi:  # several nodes, each at its own period (a list, in part order)
-        return variant_for_nodes(work, list(selection.nodes), algorithm), list(selection.periods)
-    if len(selection.parts) == 1 and isinstance(selection.parts[0], AmortizedLoop):
-        from rrcache.compiler.amortize import instance_amortized
-        from rrcache.runtime.cache import DEFAULT_PERIOD
+    none; ``runtime``: the cache's run-time fields, ``block``, ``refresh``, ``depth_epsilon``) and
+    the refresh period it runs with (for several nodes, the list of periods in part order): the
+    kind of choice (:mod:`rrcache.kinds`) says how it compiles. The variant's ``spec`` is the
+    selection's, whole. The original shader (no part) has no variant: RRCacheError."""
+    spec = kinds.spec_for(selection, selection.algorithm or "three-pass", work.filter, **runtime)
+    period = spec.period
+    return kinds.compile(work, spec), list(period) if isinstance(period, tuple) else period
 
-        part = selection.parts[0]
-        variant = instance_amortized(work.shader, part.estimator, algorithm, samples=part.samples,
-                                     blend=part.blend, phase=part.phase, history=part.history,
-                                     filter=part.filter, payload_dtype=part.payload, vertex=work.vertex)
-        # an amortized variant does not use the refresh rule: the period is the runtime's default
-        return variant, DEFAULT_PERIOD
-    raise RRCacheError(f"no variant for a selection of kind {selection.kind!r}", "selection",
-                       hint="the original shader needs none; other kinds are compiled where they are added")
+
+@dataclass(frozen=True)
+class WorkSource:
+    """How to load a :class:`ShaderWork` and its session, as a plain record (a worker of a
+    distributed executor loads it once): the shader and session paths, the user's ``defines``
+    (pairs), include folders, vertex shader and unroll limit, as :func:`load_for_session` takes
+    them."""
+
+    shader: str
+    session: str
+    defines: tuple = ()
+    include_dirs: tuple = ()
+    vertex: Optional[str] = None
+    max_unroll: int = DEFAULT_MAX_ITERATIONS
+    #: the measured order of sums (``load_for_session(term_scores=)``; None: the analysis's own)
+    term_scores: Optional[dict] = None
+
+    @classmethod
+    def of(cls, work: ShaderWork, session, user_defines=None) -> "WorkSource":
+        """The source of a loaded ``work`` over ``session`` (``user_defines``: the ``-D`` ones)."""
+        return cls(str(work.shader.path), str(session.path), tuple(sorted((user_defines or {}).items())),
+                   tuple(work.include_dirs), getattr(work.vertex, "path", None), int(work.max_unroll))
+
+    def load(self) -> tuple[ShaderWork, object]:
+        """(work, session), loaded and analysed."""
+        from rrcache.session import load_session
+
+        session = load_session(self.session)
+        work = load_for_session(self.shader, session, dict(self.defines), self.include_dirs, self.max_unroll,
+                                vertex=self.vertex, term_scores=self.term_scores)
+        return work, session
+
+
+def load_bench(source: WorkSource):
+    """A :class:`rrcache.harness.execute.Bench` for ``source`` (what a worker makes once, then runs
+    :func:`rrcache.harness.execute.execute` on for every spec it is given)."""
+    from rrcache.harness.execute import Bench
+
+    return Bench(*source.load())

@@ -50,3 +50,31 @@ def local_farm(folder, workers: int = 2, env=None):
                 proc.wait()
         for log in logs:
             log.close()
+
+
+@contextlib.contextmanager
+def killing_a_busy_worker(client, matching: str = "", within_s: float = 120.0):
+    """While the ``with`` block runs, SIGKILL the first worker seen busy with a task whose key
+    contains ``matching`` (once); yields the list that receives the killed process id."""
+    import threading
+
+    victims: list = []
+    stop = threading.Event()
+
+    def watch():
+        deadline = time.time() + within_s
+        while time.time() < deadline and not victims and not stop.is_set():
+            busy = sorted(w for w, keys in client.processing().items() if any(matching in str(k) for k in keys))
+            if busy:
+                pid = client.run(os.getpid, workers=[busy[0]])[busy[0]]
+                os.kill(pid, signal.SIGKILL)
+                victims.append(pid)
+            time.sleep(0.02)
+
+    killer = threading.Thread(target=watch)
+    killer.start()
+    try:
+        yield victims
+    finally:
+        stop.set()
+        killer.join()

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import json
 import os
+import sqlite3
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -97,27 +100,63 @@ main(sys.argv[1:])
 """
 
 
+#: a small launcher between the test and the traced command: the kernel starts a child's peak
+#: memory count from its parent's resident size at the fork, so the command is forked from this
+#: fresh interpreter (tens of MiB), not from the test process, and its own peak is what is measured
+_LAUNCH = """
+import os, sys
+usage_file, argv = sys.argv[1], sys.argv[2:]
+pid = os.fork()
+if pid == 0:
+    os.execv(sys.executable, [sys.executable, *argv])
+_, status, usage = os.wait4(pid, 0)
+with open(usage_file, "w") as f:
+    f.write(str(usage.ru_maxrss))
+sys.exit(os.waitstatus_to_exitcode(status) % 256)
+"""
+
+
 def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
     """``rrcache ARGS`` in ``cwd``, traced: (exit code, stdout, the non-empty stderr lines, the
-    child's peak resident memory in MiB (its own ``wait4`` rusage), every path it opened).
-    A run past ``timeout`` seconds is killed (a hang guard, not a timing)."""
+    command's peak resident memory in MiB (its own ``wait4`` rusage, forked from a small
+    launcher), every path it opened). A run past ``timeout`` seconds is killed (a hang guard,
+    not a timing)."""
     import tempfile
-    import threading
 
     with tempfile.TemporaryDirectory(prefix="rrcache-traced-") as tmp:
-        names = {k: os.path.join(tmp, k) for k in ("out", "err", "opens")}
+        names = {k: os.path.join(tmp, k) for k in ("out", "err", "opens", "usage")}
         open(names["opens"], "w").close()
         with open(names["out"], "w") as out, open(names["err"], "w") as err:
-            proc = subprocess.Popen([sys.executable, "-c", _TRACED, *map(str, args)], cwd=cwd, stdin=stdin,
-                                    env={**env(), "RRCACHE_TEST_OPENS": names["opens"]}, stdout=out, stderr=err)
-        timer = threading.Timer(timeout, proc.kill)
-        timer.start()
-        try:
-            _, status, usage = os.wait4(proc.pid, 0)
-        finally:
-            timer.cancel()
-        proc.returncode = code = os.waitstatus_to_exitcode(status)
-        assert code != -9, f"killed after {timeout} s: {args}"
+            proc = subprocess.run([sys.executable, "-c", _LAUNCH, names["usage"], "-c", _TRACED, *map(str, args)],
+                                  cwd=cwd, stdin=stdin, env={**env(), "RRCACHE_TEST_OPENS": names["opens"]},
+                                  stdout=out, stderr=err, timeout=timeout)
         read = lambda k: open(names[k], encoding="utf-8", errors="replace").read()  # noqa: E731
         lines = [line for line in read("err").splitlines() if line.strip()]
-        return code, read("out"), lines, usage.ru_maxrss / 1024, read("opens").splitlines()
+        return proc.returncode, read("out"), lines, int(read("usage")) / 1024, read("opens").splitlines()
+
+
+@pytest.fixture(scope="module")
+def made_profile(tmp_path_factory):
+    """A folder with ``scene.frag``, ``scene.json`` and ``p/``, their small profile (every
+    selection the original at this size: seconds), made once per test module for its tests to
+    copy."""
+    folder = tmp_path_factory.mktemp("made")
+    write_case(folder)
+    code, _, lines = rrcache(folder, "profile", "scene.frag", "scene.json", "--out", "p", *QUICK_PROFILE)
+    assert code == 0, lines
+    return folder
+
+
+def stored_error_runs(path) -> int:
+    """The error runs the store at ``path`` holds now, read without waiting on its writer (0 while
+    it is missing, being created or locked for a moment)."""
+    if not Path(path).exists():
+        return 0
+    try:
+        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=0.2)
+        try:
+            return int(conn.execute("SELECT COUNT(*) FROM error_run").fetchone()[0])
+        finally:
+            conn.close()
+    except sqlite3.Error:
+        return 0

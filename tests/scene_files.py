@@ -82,8 +82,8 @@ def node_named(shader_path, session, text: str):
     whose text is ``text``."""
     from rrcache.analysis import cacheable_nodes
     from rrcache.glsl.frontend import load_shader
-    from rrcache.harness.prepare import prepare_file
-    from rrcache.harness.vertex import mesh_defines, session_attributes
+    from rrcache.compiler.prepared import prepare_file
+    from rrcache.compiler.vertex import mesh_defines, session_attributes
 
     shader = load_shader(shader_path, defines=mesh_defines(session_attributes(session)))
     prepared = prepare_file(shader_path, session)

@@ -13,13 +13,13 @@ import json
 import math
 import os
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
 
 import pytest
 
+from safety_cli import stored_error_runs
 from scene_files import CLI_SETTINGS, write_scene
 
 from rrcache.profiles import read_store
@@ -54,25 +54,12 @@ def _spawn(*args):
                             stderr=subprocess.PIPE, text=True, env=_env(), preexec_fn=default_sigint)
 
 
-def _stored_runs(path) -> int:
-    if not path.exists():
-        return 0
-    try:
-        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=0.2)
-        try:
-            return int(conn.execute("SELECT COUNT(*) FROM error_run").fetchone()[0])
-        finally:
-            conn.close()
-    except sqlite3.Error:  # not created yet, or locked for a moment
-        return 0
-
-
 def _wait_for_runs(proc, path, at_least: int) -> int:
     deadline = time.monotonic() + 90
     while time.monotonic() < deadline:
         if proc.poll() is not None:
             pytest.fail(f"the profile finished before it could be interrupted: {proc.stderr.read()}")
-        n = _stored_runs(path)
+        n = stored_error_runs(path)
         if n >= at_least:
             return n
         time.sleep(0.01)
@@ -128,7 +115,10 @@ def test_select_json_and_out(full, tmp_path):
     choice = json.loads(proc.stdout)
     assert set(choice) == {"node", "period", "predicted_error", "predicted_ms", "predicted_speedup",
                            "predicted_speedup_range", "predicted_psnr", "predicted_psnr_uncertainty", "exact",
-                           "visible_artifacts"}
+                           "visible_artifacts", "source", "note", "warnings", "measured_error", "measured_psnr",
+                           "measured_psnr_uncertainty", "measured_speedup", "speedups", "measured_flip",
+                           "measured_temporal_psnr"}
+    assert choice["source"] in ("measured", "predicted")  # docs/levels.md: each figure says which
     data = json.loads((out / "profile.json").read_text())
     if choice["node"] is not None:
         assert choice["node"] in {n["id"] for n in data["nodes"]} and 1 <= choice["period"] <= 50
@@ -136,7 +126,7 @@ def test_select_json_and_out(full, tmp_path):
     assert by_psnr["node"] is None or by_psnr["predicted_psnr"] >= 40 - 1e-9
     assert by_psnr["exact"] == (by_psnr["node"] is None or by_psnr["predicted_error"] == 0)
     both = rrcache("select", out, "--min-psnr", "40", "--max-error", "0.1", check=False)
-    assert both.returncode == 2 and "one of --max-error and --min-psnr" in both.stderr
+    assert both.returncode == 2 and "one of --max-error, --min-psnr and --max-flip" in both.stderr
     strict = json.loads(rrcache("select", out / "profile.json", "--max-error", "0", "--json").stdout)
     assert strict["predicted_error"] <= 1e-12 and strict["predicted_ms"] >= choice["predicted_ms"]
     written = rrcache("select", out, "--max-error", "1e9", "--out", tmp_path / "opt")
@@ -196,7 +186,7 @@ def test_resume_after_sigkill(full, tmp_path, stability_case):
     proc.send_signal(signal.SIGKILL)
     proc.wait(timeout=30)
     assert proc.returncode == -signal.SIGKILL
-    killed_at = _stored_runs(store_path)
+    killed_at = stored_error_runs(store_path)
     total = 3 * len(_fits(folder / "out"))
     assert 3 <= killed_at < total
     assert not (out / "profile.json").exists()  # nothing is written before training finishes

@@ -8,7 +8,7 @@ import pytest
 
 from rrcache.cli import main
 from rrcache.cli.options import parse_defines
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import render
 from rrcache.session import load_session
 

@@ -12,16 +12,14 @@
 from __future__ import annotations
 
 import os
-import signal
 import subprocess
 import sys
-import threading
-import time
 
 import cloudpickle
 import pytest
 
 import cluster_runs
+from farm import killing_a_busy_worker
 
 cloudpickle.register_pickle_by_value(cluster_runs)
 
@@ -82,26 +80,11 @@ def test_a_killed_worker_loses_only_its_run(cluster):
     c, _ = cluster
     runs = DaskRuns(c)
     name = runs.open("sleepy", cluster_runs.Sleepy())
-    victims = []
-
-    def kill_the_first_busy_worker():
-        deadline = time.time() + 30
-        while time.time() < deadline and not victims:
-            busy = {w: keys for w, keys in c.client.processing().items() if keys}
-            if busy:
-                worker = sorted(busy)[0]
-                pid = c.client.run(os.getpid, workers=[worker])[worker]
-                os.kill(pid, signal.SIGKILL)
-                victims.append(pid)
-            time.sleep(0.05)
-
-    killer = threading.Thread(target=kill_the_first_busy_worker)
-    killer.start()
-    try:
-        done = list(runs.map(name, [(1.0, "error") for _ in range(4)]))
-    finally:
-        killer.join()
-        runs.close(name)
+    with killing_a_busy_worker(c.client) as victims:
+        try:
+            done = list(runs.map(name, [(1.0, "error") for _ in range(4)]))
+        finally:
+            runs.close(name)
     assert victims, "no worker was busy to be killed"
     assert len(done) == 4 and not any(isinstance(p, RunFailure) for _, p in done)
     assert victims[0] not in {p.pid for _, p in done}

@@ -16,7 +16,7 @@ from rrcache.analysis.estimators import find_estimators
 from rrcache.compiler.amortize import instance_amortized, subset_indices
 from rrcache.glsl.frontend import load_shader
 from rrcache.harness.cached import CachedRenderer, compare
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer
 from rrcache.session import load_session
 

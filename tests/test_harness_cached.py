@@ -16,7 +16,9 @@ import pytest
 
 from rrcache.compiler import instance
 from rrcache.harness.cached import CachedRenderer, compare
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer
+from rrcache.compiler.vertex import mesh_defines, session_attributes
 from rrcache.session import load_session
 from masks import dilate, erode  # noqa: E402
 from scene_files import FIXED_LIGHT, SPHERE, STATIC_CAMERA, fragment, node_named, session_doc, write_scene

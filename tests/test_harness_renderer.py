@@ -15,7 +15,7 @@ import pytest
 
 from rrcache.errors import GLError, SessionError, UnsupportedShaderError
 from rrcache.glsl.frontend import parse_shader
-from rrcache.harness.prepare import Decl, PreparedShader, prepare, prepare_file
+from rrcache.compiler.prepared import Decl, PreparedShader, prepare, prepare_file
 from rrcache.harness.reference import ReferenceCache
 from rrcache.harness.renderer import Renderer, frame_indices, parse_resolution, render
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rrcache.errors import SessionError
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import render
 from rrcache.session import load_session
 from rrcache.session.shadow import light_matrix

@@ -23,9 +23,10 @@ from scene_files import SESSION
 from rrcache.errors import RRCacheError, SessionError, UnsupportedShaderError
 from rrcache.harness.cached import compare
 from rrcache.harness.renderer import render
-from rrcache.harness.user_vertex import user_vertex_from_text
+from rrcache.compiler.user_vertex import user_vertex_from_text
 from rrcache.pipeline import load_for_session, variant_for
 from rrcache.session import load_session
+from rrcache.choice import write as choice_write
 
 # glslViewer's conventions: attribute vec4 a_position, MODEL_VERTEX_* guards, a custom varying
 VERT = """#ifdef GL_ES
@@ -246,12 +247,12 @@ def test_profile_remembers_the_vertex_shader(gl_ctx, tmp_path):
     assert prof.vertex == str(vert) and prof.vertex_hash
     node = next(n.id for n in prof.nodes if n.trained)
     again = load_profile(tmp_path / "out")
-    written = again.write_variant(Selection(parts=(CachedNode(node, 4),)), tmp_path / "sel")
+    written = choice_write(again, Selection(parts=(CachedNode(node, 4),)), tmp_path / "sel")
     assert "rr_userMain" in next(open(p).read() for p in written if p.endswith("reproject.vert") or
                                  p.endswith("hit.vert") or p.endswith("single.vert"))
     vert.write_text(VERT.replace("0.5 + 0.5 * a_position.y", "0.5 + 0.4 * a_position.y"))
     with pytest.raises(RRCacheError, match="the vertex shader .*gv.vert' changed") as info:
-        again.write_variant(Selection(parts=(CachedNode(node, 4),)), tmp_path / "sel2")
+        choice_write(again, Selection(parts=(CachedNode(node, 4),)), tmp_path / "sel2")
     assert "gv.frag' changed" not in str(info.value)
 
 

@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import pytest
 
 from rrcache.errors import SourceLoc, UnsupportedShaderError
-from rrcache.harness.vertex import mesh_attributes, mesh_defines, session_attributes, vertex_source
+from rrcache.compiler.vertex import mesh_attributes, mesh_defines, session_attributes, vertex_source
 
 
 def test_only_declared_varyings_are_written():

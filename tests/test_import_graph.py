@@ -1,11 +1,12 @@
-"""The import graph of ``rrcache/``: every module imports, no cycle, each package only above the
-packages it uses (docs/architecture.md, "Layers"), and the public names never shadowed.
+"""The import graph of ``rrcache/``: every module imports, no cycle (inside a package either),
+each package only above the packages it uses (docs/architecture.md, "Layers"), none of the
+imports the rooms forbid (:data:`FORBIDDEN`), and the public names never shadowed.
 
 The graph is read from the source with :mod:`ast`: an edge for every ``import`` and ``from …
 import`` anywhere in a module (inside functions too: a lazy import still runs the other module,
-and the cycle this test was written for, profile → report → profile, went through one), plus an
-edge to each package an import passes through (``import rrcache.a.b`` runs ``rrcache/a/__init__.py``),
-except the importer's own packages.
+and the cycle this test was written for, profile → report → profile, went through one), to
+modules of the importer's own package too, plus an edge to each package an import passes through
+(``import rrcache.a.b`` runs ``rrcache/a/__init__.py``), except the importer's own packages.
 """
 from __future__ import annotations
 
@@ -27,24 +28,44 @@ ROOT = Path(rrcache.__file__).resolve().parent
 LAYERS = [
     {"errors", "jsonable", "files"},
     {"budgets", "deep", "atomic", "stdio", "watchdog"},
-    {"selection", "glsl", "session", "gl"},
-    {"analysis", "runtime", "model"},
-    {"harness"},
-    {"compiler"},
+    {"glsl", "session", "gl"},
+    {"analysis", "runtime"},
+    {"compiler", "runs"},
+    {"kinds"},
+    {"selection"},
+    {"model", "harness"},
     {"pipeline"},
     {"alternatives", "profiles", "cluster", "webgl"},
-    {"report"},
+    {"report", "choice"},
     {"profiler"},
-    {"bench"},
+    {"bench", "explorer"},
     {"cli"},
     {"__main__", "rrcache"},
 ]
 
 
-def _modules() -> dict[str, Path]:
+#: imports the layers allow but the rooms forbid: (importer, imported, why). A package name
+#: stands for every module in it (docs/architecture.md, "Forbidden imports", is this table)
+FORBIDDEN = [
+    ("report", "harness", "the report only reads the profile folder: the profiler renders its frames"),
+    ("report", "pipeline", "the report only reads the profile folder: it compiles nothing"),
+    ("report", "compiler", "the report only reads the profile folder: it compiles nothing"),
+    ("report", "gl", "the report only reads the profile folder: it needs no GL context"),
+    ("profiles", "pipeline", "a profile's data compiles nothing (rrcache.choice writes a choice's files)"),
+    ("profiles", "compiler", "a profile's data compiles nothing"),
+    ("model", "harness", "the models are pure maths over measurements"),
+    ("model", "gl", "the models are pure maths over measurements"),
+    ("model", "pipeline", "the models are pure maths over measurements"),
+    ("kinds", "gl", "a kind compiles and plans; the harness runs it"),
+    ("runs", "harness", "a run is a plain record; the harness executes it"),
+]
+
+
+def _modules(root: Path = ROOT) -> dict[str, Path]:
+    """Module name → file, for every ``.py`` under the package folder ``root``."""
     out = {}
-    for path in sorted(ROOT.rglob("*.py")):
-        parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+    for path in sorted(root.rglob("*.py")):
+        parts = list(path.relative_to(root.parent).with_suffix("").parts)
         if parts[-1] == "__init__":
             parts = parts[:-1]
         out[".".join(parts)] = path
@@ -54,8 +75,12 @@ def _modules() -> dict[str, Path]:
 MODULES = _modules()
 
 
-def _imports(name: str, path: Path) -> set[str]:
-    """The rrcache modules ``name`` imports (see the module docstring)."""
+def _imports(name: str, path: Path, modules: dict = MODULES) -> set[str]:
+    """The modules of ``modules`` that module ``name`` imports (see the module docstring): every
+    module an import names, inside its own package too (``from pkg import f`` in ``pkg/b.py``
+    depends on ``pkg/__init__.py``: that is how a cycle inside a package shows), and the packages an
+    import passes through (``import pkg.a.b`` runs ``pkg/a/__init__.py``) except the importer's
+    own, which are running already."""
     package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
     found = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
@@ -69,19 +94,37 @@ def _imports(name: str, path: Path) -> set[str]:
                 module = node.module
             for alias in node.names:
                 sub = f"{module}.{alias.name}"
-                found.add(sub if sub in MODULES else module)
+                found.add(sub if sub in modules else module)
     own = {".".join(name.split(".")[:i]) for i in range(1, name.count(".") + 1)}
-    edges = set()
+    root = name.split(".")[0]  # the root package runs before any of its modules (rrcache: lazy names)
+    named, passed = set(), set()
     for target in found:
-        if target not in MODULES:
+        if target not in modules:
             continue
-        edges.add(target)
+        named.add(target)
         pieces = target.split(".")
-        edges.update(".".join(pieces[:i]) for i in range(2, len(pieces)) if ".".join(pieces[:i]) in MODULES)
-    return edges - own - {name}
+        passed.update(".".join(pieces[:i]) for i in range(2, len(pieces)) if ".".join(pieces[:i]) in modules)
+    return (named | (passed - own)) - {name, root}
 
 
-GRAPH = {name: _imports(name, path) for name, path in MODULES.items()}
+def _graph(modules: dict) -> dict[str, set[str]]:
+    return {name: _imports(name, path, modules) for name, path in modules.items()}
+
+
+GRAPH = _graph(MODULES)
+
+
+def _package(module: str) -> str:
+    """``rrcache.report.html`` → ``report`` (a top-level module is its own package)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
+
+
+def forbidden_imports(graph: dict, table=FORBIDDEN) -> list[str]:
+    """Each edge of ``graph`` that ``table`` forbids, with why."""
+    rules = {(a, b): why for a, b, why in table}
+    return sorted(f"{a} imports {b}: {rules[(_package(a), _package(b))]}" for a, targets in graph.items()
+                  for b in targets if (_package(a), _package(b)) in rules)
 
 
 def _cycle(graph: dict) -> list[str]:
@@ -124,7 +167,42 @@ def test_the_graph_is_read():
     assert "rrcache.report.plots" in GRAPH["rrcache.profiler.run"]  # imported inside a function
     assert "rrcache.profiles.document" in GRAPH["rrcache.report.html"]
     assert "rrcache.profiles" in GRAPH["rrcache.report.html"]  # the package the import runs
-    assert "rrcache.profiles" not in GRAPH["rrcache.profiles.document"]  # not its own package
+    assert "rrcache.profiles" not in GRAPH["rrcache.profiles.document"]  # not its own package, passed through
+    assert "rrcache.kinds.base" in GRAPH["rrcache.kinds.single"]  # inside a package
+
+
+def _write_package(root: Path, files: dict) -> dict:
+    """A package ``pkg`` under ``root`` with ``files`` (relative path → source); its modules."""
+    for rel, text in {"__init__.py": "", **files}.items():
+        path = root / "pkg" / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return _modules(root / "pkg")
+
+
+def test_a_cycle_inside_a_package_is_found(tmp_path):
+    """A package's ``__init__`` importing one of its modules that imports a name from the
+    ``__init__`` is a cycle (the compiler's ``__init__`` and its ``multi`` were one, unseen while
+    the reader dropped edges inside a package); a module importing a sibling is not."""
+    modules = _write_package(tmp_path / "a", {"sub/__init__.py": "from pkg.sub.b import g\ndef f(): pass\n",
+                                              "sub/b.py": "def g():\n    from pkg.sub import f\n    return f\n",
+                                              "sub/c.py": "from pkg.sub.b import g\n"})
+    graph = _graph(modules)
+    assert graph["pkg.sub.b"] == {"pkg.sub"} and graph["pkg.sub.c"] == {"pkg.sub.b"}
+    assert _cycle(graph) == ["pkg.sub", "pkg.sub.b", "pkg.sub"]
+    fixed = _write_package(tmp_path / "b", {"sub/__init__.py": "from pkg.sub.b import g\nfrom pkg.sub.a import f\n",
+                                            "sub/a.py": "def f(): pass\n",
+                                            "sub/b.py": "def g():\n    from pkg.sub.a import f\n    return f\n"})
+    assert _cycle(_graph(fixed)) == []
+
+
+def test_each_forbidden_import_fails_the_check():
+    """Every row of FORBIDDEN fails the check on a graph that has that import (and only that row),
+    and the check passes the graph without it."""
+    for importer, imported, why in FORBIDDEN:
+        graph = {f"rrcache.{importer}.x": {f"rrcache.{imported}.y"}, f"rrcache.{imported}.y": set()}
+        assert forbidden_imports(graph) == [f"rrcache.{importer}.x imports rrcache.{imported}.y: {why}"]
+        assert forbidden_imports({f"rrcache.{importer}.x": set()}) == []
 
 
 def test_every_module_imports():
@@ -145,17 +223,22 @@ def test_no_import_cycle():
     assert not cycle, "import cycle: " + " -> ".join(cycle)
 
 
+def upward_imports(graph: dict) -> list[str]:
+    """Each edge of ``graph`` from a package to one in its own layer or above."""
+    return sorted(f"{a} imports {b}" for a, targets in graph.items() for b in targets
+                  if a.split(".")[:2] != b.split(".")[:2] and _layer(b) >= _layer(a))
+
+
 def test_each_package_imports_only_lower_layers():
-    wrong = sorted(f"{a} imports {b}" for a, targets in GRAPH.items() for b in targets
-                   if a.split(".")[:2] != b.split(".")[:2] and _layer(b) >= _layer(a))
+    wrong = upward_imports(GRAPH)
     assert not wrong, "\n".join(wrong)
+    assert upward_imports({"rrcache.model.x": {"rrcache.harness.y"}, "rrcache.harness.y": set()}) == [
+        "rrcache.model.x imports rrcache.harness.y"]
 
 
-def test_the_report_only_reads_documents():
-    """The report never runs the profiler or the bench (they write the report)."""
-    for name, targets in GRAPH.items():
-        if name.startswith("rrcache.report"):
-            assert not {t for t in targets if t.startswith(("rrcache.profiler", "rrcache.bench", "rrcache.cli"))}, name
+def test_no_forbidden_import():
+    wrong = forbidden_imports(GRAPH)
+    assert not wrong, "\n".join(wrong)
 
 
 def test_public_names_survive_importing_every_module():

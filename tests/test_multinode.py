@@ -21,7 +21,7 @@ from rrcache.compiler import ALGORITHMS, instance, instance_nodes
 from rrcache.errors import UnsupportedShaderError
 from rrcache.glsl import ast as A
 from rrcache.glsl.frontend import parse_shader
-from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_REFRESH, CacheRuntime
+from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_REFRESH
 from rrcache.runtime.multi import MultiCacheRuntime
 from rrcache.runtime.refresh import refresh_mask
 
@@ -58,8 +58,7 @@ def _run(ctx, variant, periods, frames, seed=0):
     """Colour images and the runtime's payloads per frame, the static camera, u_t = 0.1·frame."""
     scene = Scene(ctx, SIZE, degrees_per_frame=0.0)
     programs = variant.build_programs(ctx)
-    rt = CacheRuntime(ctx, programs, variant.algorithm, SIZE, period=tuple(periods), seed=seed,
-                      payload_components=variant.components)
+    rt = variant.runtime(ctx, programs, SIZE, variant.spec.with_runtime(periods=tuple(periods)), seed=seed)
     out = []
     try:
         assert isinstance(rt, MultiCacheRuntime)
@@ -166,11 +165,11 @@ def test_render_target_budget_is_checked(gl_ctx):
     limit = min(int(gl_ctx.info["GL_MAX_DRAW_BUFFERS"]), int(gl_ctx.info["GL_MAX_COLOR_ATTACHMENTS"]))
     k = limit // 2 + 1
     with pytest.raises(ValueError, match=rf"needs {2 * k} render targets.*allows {limit}.*at most {limit // 2} nodes"):
-        CacheRuntime(gl_ctx, {"reproject": None, "payload": None, "shade": None}, "three-pass", SIZE,
-                     period=(4,) * k, payload_components=(1,) * k)
+        MultiCacheRuntime(gl_ctx, {"reproject": None, "payload": None, "shade": None}, "three-pass", SIZE,
+                          period=(4,) * k, payload_components=(1,) * k)
     with pytest.raises(ValueError, match=r"plus the colour.*or use three-pass"):
-        CacheRuntime(gl_ctx, {"hit": None, "miss": None}, "two-pass", SIZE,
-                     period=(4,) * (limit // 2), payload_components=(1,) * (limit // 2))
+        MultiCacheRuntime(gl_ctx, {"hit": None, "miss": None}, "two-pass", SIZE,
+                          period=(4,) * (limit // 2), payload_components=(1,) * (limit // 2))
 
 
 def test_cli_render_and_instance_pair_nodes_with_periods(gl_ctx, tmp_path, capsys):

@@ -29,7 +29,7 @@ def _pair(prof):
 def test_record_reads_nodes_periods_and_refuses_a_single_node(demo):
     sel = _pair(demo)
     a, b = sel.nodes
-    assert sel.multi and sel.periods == (50, 4) and sel.kind == "cache+cache"
+    assert sel.multi and sel.periods == (50, 4) and sel.kind == "nodes"
     assert sel.describe() == f"{a} Δn=50 + {b} Δn=4"
     with pytest.raises(Exception, match="no single node"):
         sel.node

@@ -33,7 +33,12 @@ def test_sweep_at_threshold_zero_and_fast_period_one_is_exact(tmp_path):
     session = load_session(str(session_path))
     work = load_for_session(str(shader), session)
     node = max(work.table.nodes, key=lambda n: n.cost).id
-    (point,) = sweep(work, session, node, 8, [0.0], range(3), fast_period=1, resolution=(32, 24))
+    from rrcache.harness.execute import Bench, LocalExecutor
+    from rrcache.runtime.spec import VariantSpec
+
+    spec = VariantSpec("adaptive", (node,), "three-pass", periods=(8,), fast_period=1)
+    with Bench(work, session) as bench:
+        (point,) = sweep(LocalExecutor(bench), spec, [0.0], range(3), resolution=(32, 24))
     assert point.error == 0.0 and point.hit_rate == 0.0 and point.time_ratio > 0
 
 

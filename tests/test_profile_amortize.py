@@ -215,7 +215,7 @@ def test_the_profile_command_shows_estimators_and_an_amortized_row(amortized_win
     assert "fastest option e1 m=1" in line
     prof.selections = [prof.select(1.0).replace(label="e4")]
     console = Console(record=True, width=200)
-    console.print(_table(prof))
+    _table(prof).print(console)
     text = console.export_text()
     assert "e1 m=" in text and "/8 λ=" in text
 
@@ -257,8 +257,8 @@ def test_the_slots_history_is_trained_where_it_fits(trained):
 
 
 def _old_store(path):
-    """Rewrite the amortize_run table of the store at ``path`` as it was before the history
-    column (its blend rows only)."""
+    """Rewrite the store at ``path`` as schema 2 wrote it before the history column: its
+    amortize_run table without the column (its blend rows only), no set or adaptive tables."""
     import sqlite3
 
     conn = sqlite3.connect(str(path), isolation_level=None)
@@ -273,6 +273,9 @@ def _old_store(path):
         ms REAL NOT NULL, original_ms REAL NOT NULL, wall_s REAL NOT NULL,
         PRIMARY KEY (estimator, kind, samples, blend, frame))""")
     conn.executemany(f"INSERT INTO amortize_run ({cols}) VALUES ({', '.join('?' * 13)})", rows)
+    conn.execute("DROP TABLE IF EXISTS set_run")
+    conn.execute("DROP TABLE IF EXISTS adaptive_point")
+    conn.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
     conn.close()
     return rows
 
@@ -429,7 +432,7 @@ def test_the_cli_and_report_show_the_slots_history(slots_win):
     assert "amortization trained at m = 1, 2, 4" in line and "slots history at m = 2, 4" in line
     prof.selections = [prof.select(1.0).replace(label="e1")]
     console = Console(record=True, width=200)
-    console.print(_table(prof))
+    _table(prof).print(console)
     assert "slots" in console.export_text()
     table = _estimators(prof)
     assert "<td>slots</td>" in table and "<td>blend</td>" in table and "c<sub>2</sub>" in table
@@ -449,7 +452,8 @@ def test_frame_shots_render_an_amortized_selection(amortized_wins):
     """FrameShots renders an amortized choice for real: the run settles its history (the N/m
     cycle and the blend's memory), the cached frame is near the original but not equal to it,
     hits blend and misses evaluate every term, and the payload is the running estimate."""
-    from rrcache.report.images import HIT_COLOR, MISS_COLOR, FrameShots, settle_frame
+    from rrcache.profiler.frames import FrameShots
+    from rrcache.report.images import HIT_COLOR, MISS_COLOR, settle_frame
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
@@ -473,7 +477,7 @@ def test_frame_shots_render_an_amortized_selection(amortized_wins):
 
 
 def test_frame_shots_render_a_slots_selection(slots_win):
-    from rrcache.report.images import FrameShots
+    from rrcache.profiler.frames import FrameShots
 
     prof, _ = slots_win
     choice = prof.select(1.0)
@@ -492,11 +496,13 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
     from PIL import Image
 
+    from rrcache.profiler.frames import FrameShots
     from rrcache.report.html import report_html
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
-    page = report_html(_with_selection(prof, choice))
+    shown = _with_selection(prof, choice)
+    page = report_html(shown, frames={s.label: FrameShots(prof).selection_images(s) for s in shown.selections})
     block = re.search(r'<div class="sel" id="sel-e4".*?</div></div>', page, re.S).group(0)
     assert 'data-kind="amortize"' in block and "amortize estimator <b>e1</b>" in block
     assert f"λ = {choice.parts[0].blend:g}" in block and "no frames" not in block
@@ -509,8 +515,8 @@ def test_the_report_shows_an_amortized_selections_frames(amortized_wins):
 
 
 def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
-    from rrcache.report.explore import (Explorer, default_choice, default_selection, measure_choice,
-                                        selections_figure, tradeoff_figure)
+    from rrcache.explorer import Explorer, measure_choice
+    from rrcache.report.explore import default_choice, default_selection, selections_figure, tradeoff_figure
 
     prof, _ = amortized_wins
     choice = prof.select(1.0)
@@ -540,7 +546,7 @@ def test_the_explorer_shows_and_measures_an_amortized_choice(amortized_wins):
     assert "amortized options" in fig.axes[0].get_title()
     assert any(line.get_color() == "darkorange" for line in fig.axes[0].lines)
     # the selections figure shows the amortized selection's frames
-    fig = selections_figure(prof, ui.shots)
+    fig = selections_figure(prof, {s.label: ui.shots.selection_images(s) for s in prof.selections})
     assert sum(len(ax.images) for ax in fig.axes) == 5
 
 

@@ -19,6 +19,7 @@ from scene_files import SESSION
 
 from rrcache.glsl.frontend import describe_change, file_records, load_shader
 from rrcache.profiles import load_profile
+from rrcache.choice import write as choice_write
 
 MAIN = """// glslViewer-style sketch: the noise lives in a library file
 #ifdef GL_ES
@@ -120,7 +121,7 @@ def test_select_and_accuracy_from_another_directory(made, tmp_path, monkeypatch)
     monkeypatch.chdir(elsewhere)
     prof = load_profile(profile)
     choice = Selection(parts=(CachedNode(node, 4),))
-    written = prof.write_variant(choice, "opt2")
+    written = choice_write(prof, choice, "opt2")
     assert any(p.endswith(".frag") for p in written)
     assert json.loads((elsewhere / "opt2" / "manifest.json").read_text())["node"]["id"] == node
     acc = _run("accuracy", profile, "--periods", "3", "--nodes", node, "--json", cwd=elsewhere)

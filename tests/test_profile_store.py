@@ -184,8 +184,8 @@ def test_key_ignores_budget_and_validate_and_resolves_defaults():
     b = TrainingSettings(periods=(2, 4, 8), resolution=(64, 48), frames=12, budget_s=5, validate=False,
                          min_saving=0.3).resolved(session)
     assert a.resolution == (64, 48) and a.frames == 12
-    long = TrainingSettings(periods=(2, 4, 8)).resolved(SimpleNamespace(resolution=(64, 48), frames=150, path="s.json"))
-    assert long.frames == 64  # the default: 64 consecutive frames
+    long = TrainingSettings(periods=(2, 4, 8)).resolved(SimpleNamespace(resolution=(64, 48), frames=600, path="s.json"))
+    assert long.frames == 150  # the default: 150 frames (all of a session up to that long)
     assert a.key_hash() == b.key_hash()
     assert a.key_hash() != TrainingSettings(periods=(2, 4, 9)).resolved(session).key_hash()
     assert TrainingSettings.from_json(b.to_json()) == b
@@ -247,3 +247,60 @@ def test_a_schema_1_store_is_upgraded_in_place(tmp_path):
         assert first.algorithm is None  # schema 1 did not record it
         assert second.parts == () and second.measured_speedup == 1.0
         assert [r.period for r in store.error_runs("n1")] == [2]  # the measurements stay
+
+
+def _as_schema_2(path) -> None:
+    """Make a schema-3 store at ``path`` what schema 2 wrote: no set_run or adaptive_point table
+    (the sets in meta('sets')), the amortize_run table from before its history column."""
+    conn = sqlite3.connect(str(path))
+    conn.executescript("""
+        DROP TABLE set_run; DROP TABLE adaptive_point; DROP TABLE amortize_run; DROP TABLE timing_run;
+        CREATE TABLE timing_run (node TEXT NOT NULL, period INTEGER NOT NULL, wall_s REAL NOT NULL,
+            run_id INTEGER NOT NULL REFERENCES run_log(id), PRIMARY KEY (node, period));
+        CREATE TABLE amortize_run (estimator TEXT NOT NULL, kind TEXT NOT NULL, samples INTEGER NOT NULL,
+            blend REAL NOT NULL, frame INTEGER NOT NULL, mean_error REAL NOT NULL, psnr REAL NOT NULL,
+            hit_rate REAL NOT NULL, hits INTEGER NOT NULL, misses INTEGER NOT NULL, ms REAL NOT NULL,
+            original_ms REAL NOT NULL, wall_s REAL NOT NULL, PRIMARY KEY (estimator, kind, samples, blend, frame));
+        INSERT INTO amortize_run VALUES ('e1', 'error', 4, 0.6, -1, 0.01, 40.0, 0.8, 80, 20, 0, 0, 0.5);
+        INSERT INTO meta(key, value) VALUES ('sets', '[{"nodes": ["n1", "n2"], "periods": [50, 4], "layout": "union",
+            "predicted_error": 0.01, "predicted_ms": 2.0, "trained": true, "trained_error": 0.02}]');
+        UPDATE meta SET value = '2' WHERE key = 'schema_version';
+    """)
+    conn.commit()
+    conn.close()
+
+
+def test_a_schema_2_store_is_read_as_it_is_and_upgraded_when_written(tmp_path):
+    """One store schema: the amortized runs, the sets and the adaptive points are tables of it. A
+    store written by schema 2 (the sets in meta, an amortization table without its history column)
+    reads as it is without being changed, and opening it to write upgrades it in one go."""
+    path = tmp_path / "profile.sqlite"
+    ProfileStore.open(path, _key()).close()
+    _as_schema_2(path)
+    before = path.read_bytes()
+    with read_store(path) as store:
+        assert [d["nodes"] for d in store.set_runs()] == [["n1", "n2"]]
+        assert [r["history"] for r in store.amortize_rows("e1", "error")] == ["blend"]
+        assert store.adaptive_points() == [] and store.amortize_spent_s() == 0.5
+    assert path.read_bytes() == before  # reading changed nothing
+    with ProfileStore.open(path, _key()) as store:
+        assert store.meta()["schema_version"] == str(SCHEMA_VERSION) == "3" and "sets" not in store.meta()
+        assert [(d["nodes"], d["trained_error"]) for d in store.set_runs()] == [(["n1", "n2"], 0.02)]
+        assert [(r["history"], r["samples"]) for r in store.amortize_rows("e1", "error")] == [("blend", 4)]
+        columns = [r[1] for r in store.conn.execute("PRAGMA table_info(amortize_run)")]
+        assert "host" in [r[1] for r in store.conn.execute("PRAGMA table_info(timing_run)")]
+        assert "history" in columns and store.conn.execute("SELECT COUNT(*) FROM adaptive_point").fetchone() == (0,)
+        store.add_set_run({"nodes": ["n1", "n3"], "periods": [8, 8], "trained": False, "note": "x"})
+        assert len(store.set_runs()) == 2
+
+
+def test_every_kind_table_is_in_the_one_schema(tmp_path):
+    from rrcache import kinds
+    from rrcache.profiles.store import SCHEMA
+
+    with ProfileStore.open(tmp_path / "profile.sqlite", _key()) as store:
+        tables = {r[0] for r in store.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    for kind in kinds.all_kinds():
+        for table in ("amortize_run", "set_run", "adaptive_point"):
+            if f"TABLE IF NOT EXISTS {table}" in kind.tables:
+                assert table in tables and table in SCHEMA, (kind.name, table)

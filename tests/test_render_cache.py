@@ -29,7 +29,7 @@ from rrcache.alternatives.render_cache.sampling import (blocks_to_pixels, dither
                                                         predicted_requests, scaled)
 from rrcache.alternatives.render_cache.tune import compare
 from rrcache.errors import RRCacheError
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer
 from rrcache.session import load_session
 from rrcache.session.camera import look_at, perspective
@@ -427,3 +427,28 @@ def test_the_equal_time_tool_writes_its_table_sheet_and_stages(gl_ctx, tmp_path)
     assert (tmp_path / "out" / "contact_sheet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(RRCacheError, match="not a choice"):
         bench.Choice.parse("n66")
+
+
+def test_the_render_cache_is_a_registered_kind_that_is_never_compiled():
+    from rrcache import kinds
+    from rrcache.selection import Selection
+
+    part = RenderCacheSettings(samples=0.05, block=1)
+    kind = kinds.get("render-cache")
+    assert kinds.kind_of((part,)) is kind and kind.part is RenderCacheSettings
+    assert kind.training("anything", None) == [] and not kind.tables
+    sel = Selection((part,), 0.0, float("nan"), 1.0, label="render cache")
+    assert kind.cells(sel) == ("render cache: 5% of the pixels per frame in 1×1 blocks", "–")
+    assert kind.summary(sel)["samples"] == 0.05
+    (back,) = kinds.parts_from_json(kinds.parts_to_json((part,)), "parts")
+    assert back == part and back.key() == part.key()
+    for call in (lambda: kinds.spec_for(sel), lambda: kind.compile(None, None)):
+        with pytest.raises(RRCacheError, match="an alternative to compare"):
+            call()
+    for data, where in (({"kind": "render-cache", "samples": 2.0}, "parts[0]"),
+                        ({"kind": "render-cache", "samples": 0.1, "blocks": 2}, "parts[0]"),
+                        ({"kind": "render-cache", "samples": "0.1"}, "parts[0].samples"),
+                        ({"kind": "render-cache", "predict": 1}, "parts[0].predict")):
+        with pytest.raises(RRCacheError) as info:
+            kinds.parts_from_json([data], "parts")
+        assert str(info.value).startswith(where), str(info.value)

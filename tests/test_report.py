@@ -29,7 +29,8 @@ from rrcache.errors import RRCacheError
 from rrcache.profiler import demo_profile
 from rrcache.report import REPORT_NAME, write_report
 from rrcache.report.data import selection_timing
-from rrcache.report.images import HIT_COLOR, MISS_COLOR, FrameShots, image_size
+from rrcache.profiler.frames import FrameShots
+from rrcache.report.images import HIT_COLOR, MISS_COLOR, image_size, read_frames
 
 
 @pytest.fixture(scope="module")
@@ -106,6 +107,32 @@ def test_renders_are_real(demo):
     assert np.abs(images.arrays["cached"] - images.arrays["original"]).max() > 0
     assert shots.images(node, period) is images  # kept, not rendered again
     assert list(shots.images(None, None).arrays) == ["original"]
+
+
+def test_the_report_is_built_from_the_folder_without_gl(demo, tmp_path):
+    """The profiler rendered the selections' frames into the folder; the report reads them (and
+    the folder's other files) in a process where making a GL context fails, and loads none of the
+    harness's renderers, the pipeline or the profiler."""
+    frames = read_frames(demo.path)
+    assert set(frames) == {s.label for s in demo.selections if not s.parts or s.choice.has_frames}
+    assert all((demo.path / rel).is_file() for f in frames.values() for rel in f.files.values())
+    code = ("import sys, moderngl, rrcache.gl.context as gl\n"
+            "def refuse(*a, **k): raise SystemExit('a GL context was asked for')\n"
+            "moderngl.create_context = moderngl.create_standalone_context = gl.get_context = refuse\n"
+            "from rrcache.profiles import load_profile\nfrom rrcache.report import write_report\n"
+            "path = write_report(load_profile(sys.argv[1]), sys.argv[2])\n"
+            "bad = sorted(m for m in sys.modules if m.startswith(('rrcache.harness.renderer', 'rrcache.harness.cached', "
+            "'rrcache.harness.drawer', 'rrcache.pipeline', 'rrcache.profiler')))\n"
+            "print('imported:', bad)\n")
+    run = subprocess.run([sys.executable, "-c", code, str(demo.path), str(tmp_path)], capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert "imported: []" in run.stdout
+    page = (tmp_path / REPORT_NAME).read_text(encoding="utf-8")
+    images = re.findall(r'<img [^>]*data-image="(\w+)"', page)
+    assert images.count("original") == len(frames) and "no frames" not in page
+    ours = (demo.path / REPORT_NAME).read_text(encoding="utf-8")
+    assert re.findall(r'src="(data:image[^"]+)"', page) == re.findall(r'src="(data:image[^"]+)"', ours)
 
 
 def test_cli_rebuilds_the_report(demo, tmp_path):

@@ -12,18 +12,14 @@ import pytest
 
 from rrcache.errors import RRCacheError
 from rrcache.profiles.document import load_profile
-from safety_cli import QUICK_PROFILE, one_error_line, rrcache, write_case
+from safety_cli import made_profile, one_error_line, rrcache  # noqa: F401 (a fixture)
 
 AREA = "safety: profile.json damaged or edited"
 
 
 @pytest.fixture(scope="module")
-def profiled(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("profiled")
-    write_case(folder)
-    code, _, lines = rrcache(folder, "profile", "scene.frag", "scene.json", "--out", "out", *QUICK_PROFILE)
-    assert code == 0, lines
-    return folder / "out"
+def profiled(made_profile):
+    return made_profile / "p"
 
 
 def _trained(doc) -> int:

@@ -19,7 +19,7 @@ import pytest
 
 from rrcache.atomic import OutputFolder, write_text
 from rrcache.errors import RRCacheError
-from safety_cli import QUICK_PROFILE, one_error_line, rrcache, tree, write_case
+from safety_cli import QUICK_PROFILE, made_profile, one_error_line, rrcache, tree  # noqa: F401 (a fixture)
 
 AREA = "safety: the one rule for writing"
 
@@ -32,16 +32,6 @@ def _device(path) -> bool:
         return True
     except (PermissionError, OSError):
         return False
-
-
-@pytest.fixture(scope="module")
-def made_profile(tmp_path_factory):
-    """One small profile (every selection the original at this size: seconds), copied by each test."""
-    folder = tmp_path_factory.mktemp("made")
-    write_case(folder)
-    code, _, lines = rrcache(folder, "profile", "scene.frag", "scene.json", "--out", "p", *QUICK_PROFILE)
-    assert code == 0, lines
-    return folder
 
 
 @pytest.fixture

@@ -17,9 +17,9 @@ from rrcache.errors import GLError, RRCacheError
 from rrcache.gl import limits
 from rrcache.glsl.frontend import load_shader
 from rrcache.harness.cached import HALF_MAX, CachedRenderer, compare
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer, render
-from rrcache.harness.vertex import mesh_defines, session_attributes
+from rrcache.compiler.vertex import mesh_defines, session_attributes
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.runtime import CacheRuntime
 from rrcache.session import load_session

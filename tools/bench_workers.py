@@ -5,20 +5,23 @@ The error runs of the costliest nodes (training order) at every training period,
 places it), are made three ways: in this process (the reference numbers), then on a
 ``LocalCluster`` of each worker count in ``--workers``. Each cluster is started before its clock
 starts; its workers receive the scene once, render their reference frames once and compile each
-variant they are given, all inside the timed stage, as in a profile. The numbers of every run must
-equal the in-process ones; the JSON written gives the wall time of each stage and the ratios.
+variant they are given, all inside the timed stage, as in a profile. The numbers of every run are
+compared with the in-process ones; the JSON written gives the wall time of each stage and the
+ratios of the medians (``--workers 1,2,1,2`` interleaves repeats, so that load drifting over the
+run touches both counts alike).
 
     nice -n 5 flock /tmp/measure.lock python tools/bench_workers.py shaders/marble.glsl \\
         sessions/marble.json --nodes 6 --frames 32 --workers 1,2 --out bench_workers.json
 
-The runs use the training code's own error run (``rrcache.profiler.train._error_run``); the
-cluster side is :mod:`rrcache.cluster`.
+The runs are the training's own error runs (:func:`rrcache.harness.execute.execute` of a
+:class:`rrcache.runs.RunSpec`); the cluster side is :mod:`rrcache.cluster`.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import statistics
 import time
 
 
@@ -30,48 +33,31 @@ class ErrorStage:
     def __init__(self, shader, session, frames, window, periods):
         self.shader, self.session_path = str(shader), str(session)
         self.frames, self.window, self.periods = int(frames), window, tuple(periods)
-        self._ready = None
-        self._cached = {}
+        self._bench = None
 
     def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k not in ("_ready", "_cached")}
+        return {k: v for k, v in self.__dict__.items() if k != "_bench"}
 
     def __setstate__(self, state):
-        self.__dict__.update(state, _ready=None, _cached={})
-
-    def _setup(self):
-        from rrcache.harness.renderer import Renderer
-        from rrcache.pipeline import load_for_session
-        from rrcache.session import load_session
-
-        session = load_session(self.session_path)
-        work = load_for_session(self.shader, session)
-        size = tuple(int(v) for v in session.resolution)
-        with Renderer(work.prepared, session, size, window=self.window) as renderer:
-            refs = [renderer.render_frame(i) for i in range(self.frames)]
-        self._ready = (session, work, size, refs)
+        self.__dict__.update(state, _bench=None)
 
     def run(self, spec):
-        from rrcache.harness.cached import CachedRenderer
-        from rrcache.pipeline import variant_for
-        from rrcache.profiler.train import _error_run, _Meter
+        from rrcache.harness.execute import execute
+        from rrcache.pipeline import WorkSource, load_bench
+        from rrcache.runs import RunSpec
+        from rrcache.runtime.spec import VariantSpec
 
-        if self._ready is None:
-            self._setup()
-        session, work, size, refs = self._ready
+        if self._bench is None:
+            self._bench = load_bench(WorkSource(self.shader, self.session_path))
         node, period = spec
-        if node not in self._cached:
-            for old in self._cached.values():
-                old.release()
-            self._cached = {node: CachedRenderer(variant_for(work, node, "three-pass"), session, work.prepared, size,
-                                                 period=period, window=self.window)}
-        run, frames = _error_run(self._cached[node], node, period, refs, _Meter(None, 0))
-        return [run.mean_error, run.psnr, run.hit_rate] + [f.mean_error for f in frames]
+        size = tuple(int(v) for v in self._bench.session.resolution)
+        result = execute(RunSpec("error", VariantSpec("cache", (node,), "three-pass", periods=(period,)),
+                                 tuple(range(self.frames)), size, self.window), self._bench)
+        return [result.steady_error, result.steady_psnr, result.hit_rate] + [f.error for f in result.frames]
 
     def release(self):
-        for old in self._cached.values():
-            old.release()
-        self._cached = {}
+        if self._bench is not None:
+            self._bench.close()
 
 
 def main():
@@ -110,7 +96,7 @@ def main():
     out = {"shader": args.shader, "session": args.session, "nodes": nodes, "periods": periods,
            "frames": args.frames, "window": list(window) if window else None, "runs": len(specs),
            "in_process_s": time.perf_counter() - t0, "load_before": os.getloadavg(), "workers": {}}
-    for count in [int(w) for w in args.workers.split(",")]:
+    for count in [int(w) for w in args.workers.split(",")]:  # "1,2,1,2": interleaved repeats
         with connect(workers=count, dashboard_address=":0", announce=print) as cluster:
             runs = DaskRuns(cluster)
             t0 = time.perf_counter()
@@ -119,12 +105,13 @@ def main():
             wall = time.perf_counter() - t0
             runs.close()
         worst = max(max(abs(a - b) for a, b in zip(reference[s], got[s].result)) for s in specs)
-        out["workers"][count] = {"wall_s": wall, "max_abs_difference": worst,
-                                 "per_worker_runs": _count(runs.placements)}
-        print(f"{count} workers: {wall:.1f} s, largest difference from in-process {worst:.3g}")
-    base = out["workers"].get(1, {}).get("wall_s")
-    if base:
-        out["speedup_vs_1"] = {k: base / v["wall_s"] for k, v in out["workers"].items()}
+        out["workers"].setdefault(str(count), []).append(
+            {"wall_s": wall, "max_abs_difference": worst, "per_worker_runs": _count(runs.placements),
+             "load": os.getloadavg()})
+        print(f"{count} worker(s): {wall:.1f} s, largest difference from in-process {worst:.3g}", flush=True)
+    median = {k: statistics.median(r["wall_s"] for r in v) for k, v in out["workers"].items()}
+    if "1" in median:
+        out["speedup_vs_1"] = {k: median["1"] / v for k, v in median.items()}
     out["load_after"] = os.getloadavg()
     with open(args.out, "w") as f:
         json.dump(out, f, indent=1)

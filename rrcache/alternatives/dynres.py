@@ -21,7 +21,6 @@ and searched by :func:`rrcache.alternatives.search.match_scale`.
 """
 from __future__ import annotations
 
-import time
 from typing import Callable, Optional
 
 import moderngl
@@ -33,7 +32,8 @@ from rrcache.gl.program import build_program, fullscreen_vertex
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import FrameResult, Renderer, check_frame_index, session_background
-from rrcache.harness.vertex import vertex_for
+from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
+from rrcache.compiler.vertex import vertex_for
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, match_scale
 
@@ -67,8 +67,9 @@ class DynresRenderer:
     coverage upsampled by nearest neighbour."""
 
     def __init__(self, prepared, session, size: Optional[tuple[int, int]], scale: float,
-                 ctx: Optional[moderngl.Context] = None):
+                 ctx: Optional[moderngl.Context] = None, clock: str = DEFAULT_CLOCK):
         self.ctx = ctx or get_context()
+        self.clock = make_clock(clock, self.ctx)
         self.session = session
         self.size = tuple(int(v) for v in (size or session.resolution))
         self.scale = float(scale)
@@ -106,8 +107,7 @@ class DynresRenderer:
     def _draw(self, index: int) -> float:
         ctx = self.ctx
         self.drawer.set_frame(index)
-        ctx.finish()
-        start = time.perf_counter()
+        self.clock.start()
         self.drawer.render_shadow_map()  # the light's depth pass is part of the frame
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
@@ -120,8 +120,7 @@ class DynresRenderer:
         self._fbo.viewport = (0, 0, *self.size)
         self._low.use(location=0)
         self._quad.render(moderngl.TRIANGLES, vertices=3)
-        ctx.finish()
-        return (time.perf_counter() - start) * 1000.0
+        return self.clock.stop()
 
     def render_frame(self, index: int) -> FrameResult:
         """Render frame ``index`` (the first call draws once untimed: llvmpipe compiles then)."""

@@ -57,9 +57,9 @@ from rrcache.glsl.printer import print_with_map
 from rrcache.glsl.semantic import check
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2
-from rrcache.harness.prepare import PreparedShader, declarations
+from rrcache.compiler.prepared import PreparedShader, declarations
 from rrcache.harness.renderer import Renderer
-from rrcache.harness.vertex import VARYINGS
+from rrcache.compiler.vertex import VARYINGS
 from rrcache.alternatives.measure import compare_renderers
 from rrcache.alternatives.search import SearchResult, first_reaching
 

@@ -33,7 +33,7 @@ from rrcache.bench.amortize_sheet import write_sheet
 from rrcache.compiler.amortize import instance_amortized
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import Renderer, frame_indices
 from rrcache.pipeline import load_for_session
 from rrcache.session import load_session

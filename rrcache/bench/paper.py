@@ -375,8 +375,9 @@ def render_cache_row(work, session, frames, search, target, settings, progress, 
     found = tune_samples(work.prepared, session, search, target, base, rel_tol=settings.tolerance,
                          max_steps=settings.max_steps, progress=step)
     final = compare(work.prepared, session, frames, replace(base, samples=found.value), on_frame=on_frame)
-    row = MethodRow(RENDER_CACHE, f"{found.value:.2%} of the pixels per frame ({final.budget} pixels, "
-                                  f"{base.block}×{base.block} blocks, {base.points_per_pixel:g} points per pixel)",
+    chosen = replace(base, samples=found.value)
+    row = MethodRow(RENDER_CACHE, f"{chosen.describe().split(': ', 1)[1]} ({final.budget} pixels), a cache of "
+                                  f"{base.points_per_pixel:g}× the pixels",
                     final.speedup, final.mean_error, _cap(final.psnr), final.ms_per_frame,
                     final.original_ms_per_frame, _within(final.speedup, target, settings.tolerance),
                     [list(s) for s in found.steps])
@@ -503,12 +504,10 @@ def run_scene(scene: Scene, settings: BenchSettings, out, progress: Optional[Pro
     if medium.label != MEDIUM:
         result.notes.append(f"{MEDIUM} caches nothing; the medium selection is {medium.label}")
 
-    if medium.kind != "cache":  # an amortized estimator or several nodes: the algorithms and limit are one node's
-        what = ("amortized sampling" if medium.kind == "amortize" else "several cached nodes" if medium.multi
-                else f"a selection of kind {medium.kind}")
+    if not medium.choice.one_node:  # an amortized estimator, several nodes: the algorithms and limit are one node's
         if medium.multi:  # the all-hit limit of the set (the algorithms and the misses are one node's)
             _set_limit(prof, work, session, frames, medium, result, progress)
-        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({what}): the "
+        result.notes.append(f"the {medium.label} selection is {medium.describe()} ({medium.choice.title}): the "
                             "algorithms and the miss breakdown are measured for a single cached node only")
         if medium.measured_speedup > 1.0 + settings.tolerance:
             result.equal_time = _equal_time(work, session, frames, medium, settings, result, progress)

@@ -42,12 +42,10 @@ def _methods(rows, title: str) -> list[str]:
 def _what(r) -> tuple[str, str]:
     """The node and Δn cells of a selection: an estimator at m samples and λ has no Δn; several
     nodes show each expression and period, in part order."""
-    if r.kind == "amortize":
-        return _code(f"{r.describe()}: {r.parts[0].text}"), "–"
-    if r.multi:
-        return (_code(" + ".join(p.text or p.node for p in r.parts), limit=110),
-                " + ".join(str(p) for p in r.periods))
-    return _code(r.text if r.parts else None), _f(r.period, "d")
+    if not r.parts:
+        return _code(None), _f(None, "d")
+    what, period = r.choice.cells(r, texts=True)  # the kind of choice says what its cells show
+    return _code(what, limit=110), period
 
 
 def _filter_text(s) -> str:

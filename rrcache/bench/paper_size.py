@@ -99,7 +99,9 @@ def run(bench_out, scenes=("chess",), labels=("e3",), frames: Optional[int] = No
     from rrcache.session import load_session
 
     bench_out = Path(bench_out)
-    doc = json.loads((bench_out / "bench.json").read_text(encoding="utf-8"))
+    from rrcache.files import read_bytes
+
+    doc = json.loads(read_bytes(bench_out / "bench.json", None))
     result = SizeResult(str(bench_out), time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()))
     t0 = time.time()
     root = default_root()
@@ -159,7 +161,9 @@ def main(argv=None) -> int:
         print(str(err))
         return 2
     if args.json:
-        Path(args.json).write_text(json.dumps(result.to_json(), indent=2) + "\n", encoding="utf-8")
+        from rrcache.atomic import write_text
+
+        write_text(args.json, json.dumps(result.to_json(), indent=2) + "\n")
     print(result.markdown())
     return 0
 

@@ -17,7 +17,8 @@ over the same frames (:func:`rrcache.bench.paper.dynres_row`,
 :func:`rrcache.bench.paper.render_cache_row`, as ``rrcache bench`` does); one frame of each
 (``--sheet-frame``, default the middle one) kept with its error for the contact sheet. Writes
 ``equal_time.json``, ``equal_time.md`` (the table, the render cache's per-stage times) and
-``contact_sheet.png`` into ``--out``, after every scene. Scenes are sized like ``rrcache bench``
+``contact_sheet.png`` into ``--out`` after every scene, adding to the scenes already there (a
+scene measured again replaces its row), so scenes can be measured one run each. Scenes are sized like ``rrcache bench``
 (chess at 320×240 over its first 60 frames; the others at the session's size).
 
 ``mask``: the renderer's cost on llvmpipe: a frame shaded through a sample mask of a given
@@ -48,6 +49,7 @@ Timings are ratios measured side by side in one run; the machine's load is recor
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import os
 import statistics
@@ -262,8 +264,9 @@ def contact_sheet(results: list, images: dict, path) -> str:
                     top.set_title(f"{r.name}, frame {r.sheet_frame}: original", fontsize=8)
                     bottom.axis("off")
                     continue
-                err, db = r.sheet[method]
-                top.set_title(f"{method}: error {err:.4f}, {min(db, 100):.1f} dB", fontsize=8)
+                err, db = r.sheet[method]  # an exact image's PSNR is infinite (null once written)
+                db_text = "∞" if db is None or db == float("inf") else f"{db:.1f}"
+                top.set_title(f"{method}: error {err:.4f}, {db_text} dB", fontsize=8)
                 diff = np.abs(np.nan_to_num(image[..., :3]) - np.nan_to_num(original[..., :3])) * ERROR_GAIN
                 bottom.imshow(np.clip(diff, 0, 1), interpolation="nearest")
                 bottom.set_title(f"|{method} − original| × {ERROR_GAIN:g}", fontsize=7)
@@ -274,87 +277,40 @@ def contact_sheet(results: list, images: dict, path) -> str:
     return str(path)
 
 
-def _write(out: Path, results: list, images: dict) -> None:
-    from rrcache.atomic import write_text
+def _write(out: Path, result: SceneComparison, shots: dict) -> list:
+    """Add ``result`` (replacing a scene of the same name) to ``equal_time.json`` in ``out``, keep
+    its sheet frame's images (``sheet/<scene>.npz``), and rewrite the table and the contact sheet
+    from every scene there (so runs of one scene each add up, and an interrupted run keeps what
+    it finished). Returns the scenes."""
+    from rrcache.atomic import write_bytes, write_text
+    from rrcache.bench.paper import MethodRow
     from rrcache.jsonable import finite_json
 
-    doc = {"rrcache_render_cache_bench": 1, "scenes": [
-        dict(name=r.name, resolution=list(r.resolution), frames=r.frames, choice=r.choice, texts=r.texts,
-             target_speedup=r.target_speedup, sheet_frame=r.sheet_frame, sheet=r.sheet, load=r.load, wall_s=r.wall_s,
-             rows=[vars(row) for row in r.rows]) for r in results]}
-    write_text(out / "equal_time.json", json.dumps(finite_json(doc), indent=2, ensure_ascii=False) + "\n")
+    path = out / "equal_time.json"
+    scenes = json.loads(path.read_text(encoding="utf-8"))["scenes"] if path.is_file() else []
+    record = dict(name=result.name, resolution=list(result.resolution), frames=result.frames, choice=result.choice,
+                  texts=result.texts, target_speedup=result.target_speedup, sheet_frame=result.sheet_frame,
+                  sheet=result.sheet, load=result.load, wall_s=result.wall_s, rows=[vars(row) for row in result.rows])
+    scenes = [s for s in scenes if s["name"] != result.name] + [finite_json(record)]
+    write_text(path, json.dumps({"rrcache_render_cache_bench": 1, "scenes": scenes}, indent=2, ensure_ascii=False)
+               + "\n")
+    (out / "sheet").mkdir(exist_ok=True)
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **{k.replace(" ", "_"): v for k, v in shots.items()})
+    write_bytes(out / "sheet" / f"{result.name}.npz", buffer.getvalue())
+    results, images = [], {}
+    for s in scenes:
+        rows = [MethodRow(**row) for row in s["rows"]]
+        results.append(SceneComparison(s["name"], tuple(s["resolution"]), s["frames"], s["choice"], s["texts"],
+                                       s["target_speedup"], rows, s["sheet_frame"],
+                                       {k: tuple(v) for k, v in s["sheet"].items()}, s["load"], s["wall_s"]))
+        stored = out / "sheet" / f"{s['name']}.npz"
+        if stored.is_file():
+            with np.load(stored) as data:
+                images[s["name"]] = {k.replace("_", " "): data[k] for k in data.files}
     write_text(out / "equal_time.md", _markdown(results))
     contact_sheet(results, images, out / "contact_sheet.png")
-
-
-def mask_cost(scene, out, densities=(0.01, 0.03, 0.1, 0.3), blocks=(1, 2, 4), repeats: int = 5,
-              frame: int = 10) -> dict:
-    """The renderer's frame through sample masks against the whole frame (see the module docstring)."""
-    from rrcache.alternatives.render_cache.sampling import blocks_to_pixels, grid_size
-    from rrcache.alternatives.render_cache.shading import SampleShader
-    from rrcache.harness.prepare import prepare_file
-    from rrcache.session import load_session
-
-    session = load_session(_sizes(scene, out))
-    prepared = prepare_file(scene.shader, session)
-    rng = np.random.default_rng(0)
-    rows = []
-    with SampleShader(prepared, session, tuple(session.resolution)) as shader:
-        w, h = shader.size
-        every = np.arange(w * h)
-
-        def timed(pixels, every_pixel=False):
-            shader.ctx.finish()
-            start = time.perf_counter()
-            shader.shade(frame, pixels, every_pixel)
-            return (time.perf_counter() - start) * 1000.0
-
-        timed(every, True)
-        timed(every[:1])
-        for density in (0.0,) + tuple(densities):
-            for block in (blocks if density else (1,)):
-                gw, gh = grid_size((w, h), block)
-                full, masked = [], []
-                for _ in range(repeats):
-                    chosen = np.flatnonzero(rng.random(gw * gh) < density)
-                    pixels = blocks_to_pixels(chosen, (w, h), block)
-                    full.append(timed(every, True))
-                    masked.append(timed(pixels))
-                f, m = statistics.median(full), statistics.median(masked)
-                rows.append(dict(density=density, block=block, full_ms=f, masked_ms=m, ratio=m / f))
-    return {"scene": scene.name, "resolution": [w, h], "frame": frame, "repeats": repeats, "load": _load(),
-            "rows": rows}
-
-
-def zbuffer_cost(scene, out, tiles=(16, 32, 64), repeats: int = 9, frames: int = 8, samples: float = 0.03) -> dict:
-    """The z-buffer of a real point cache, untiled and tiled (see the module docstring)."""
-    from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
-    from rrcache.alternatives.render_cache.projection import zbuffer
-    from rrcache.harness.prepare import prepare_file
-    from rrcache.session import load_session
-
-    session = load_session(_sizes(scene, out))
-    prepared = prepare_file(scene.shader, session)
-    with RenderCacheRenderer(prepared, session, settings=RenderCacheSettings(samples=samples)) as rc:
-        for i in range(frames):
-            rc.render_frame(i)
-        screen, moving = rc._matrices(frames - 1)
-        project_ms = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            pix, depth, slots = rc.projector.project(rc.cache, screen, rc.size, moving)
-            project_ms.append((time.perf_counter() - start) * 1000.0)
-        w, h = rc.size
-        reference = zbuffer(pix, depth, slots, w * h)
-        variants = [("untiled", {})] + [(f"tiled {t}×{t}", dict(tiled=True, width=w, tile=t)) for t in tiles]
-        for name, kwargs in variants:
-            got = zbuffer(pix, depth, slots, w * h, **kwargs)
-            if not (np.array_equal(got[0], reference[0]) and np.array_equal(got[1], reference[1])):
-                raise AssertionError(f"the {name} z-buffer differs from the untiled one")
-        ms = _side_by_side([(name, lambda kw=kwargs: zbuffer(pix, depth, slots, w * h, **kw))
-                            for name, kwargs in variants], repeats)
-    return {"scene": scene.name, "resolution": [w, h], "points": int(len(pix)), "capacity": rc.cache.capacity,
-            "load": _load(), "project_ms": statistics.median(project_ms), "zbuffer_ms": ms}
+    return results
 
 
 _POINTS_VERTEX = """#version 330 core
@@ -403,7 +359,7 @@ def projection_cost(scene, out, repeats: int = 9, frames: int = 8, samples: floa
     from rrcache.alternatives.render_cache import RenderCacheRenderer, RenderCacheSettings
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.gl.resources import GLScope
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -548,7 +504,7 @@ def filters_cost(scene, out, repeats: int = 9, frames: int = 8, samples: float =
     from rrcache.alternatives.render_cache.filters import depth_cull, reconstruct
     from rrcache.alternatives.render_cache.projection import zbuffer
     from rrcache.gl.resources import GLScope
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
@@ -653,7 +609,7 @@ def sweep(scene, out, configs: list, shares, frames: int = 40) -> dict:
     """Each config at each share beside the original (see the module docstring)."""
     from rrcache.alternatives.render_cache import RenderCacheSettings
     from rrcache.alternatives.render_cache.tune import compare
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.harness.renderer import Renderer
     from rrcache.session import load_session
 
@@ -726,16 +682,13 @@ def main(argv=None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     if args.what == "equal-time":
-        results, images = [], {}
         for item in args.choice:
             name, sep, spec = item.partition("=")
             if not sep:
                 parser.error(f"--choice {item!r}: give NAME=NODE:PERIOD")
             (scene,) = resolve_scenes(name)
             result, shots = equal_time(scene, Choice.parse(spec), out, args.search_frames, args.sheet_frame)
-            results.append(result)
-            images[result.name] = shots
-            _write(out, results, images)
+            _write(out, result, shots)
             print(f"{result.name}: done in {result.wall_s:.0f} s; {out / 'equal_time.md'} updated", flush=True)
         return 0
     (scene,) = resolve_scenes(args.scene)

@@ -17,7 +17,7 @@ from typing import Optional
 
 from rrcache import atomic
 from rrcache.errors import RRCacheError
-from rrcache.files import Refused, read_file
+from rrcache.files import Refused, inside, read_file
 
 #: name -> (shader, session), relative to the repository root
 PAPER_SCENES = {
@@ -124,7 +124,7 @@ def scaled_session(session_path, out_path, resolution: tuple[int, int], frames: 
     if not doc.get("allow_outside_paths"):
         # the copy lives elsewhere: its paths are the original's, confined to the original's folder
         root = os.path.realpath(folder)
-        outside = [p for p in paths if not os.path.realpath(p).startswith(root.rstrip(os.sep) + os.sep)]
+        outside = [p for p in paths if not inside(os.path.realpath(p), [root])]
         if outside:
             raise RRCacheError(f"the session names {outside[0]}, outside its folder {root}", str(source),
                                hint='paths are confined to the session file\'s folder tree; if you trust the '

@@ -3,7 +3,7 @@
 ``python -m rrcache.bench.sets PROFILE SHADER SESSION --pairs 4 --out result.json`` loads a
 trained profile, predicts every pair of its trained nodes at the period pair the rule finds best
 against the single-node front (improving or not) and measures the ``--pairs`` best of them, plus any ``--set
-n1:4,n2:50``, exactly as the profiler's set stage trains a set (:class:`rrcache.profiler.sets._Runner`:
+n1:4,n2:50``, exactly as the profiler's set stage trains a set (:func:`rrcache.profiler.sets.train_set`:
 the error over the training frames in the error window, the time on the timing frames each
 beside the original). It prints and writes predicted against measured error and time, and with
 ``--plot`` draws the single-node front, the front with the measured sets and the profile's
@@ -25,6 +25,14 @@ import numpy as np
 from rrcache import atomic
 
 
+def _json(path) -> dict:
+    """A JSON file this tool was given, read by rrcache.files' rule."""
+    from rrcache.budgets import budget
+    from rrcache.files import read_bytes
+
+    return json.loads(read_bytes(path, budget.document_bytes))
+
+
 def _parse_set(text: str) -> tuple[list[str], list[int]]:
     nodes, periods = [], []
     for item in text.split(","):
@@ -38,7 +46,9 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
     """Predict and measure (see the module docstring); returns the JSON-able result."""
     from rrcache.model.sets import SetOption, _pair_grids, _SingleFront, set_prediction
     from rrcache.pipeline import load_for_session
-    from rrcache.profiler.sets import _Runner, feeds, layout_for
+    from rrcache.harness.execute import Bench, LocalExecutor
+    from rrcache.profiler.jobs import Meter
+    from rrcache.profiler.sets import feeds, layout_for, train_set
     from rrcache.profiles import load_profile
     from rrcache.session import load_session
 
@@ -62,12 +72,12 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
         rows = [table.node_ids.index(n) for n in nodes]
         err, ms = set_prediction(table, rows, periods, relation, layout)
         chosen.append(SetOption(nodes, periods, layout, err, ms, None, 0.0))
-    runner = _Runner(prof, work, session, prof.settings, None)
+    executor = LocalExecutor(Bench(work, session))
     rows_out = []
     try:
         for o in chosen:
             start = clock()
-            runner.train(o)
+            train_set(prof, prof.settings, session, o, executor, Meter(None))
             idx = [table.node_ids.index(n) for n in o.nodes]
             nested = [(o.nodes[a], o.nodes[b]) for a in range(len(idx)) for b in range(len(idx))
                       if (idx[a], idx[b]) in relation]
@@ -81,7 +91,7 @@ def measure(profile_dir, shader, session_path, pairs: int = 4, extra=(), clock=t
                   f"measured {o.trained_error:.4f} {prof.original_ms / o.trained_ms:.2f}×  (gain {o.gain:.2f}, "
                   f"feeds {nested})", flush=True)
     finally:
-        runner.release()
+        executor.close()
     return {"profile": str(profile_dir), "original_ms": prof.original_ms, "layout": layout,
             "algorithm": prof.algorithm, "sets": rows_out,
             "selections": [s.to_json() for s in prof.selections]}
@@ -149,11 +159,11 @@ def plot(profile_dirs: list, measured: list, levels_json: list, path, titles=Non
     for folder, bench, lev in zip(profile_dirs, measured, levels_json):
         prof = load_profile(folder)
         known = {o.key for o in prof.sets if o.trained}
-        extra = [SetOption.from_json(r) for r in json.load(open(bench))["sets"]] if bench else []
+        extra = [SetOption.from_json(r) for r in _json(bench)["sets"]] if bench else []
         extra = [o for o in extra if o.key not in known]
         taken = {o.key for o in extra}  # a measured set replaces its untrained prediction
         prof.sets = [o for o in prof.sets if o.key not in taken] + extra
-        rows = json.load(open(lev))["levels"] if lev else []
+        rows = _json(lev)["levels"] if lev else []
         prof.selections = [_read_dataclass(Selection, r[side], "", lev) for r in rows for side in ("single", "with_sets")
                            if side == "single" or r["changed"]]
         profiles.append(prof)
@@ -182,7 +192,7 @@ def main(argv: Optional[list] = None) -> None:  # pragma: no cover - a measureme
                    a.plot))
         return
     if a.levels:
-        extra = json.load(open(a.extra))["sets"] if a.extra else []
+        extra = _json(a.extra)["sets"] if a.extra else []
         result = levels(a.profile, a.shader, a.session, a.validation_frames, extra)
         for row in result["levels"]:
             for side in ("single", "with_sets"):

@@ -6,7 +6,7 @@
 
 ``rrcache instance PROFILE --level eN`` writes exactly the files of the profile's
 ``optimized/eN`` (the level's choice with its algorithm, period and every cache option;
-:mod:`rrcache.profiles.choice`). With a PROFILE and ``--node``, the algorithm defaults to the
+:mod:`rrcache.choice`). With a PROFILE and ``--node``, the algorithm defaults to the
 profile's; with a SHADER, to three-pass (the command says which it used).
 
 ``rrcache instance SHADER --estimator e1 --samples 4 --lambda 0.6 --out DIR`` writes an
@@ -33,6 +33,7 @@ from rrcache.cli.options import PERIOD, include_dirs_option, pair_periods, parse
 from rrcache.cli.sources import describe_selection, refuse_with_level, resolve
 from rrcache.runtime import ALGORITHMS, DEFAULT_FILTER, DEFAULT_PERIOD, FILTERS
 from rrcache.selection import AMORTIZE_PAYLOADS
+from rrcache.choice import write as choice_write
 
 #: what --target writes: GLSL 3.30 core files, or WebGL2 (GLSL ES 3.00 and a page)
 TARGETS = ("glsl", "webgl2")
@@ -177,11 +178,11 @@ def _compile(variant) -> None:
 
 def _write_level(prof, level, include_dirs, out_dir, target) -> None:
     """``instance PROFILE --level eN``: the level's choice, as the profile wrote optimized/eN."""
-    from rrcache.profiles import choice
+    from rrcache import choice
 
     sel = choice.level(prof, level)
     if not sel.parts:
-        written = prof.write_variant(sel, out_dir)
+        written = choice_write(prof, sel, out_dir)
         click.echo(f"{sel.label} keeps the original shader ({choice.original_note(prof, sel)}):")
     else:
         work, session = choice.load_work(prof, include_dirs)

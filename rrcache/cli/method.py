@@ -65,7 +65,7 @@ def render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_j
     """The render cache at ``samples`` beside the original: table and summary (or JSON)."""
     from rrcache.alternatives.render_cache import RenderCacheSettings
     from rrcache.alternatives.render_cache.tune import compare
-    from rrcache.harness.prepare import prepare_file
+    from rrcache.compiler.prepared import prepare_file
     from rrcache.pipeline import all_include_dirs
 
     settings = RenderCacheSettings(samples=DEFAULT_SAMPLES if samples is None else samples).checked()
@@ -75,9 +75,8 @@ def render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_j
     out = Path(out_dir) if out_dir else None
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
-    said = (f"render cache (Walter et al. 2002): {settings.samples:g} of the pixels per frame in "
-            f"{settings.block}×{settings.block} blocks, a cache of {settings.points_per_pixel:g}× the pixels in points, "
-            f"prediction {'on' if settings.predict else 'off'}")
+    said = (f"{settings.describe().replace('render cache', 'render cache (Walter et al. 2002)', 1)}, a cache of "
+            f"{settings.points_per_pixel:g}× the pixels in points, prediction {'on' if settings.predict else 'off'}")
     if not quiet:
         err_console.print(f"{prepared.path}: {said}; colour target {color_format}, {len(indices)} frames",
                           highlight=False, markup=False, soft_wrap=True)

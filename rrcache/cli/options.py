@@ -71,3 +71,15 @@ def pair_periods(nodes, periods, default: int) -> list[int]:
             f"{len(nodes)} --node but {len(periods)} --period: give one --period per --node, in the "
             "same order (or one for all)", param_hint="--period")
     return periods
+
+
+def cluster_options(fn):
+    """``--workers N`` and ``--scheduler ADDRESS``: where a profile's runs are made
+    (:func:`rrcache.cluster.maybe_cluster`; neither: in this process)."""
+    fn = click.option("--scheduler", metavar="ADDRESS", default=None,
+                      help="Make the runs on the Dask cluster of this running scheduler (tcp://HOST:8786; "
+                           "default: $RRCACHE_SCHEDULER). docs/distributed.md has a farm recipe.")(fn)
+    return click.option("--workers", type=click.IntRange(min=1, max=512), default=None, metavar="N",
+                        help="Make the runs on a Dask cluster of N worker processes started here (its "
+                             "dashboard link is printed); more workers also train more nodes on more "
+                             "frames (docs/distributed.md).")(fn)

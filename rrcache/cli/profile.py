@@ -23,10 +23,13 @@ import click
 from rich.console import Console
 
 from rrcache.cli import interrupt
-from rrcache.cli.options import include_dirs_option, parse_defines, resolution_option as _resolution, vert_option
+from rrcache.cli.options import (cluster_options, include_dirs_option, parse_defines, resolution_option as _resolution,
+                                 vert_option)
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.cluster import maybe_cluster
 from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS
+from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK, UNRELIABLE_NOISE
 from rrcache.model.psnr import psnr_text
 from rrcache.errors import RRCacheError
 from rrcache.profiler.run import default_out_dir, profile
@@ -83,7 +86,8 @@ def _fmt(value, spec=".3g", none="–"):
               help="Share of the frame the error runs render at full resolution (default: chosen from the "
                    "original's cost, at most 0.25; 1: the whole frame).")
 @click.option("--frames", type=click.IntRange(min=2), default=None,
-              help="Train the error on the first N frames (default: 64, or all of a shorter session).")
+              help="Train the error on N frames, spread over the session in segments (default: 150, all of a "
+                   "shorter session).")
 @click.option("--periods", callback=_periods, default=None, metavar="LIST",
               help=f"Training refresh periods (default: {','.join(map(str, DEFAULT_PERIODS))}).")
 @click.option("--timing-frames", type=click.IntRange(min=1), default=None,
@@ -127,18 +131,27 @@ def _fmt(value, spec=".3g", none="–"):
               help="After validation, measure each selection's node with adaptive refresh at these "
                    "thresholds (e.g. 0.005,0.01,0.02) and keep it where faster at the same level "
                    "(docs/adaptive.md).")
+@click.option("--max-flip", type=click.FloatRange(min=0, min_open=True), default=None, metavar="F",
+              help="Add a level 'flip': the fastest choice measured at mean FLIP <= F against the original "
+                   "(docs/levels.md).")
+@click.option("--clock", type=click.Choice(sorted(CLOCKS)), default=DEFAULT_CLOCK, show_default=True,
+              help="The frame clock of every timed run: wall = wall time around glFinish (the only one that "
+                   "means anything on a software rasterizer); gl-timer = GL timer queries (real GPUs). "
+                   "Recorded in the profile.")
+@cluster_options
 @quiet_option
 @vert_option
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
-            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain, timing_format, levels,
-            wait, max_sets, defines, adaptive, quiet, vert, include_dirs):
+            algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain,
+            timing_format, levels, wait, max_sets, defines, adaptive, clock, workers, scheduler, max_flip, quiet, vert,
+            include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
     err_console = Console(stderr=True)
     kwargs = dict(resolution=resolution, error_window=error_window, frames=frames, algorithm=algorithm, filter=filter_,
                   measure_terms=measure_terms,
-                  validate=not no_validate, validation_frames=validation_frames, levels=levels)
+                  validate=not no_validate, validation_frames=validation_frames, levels=levels, clock=clock)
     for name, value in (("timing_frames", timing_frames), ("budget_s", budget), ("min_saving", min_saving),
                         ("min_gain", min_gain), ("timing_format", timing_format),
                         ("max_sets", max_sets)):
@@ -155,8 +168,10 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
         with Reporter(err_console, quiet=quiet) as reporter, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
-                               vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive)
+                with maybe_cluster(workers, scheduler, announce=reporter.line) as cluster:
+                    prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
+                                   vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive,
+                                   executor=cluster, max_flip=max_flip)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
@@ -223,6 +238,11 @@ def _summary(prof, console: Console) -> None:
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
     console.print(f"filter: {filter_line(prof)}", highlight=False)
+    if prof.plan:
+        from rrcache.profiler.plan import Plan
+
+        console.print(Plan.from_json(prof.plan).describe(prof.settings.resolution, prof.settings.frames),
+                      highlight=False)
     for line in _estimator_lines(prof):
         console.print(line, highlight=False)
     ceiling = prof.measured_ceiling
@@ -365,17 +385,7 @@ def _table(prof) -> TextTable:
                           "level", "node", "Δn", "speed-up pred.", "speed-up meas.", "PSNR pred.", "PSNR meas.",
                           "FLIP meas.", "level met")])
     for s in prof.selections:
-        if s.multi:  # several nodes, each at its own period
-            node = " + ".join(f"{p.node}: {p.text or prof.node(p.node).text}" for p in s.parts)
-            period = "/".join(str(p) for p in s.periods)
-        elif s.kind == "amortize":  # amortized sampling: the estimator at m samples, blend λ
-            part = s.parts[0]
-            slots = " slots" if part.history == "slots" else ""
-            node, period = (f"{part.estimator} m={part.samples}/{prof.estimator(part.estimator).samples} "
-                            f"λ={part.blend:g}{slots}: {part.text or ''}"), "–"
-        else:
-            node = "(original)" if s.node is None else f"{s.node}: {s.text}"
-            period = _fmt(s.period, "d")
+        node, period = s.choice.cells(s, prof) if s.parts else ("(original)", "–")
         if s.fallback:
             node = "↩ " + node
         table.add_row(f"{s.label} {_level(s)}", node, period, _predicted_speedup(s), _speedup(s),

@@ -25,8 +25,10 @@ from rich.console import Console
 from rich.table import Table
 
 from rrcache.cli import interrupt
+from rrcache.cli.options import cluster_options
 from rrcache.cli.profile import _periods, _seconds
 from rrcache.cli.progress import Reporter, quiet_option
+from rrcache.cluster import maybe_cluster
 from rrcache.profiles.settings import ALGORITHM_CHOICES, LEVEL_KINDS, TrainingSettings
 from rrcache.report.library import LEVELS
 
@@ -52,9 +54,10 @@ from rrcache.report.library import LEVELS
 @click.option("--no-validate", is_flag=True, help="Do not measure the selections beside the original.")
 @click.option("--no-plots", is_flag=True, help="Write no plots or report.html (faster).")
 @click.option("--fresh", is_flag=True, help="Start every profile over (each store moved aside as .bak).")
+@cluster_options
 @quiet_option
 def command(manifest, shaders, sessions, out_dir, budget, frames, periods, timing_frames, timing_periods, algorithm,
-            min_gain, levels, no_validate, no_plots, fresh, quiet):
+            min_gain, levels, no_validate, no_plots, fresh, workers, scheduler, quiet):
     """Profile every (shader, session) pair of MANIFEST (or of --shaders and --sessions) into OUT."""
     from rrcache.profiler.library import profile_library
     from rrcache.profiler.manifest import entries_from_globs, read_manifest
@@ -79,8 +82,9 @@ def command(manifest, shaders, sessions, out_dir, budget, frames, periods, timin
         warnings.simplefilter("always")
         try:
             # the command line's options win over the manifest's settings, the entries' own over both
-            rows = profile_library(entries, out_dir, None, {**manifest_settings, **overrides}, reporter.event,
-                                   announce=reporter.line, fresh=fresh, plots=not no_plots)
+            with maybe_cluster(workers, scheduler, announce=reporter.line) as cluster:
+                rows = profile_library(entries, out_dir, None, {**manifest_settings, **overrides}, reporter.event,
+                                       announce=reporter.line, fresh=fresh, plots=not no_plots, cluster=cluster)
         except KeyboardInterrupt:
             interrupted = True
             rows = None

@@ -60,7 +60,7 @@ from rrcache.jsonable import finite_json
 from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
-from rrcache.harness.prepare import prepare_file
+from rrcache.compiler.prepared import prepare_file
 from rrcache.harness.renderer import frame_indices, render
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
@@ -149,7 +149,7 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
                      err_console, quiet)
         return
     if level is not None:
-        from rrcache.profiles import choice
+        from rrcache import choice
 
         sel = choice.level(prof, level)
         if not sel.parts:

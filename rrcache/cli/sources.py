@@ -3,7 +3,7 @@
 A profile folder (the folder ``rrcache profile`` wrote, or its ``profile.json``) stands for the
 shader, the session, the defines, the include folders and the vertex shader it was profiled
 with, and for its choices: ``--level eN`` takes a level's choice with every option the profile
-chose (:mod:`rrcache.profiles.choice`), and ``--node`` defaults to the profile's algorithm and
+chose (:mod:`rrcache.choice`), and ``--node`` defaults to the profile's algorithm and
 cache options instead of the commands' own defaults.
 """
 from __future__ import annotations

@@ -46,12 +46,31 @@ def _import_distributed():
 class Cluster:
     """A connected cluster: ``client`` (a ``distributed.Client``), ``local`` (the
     ``LocalCluster`` started here, or None), ``dashboard`` (the link, or None), ``workers``
-    ({address: info} from each worker's plugin: host, pid, renderer, ``LP_NUM_THREADS``)."""
+    ({address: info} from each worker's plugin: host, pid, renderer, ``LP_NUM_THREADS``) and
+    ``placements`` (where and when every run made through it ran:
+    :class:`rrcache.cluster.worker.Placed` without the results)."""
 
     client: object
     local: object = None
     dashboard: Optional[str] = None
     workers: dict = field(default_factory=dict)
+    placements: list = field(default_factory=list)
+
+    def executor(self, work, session, on_frame=None):
+        """The executor of one profile's runs (``work`` over ``session``) on this cluster:
+        :class:`rrcache.cluster.executor.DaskExecutor`. The cluster itself is the executor
+        factory :func:`rrcache.profile` takes (``executor=cluster``)."""
+        from rrcache.cluster.executor import DaskExecutor
+
+        return DaskExecutor(self, work, session, on_frame)
+
+    __call__ = executor
+
+    @property
+    def capacity(self) -> int:
+        """The workers that run error runs (each one run at a time): as many as were connected
+        when the cluster was reached (:mod:`rrcache.profiler.capacity` scales a profile by it)."""
+        return max(1, len(self.workers))
 
     @property
     def hosts(self) -> list[str]:

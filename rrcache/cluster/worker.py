@@ -53,6 +53,8 @@ class Placed:
     started: float
     finished: float
     kind: str
+    #: what ran (the run's label, filled in on the client)
+    label: str = ""
 
 
 class GLWorker(WorkerPlugin):

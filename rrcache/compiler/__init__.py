@@ -34,27 +34,16 @@ from typing import Any, Union
 from rrcache.errors import UnsupportedShaderError
 from rrcache.deep import deep
 from rrcache.glsl import ast as A
+from rrcache.compiler.checks import check_algorithm
 from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.locate import prepare
 from rrcache.compiler.passes import build_pass
 from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS, DEFAULT_FILTER, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS, depth_channel_for
+from rrcache.runtime.spec import VariantSpec
 
 __all__ = ["instance", "instance_nodes", "check_algorithm", "Variant", "PassSource"]
-
-
-def check_algorithm(analysed: Any, node_id: Union[int, str, A.Expr], algorithm: str) -> None:
-    """Raise :class:`UnsupportedShaderError` when ``analysed`` is a node table whose entry for
-    ``node_id`` is not valid for ``algorithm`` (a node that needs screen-space derivatives
-    cannot be cached by one-pass), naming the reason and the algorithms that can."""
-    for n in getattr(analysed, "nodes", None) or ():
-        if (n.id == node_id or n.node is node_id) and algorithm in getattr(n, "invalid", {}):
-            valid = getattr(n, "algorithms", [])
-            raise UnsupportedShaderError(
-                f"node {n.id} '{n.text}' cannot be cached with {algorithm}: "
-                f"{n.invalid[algorithm]}", n.node.loc,
-                f"use --algorithm {' or '.join(valid)}" if valid else "pick another node")
 
 
 @deep
@@ -68,7 +57,7 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
     payload reconstruction filter (``nearest``, ``bilinear``, ``catmull-rom``) and
     ``payload_dtype`` the cache precision (``f4``, or ``f2`` for half floats), recorded for the
     runtime. ``vertex`` is the user's vertex shader (a
-    :class:`rrcache.harness.user_vertex.UserVertex`; None: generated). Raises
+    :class:`rrcache.compiler.user_vertex.UserVertex`; None: generated). Raises
     :class:`~rrcache.errors.UnsupportedShaderError` (at the node's place) for a node that cannot
     be cached, or that the node table says ``algorithm`` cannot cache (:func:`check_algorithm`).
     ``pack_depth``: keep the inverse depth in the payload's free channel when it has one
@@ -109,7 +98,9 @@ def instance(analysed: Any, node_id: Union[int, A.Expr], algorithm: str = "three
         node_type=loc.type_name, node_text=loc.text, components=loc.components, filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.loc, shader_path=loc.path,
-        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel, adaptive=bool(adaptive))
+        vertex_path=getattr(vertex, "path", None), depth_channel=depth_channel, adaptive=bool(adaptive),
+        spec=VariantSpec("adaptive" if adaptive else "cache", (node_id,) if isinstance(node_id, (int, str)) else (),
+                         algorithm, filter, payload_dtype, pack_depth))
 
 
-from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes; imports check_algorithm lazily)
+from rrcache.compiler.multi import instance_nodes  # noqa: E402  (k >= 2 nodes)

@@ -27,7 +27,7 @@ estimators`: ``a0 + Σ_i t(i)`` over ``N`` iterations), packed into the payload.
 - at a **miss** (disocclusion) all ``N`` iterations run, as in the original.
 
 ``history="slots"`` (with the ``frame`` phase and ``N = s·m``, when ``s`` times the
-accumulators fit in the payload's 4 components: :func:`rrcache.selection.slots_fit`, the rule the
+accumulators fit in the payload's 4 components: :func:`rrcache.compiler.slots.slots_fit`, the rule the
 profiler and the models use too): the payload keeps the ``s`` subset sums
 apart. A hit recomputes its phase's sum (blended with that slot's reprojected value by ``λ``;
 ``λ = 0`` replaces it) and the value is the start plus all ``s`` slots, so on a still image the
@@ -77,8 +77,9 @@ from rrcache.compiler.passes import PASS_SPECS, PassUnit, runtime_snippets
 from rrcache.compiler.prune import prune
 from rrcache.compiler.variant import PassSource, Variant
 from rrcache.runtime.cache import ALGORITHMS
+from rrcache.runtime.spec import VariantSpec
 from rrcache.runtime.glsl import AMORTIZE_GLSL, AMORTIZE_PIXEL_GLSL, FILTERS
-from rrcache.selection import AMORTIZE_PAYLOADS, slots_fit
+from rrcache.compiler.slots import AMORTIZE_PAYLOADS, slots_fit
 
 __all__ = ["instance_amortized", "LocatedLoop", "HISTORIES", "PHASES", "prepare_loop", "subset_indices"]
 
@@ -476,7 +477,7 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
     how the subset changes (``frame`` or ``pixel``, see the module doc); ``history``: ``blend``
     (the paper's running estimate) or ``slots`` (one reprojected sum per subset, see the module
     doc). ``vertex`` is the user's vertex shader (a
-    :class:`rrcache.harness.user_vertex.UserVertex`; None: generated), as for
+    :class:`rrcache.compiler.user_vertex.UserVertex`; None: generated), as for
     :func:`rrcache.compiler.instance`. ``payload_dtype="u8"`` (``slots`` only) stores the slots
     in 8 bits (:mod:`rrcache.compiler.payload_encoding`) by the range of the estimator's terms
     (``term_range``, else the analysis's or the pragma's: ``Estimator.term_range``).
@@ -533,6 +534,8 @@ def instance_amortized(shader: Any, estimator_id: str, algorithm: str = "three-p
         components=payload_components, filter=filter, payload_dtype=payload_dtype, passes=passes,
         uniforms=uniforms, samplers=samplers, runtime_uniforms=runtime, forms=forms,
         node_loc=loop_loc, shader_path=loc.path, vertex_path=getattr(vertex, "path", None),
+        spec=VariantSpec("amortize", (), algorithm, filter, payload_dtype, estimator=est.id, samples=int(samples),
+                         history=history, phase=phase, blend=float(blend)),
         amortized={"estimator": est.id, "samples": samples, "of": est.samples, "lambda": float(blend),
                    "phase": phase, "cycle": cycle, "history": history, "accumulators": [display_name(a) for a in est.accumulators],
                    **({"payload_encoding": encoding.to_json(),

@@ -5,9 +5,9 @@ core version when higher) with the runtime's GLSL inserted verbatim after the ``
 ``#extension`` lines; its line map (printed line → original place, None for generated lines)
 maps driver errors back to the user's file.
 
-The vertex shader is the user's own when one was given (:mod:`rrcache.harness.user_vertex`:
+The vertex shader is the user's own when one was given (:mod:`rrcache.compiler.user_vertex`:
 ``rr_prevClip`` and ``invariant gl_Position`` added, the user's varyings passed through every
-pass), else it comes from the harness generator (:func:`rrcache.harness.vertex.
+pass), else it comes from the harness generator (:func:`rrcache.compiler.vertex.
 vertex_for`), asked for exactly the varyings the fragment shader declares (plus
 ``rr_prevClip`` when the pass reads the previous frame's cache), with ``gl_Position`` declared
 ``invariant``: every pass must produce bit-identical depths, or the depth tests between passes
@@ -27,7 +27,7 @@ from rrcache.errors import SourceLoc
 from rrcache.glsl import ast as A
 from rrcache.glsl.printer import print_with_map
 from rrcache.glsl.types import OPAQUE_NAMES
-from rrcache.harness.vertex import vertex_for
+from rrcache.compiler.vertex import vertex_for
 from rrcache.runtime import glsl as G
 
 _UNIFORM_LINE = re.compile(r"^\s*uniform\s+\w+\s+(\w+)\s*;", re.MULTILINE)
@@ -126,7 +126,7 @@ def vertex_shader(inputs: dict[str, str], prev_clip: bool,
                   locs: Optional[dict[str, Optional[SourceLoc]]] = None, user=None) -> str:
     """The vertex shader writing ``inputs`` (and ``rr_prevClip``), with an invariant
     ``gl_Position``: generated, or the user's own (``user``, a
-    :class:`rrcache.harness.user_vertex.UserVertex`) with the cache's additions."""
+    :class:`rrcache.compiler.user_vertex.UserVertex`) with the cache's additions."""
     return vertex_for(inputs, locs, user, prev_clip=prev_clip, invariant=True)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from rrcache.deep import deep
+from rrcache.compiler.checks import check_algorithm
 from rrcache.compiler.emit import emit_pass
 from rrcache.compiler.multi_locate import prepare_nodes
 from rrcache.compiler.multi_passes import build_multi_pass, has_discard, node_order
@@ -18,6 +19,7 @@ from rrcache.compiler.multi_variant import MultiVariant
 from rrcache.compiler.variant import PassSource
 from rrcache.runtime.cache import ALGORITHMS, DEFAULT_FILTER, PAYLOAD_DTYPES
 from rrcache.runtime.glsl import FILTERS
+from rrcache.runtime.spec import VariantSpec
 
 
 def _table_entry(analysed: Any, node_id: Any):
@@ -36,8 +38,6 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
     order). Raises :class:`~rrcache.errors.UnsupportedShaderError` for a node that cannot be
     cached, or not with ``algorithm`` (:func:`rrcache.compiler.check_algorithm`), or a nest that
     cannot be compiled."""
-    from rrcache.compiler import check_algorithm
-
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm must be one of {tuple(ALGORITHMS)}, not {algorithm!r}")
     if filter not in FILTERS:
@@ -79,12 +79,10 @@ def instance_nodes(analysed: Any, node_ids: Sequence[Any], algorithm: str = "thr
         "location": str(n.loc) if n.loc else None,
         "inside": ids[n.parent] if n.parent is not None else None,
     } for n in loc.nodes]
+    spec = VariantSpec("nodes", tuple(ids) if all(i is not None for i in ids) else (), algorithm, filter, payload_dtype)
     return MultiVariant(
-        algorithm=algorithm,
-        node_id="+".join(str(i) for i in ids) if all(i is not None for i in ids) else None,
-        node_type=", ".join(n.type_name for n in loc.nodes),
-        node_text=" + ".join(n.text for n in loc.nodes),
+        algorithm=algorithm, node_id=None, node_type=None, node_text=None,
         components=tuple(n.components for n in loc.nodes), filter=filter,
         payload_dtype=payload_dtype, passes=passes, uniforms=uniforms, samplers=samplers,
         runtime_uniforms=runtime, forms=forms, node_loc=loc.nodes[0].loc, shader_path=loc.path,
-        vertex_path=getattr(user_vertex, "path", None), nodes=nodes)
+        vertex_path=getattr(user_vertex, "path", None), nodes=nodes, spec=spec)

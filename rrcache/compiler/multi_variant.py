@@ -3,8 +3,9 @@
 A :class:`MultiVariant` is a :class:`~rrcache.compiler.variant.Variant` whose ``nodes`` lists
 every cached node (id, type, text, components, place, and the node it is nested in) in the order
 the runtime's periods follow; ``components`` is then one count per node (what
-:class:`rrcache.runtime.CacheRuntime` takes as ``payload_components`` beside one period per
-node). Its manifest has ``"nodes"`` (each with the period it runs with) instead of ``"node"``,
+:class:`rrcache.runtime.multi.MultiCacheRuntime` takes as ``payload_components`` beside one period
+per node), and the one-node fields ``node_id``, ``node_type`` and ``node_text`` are None (read
+``nodes``). Its manifest has ``"nodes"`` (each with the period it runs with) instead of ``"node"``,
 and ``"period"`` is the list of periods.
 """
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Optional, Sequence
 
 from rrcache.compiler.variant import Variant
 from rrcache.runtime.cache import DEFAULT_PERIOD
+from rrcache.runtime.multi import MultiCacheRuntime
 
 
 @dataclass
@@ -21,6 +23,12 @@ class MultiVariant(Variant):
     """Several nodes cached with one algorithm (see the module docstring)."""
 
     nodes: list = field(default_factory=list)
+
+    runtime_class = MultiCacheRuntime
+
+    def describe(self) -> str:
+        """``nodes n1 'a' + n2 'b'``."""
+        return "nodes " + " + ".join(f"{n.get('id')} '{n.get('text')}'" for n in self.nodes)
 
     @property
     def node_count(self) -> int:
@@ -42,7 +50,7 @@ class MultiVariant(Variant):
         ``"period"`` the list of periods.
 
         >>> from rrcache.compiler.variant import PassSource
-        >>> v = MultiVariant("one-pass", "n1+n2", "float, vec3", "a + b", (1, 3), "bilinear", "f4",
+        >>> v = MultiVariant("one-pass", None, None, None, (1, 3), "bilinear", "f4",
         ...                  {"single": PassSource("vs", "fs")},
         ...                  nodes=[{"id": "n1", "type": "float"}, {"id": "n2", "type": "vec3"}])
         >>> m = v.manifest([50, 4])

@@ -8,13 +8,15 @@ to the original shader), what the application must bind, and how the runtime mus
 
     variant = instance(analysed, node_id)            # rrcache.compiler.instance
     programs = variant.build_programs(ctx)
-    rt = CacheRuntime(ctx, programs, variant.algorithm, (w, h), period=16,
-                      payload_dtype=variant.payload_dtype, payload_components=variant.components,
-                      depth_channel=variant.depth_channel, payload_decode=variant.payload_decode)
+    rt = variant.runtime(ctx, programs, (w, h), spec=variant.spec.with_runtime(periods=(16,)))
     variant.write("out/", period=16)                 # the manifest records the period it ran with
 
-The refresh period and the cache's other run-time parameters are not part of a variant (the same
-passes run at any period): they are the runtime's, with their defaults in
+``variant.spec`` (a :class:`rrcache.runtime.spec.VariantSpec`) is what was compiled: the kind, the
+nodes, the algorithm, the filter and payload, and the runtime's fields at their defaults; the
+runtime takes a spec whole (:meth:`Variant.runtime`, with this variant's compiled facts: payload
+components, where the inverse depth is kept, the 8-bit payload's decoding, the phase cycle). The
+refresh period and the cache's other run-time parameters are not part of a variant (the same
+passes run at any period): they are the spec's runtime fields, with their defaults in
 :mod:`rrcache.runtime.cache` (``DEFAULT_PERIOD`` …).
 """
 from __future__ import annotations
@@ -29,7 +31,8 @@ import moderngl
 from rrcache import atomic
 from rrcache.errors import GLError, SourceLoc
 from rrcache.gl.program import build_program
-from rrcache.runtime.cache import ALGORITHMS, DEFAULT_PERIOD
+from rrcache.runtime.cache import ALGORITHMS, DEFAULT_PERIOD, CacheRuntime
+from rrcache.runtime.spec import VariantSpec
 
 
 @dataclass
@@ -75,6 +78,37 @@ class Variant:
     depth_channel: Optional[int] = None
     # adaptive refresh (rrcache.runtime.adaptive): the passes keep each entry's volatility
     adaptive: bool = False
+    #: what was compiled (the runtime's fields at their defaults); the compiler sets it
+    spec: Optional[VariantSpec] = None
+
+    #: the runtime class these passes run in (MultiVariant: one cache per node)
+    runtime_class = CacheRuntime
+
+    @property
+    def node_count(self) -> int:
+        """The cached values: one (MultiVariant: one per node, each with its own period)."""
+        return 1
+
+    def describe(self) -> str:
+        """What is cached, for messages: ``node n12 'sin(x)'``."""
+        what = "estimator" if self.amortized else "node"
+        return f"{what} {self.node_id} '{self.node_text}'"
+
+    def runtime(self, ctx: moderngl.Context, programs: dict, size: tuple[int, int],
+                spec: Optional[VariantSpec] = None, **target):
+        """The runtime that runs these passes (:attr:`runtime_class`), made from ``spec`` (this
+        variant's spec with the runtime's fields it runs with; default :attr:`spec`) and this
+        variant's compiled facts; ``target``: ``color_format``, ``clear_color``, ``seed``,
+        ``cull_back_faces``, ``payload_dtype`` (see :meth:`rrcache.runtime.CacheRuntime.from_spec`)."""
+        spec = spec if spec is not None else self.spec
+        if spec is None:
+            raise ValueError("this variant has no spec: compile it with rrcache.compiler (or rrcache.kinds.compile)")
+        if spec.compiled() != self.spec.compiled():
+            raise ValueError(f"the spec {spec.compiled()} is not the one these passes were compiled for "
+                             f"({self.spec.compiled()})")
+        return self.runtime_class.from_spec(
+            ctx, programs, spec, size, payload_components=self.components, depth_channel=self.depth_channel,
+            payload_decode=self.payload_decode, phase_cycle=(self.amortized or {}).get("cycle", 1), **target)
 
     @property
     def pass_names(self) -> tuple[str, ...]:
@@ -168,8 +202,8 @@ class Variant:
                 for prog in programs.values():
                     prog.release()
                 new = GLError(
-                    f"the {name} pass of the {self.algorithm} variant caching node "
-                    f"{self.node_id} '{self.node_text}' was refused: {err.message}",
+                    f"the {name} pass of the {self.algorithm} variant caching {self.describe()} was refused: "
+                    f"{err.message}",
                     err.where, err.hint or "this is a bug in rrcache's compiler; please report it")
                 new.loc = getattr(err, "loc", None)
                 new.diagnostics = getattr(err, "diagnostics", [])

@@ -17,7 +17,7 @@ import moderngl
 
 from rrcache.errors import SessionError, UnsupportedShaderError
 from rrcache.gl.uniforms import encode_uniform, opaque_type_name, sampler_kind
-from rrcache.harness.prepare import PreparedShader
+from rrcache.compiler.prepared import PreparedShader
 
 # uniforms the harness sets itself (per frame or per object); name -> expected GLSL type
 BUILTINS = {

@@ -29,10 +29,11 @@ from rrcache.gl.context import get_context
 from rrcache.gl.resources import GLScope
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.metrics import mean_l2, nonfinite_count, psnr
-from rrcache.harness.prepare import PreparedShader
+from rrcache.compiler.prepared import PreparedShader
 from rrcache.harness.renderer import Renderer, check_frame_index, session_background
-from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD, DEFAULT_SPREAD
-from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_PERIOD, DEFAULT_REFRESH, CacheRuntime
+from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
+from rrcache.runtime import DEFAULT_PERIOD
+from rrcache.runtime.spec import VariantSpec
 
 def _unreliable() -> float:
     from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -81,6 +82,26 @@ def _range_remedy(variant) -> str:
     return f"the term range given for {loop} does not hold"
 
 
+def runtime_spec(variant, spec: Optional[VariantSpec] = None, period=None, **fields) -> VariantSpec:
+    """The spec ``variant`` runs with: ``spec`` whole, else the variant's own spec with the runtime
+    fields given as keywords (``period``: one int for every node, or one per node; ``block``,
+    ``refresh``, ``depth_epsilon``, ``threshold``, ``fast_period``, ``spread``, ``blend``)."""
+    if spec is not None:
+        if fields or period is not None:
+            raise TypeError("give the spec, or its runtime fields as keywords, not both")
+        return spec
+    if period is not None:
+        if isinstance(period, (int, np.integer)):
+            fields["periods"] = (int(period),) * variant.node_count
+        else:
+            fields["periods"] = tuple(int(p) for p in period)
+            if len(fields["periods"]) != variant.node_count:
+                raise ValueError(f"{variant.node_count} periods expected (one per node), not {len(fields['periods'])}")
+    elif not variant.spec.periods and variant.node_count > 1:
+        fields["periods"] = (DEFAULT_PERIOD,) * variant.node_count
+    return variant.spec.with_runtime(**fields)
+
+
 class CachedRenderer:
     """Renders frames of ``session`` with ``variant`` (a compiled :class:`Variant`).
 
@@ -89,20 +110,21 @@ class CachedRenderer:
     order for the cache to mean anything (frame ``i`` reprojects from the last rendered frame);
     a jump resets the cache (every pixel misses, as after a camera cut). ``window`` (x, y, w, h)
     renders only that rectangle at full pixel density (see :mod:`rrcache.gl.window`).
-    A variant of several nodes (:func:`rrcache.compiler.instance_nodes`) takes one ``period`` per
-    node (a sequence in the variant's node order; one int: every node).
+    ``spec`` is what the runtime runs (the variant's :class:`~rrcache.runtime.spec.VariantSpec`
+    with the runtime's fields set: periods, refresh, adaptive threshold, blend); or give those
+    fields as keywords (``period=``, ``block=``, ``threshold=`` …; :func:`runtime_spec`). A
+    variant of several nodes takes one period per node (a sequence in the variant's node order;
+    one int: every node).
     """
 
     def __init__(self, variant, session, prepared: PreparedShader, resolution: Optional[tuple[int, int]] = None,
-                 period=DEFAULT_PERIOD, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
-                 depth_epsilon: float = DEFAULT_DEPTH_EPSILON,
-                 seed: int = 0, hit_maps: bool = False, keep_payload: bool = False,
-                 ctx: Optional[moderngl.Context] = None, window: Optional[tuple[int, int, int, int]] = None,
-                 color_format: str = "rgba32f", threshold: Optional[float] = None,
-                 fast_period: int = DEFAULT_FAST_PERIOD, spread: float = DEFAULT_SPREAD,
-                 miss_causes: bool = False):
-        self.ctx = ctx or get_context()
+                 spec: Optional[VariantSpec] = None, *, seed: int = 0, hit_maps: bool = False,
+                 keep_payload: bool = False, window: Optional[tuple[int, int, int, int]] = None,
+                 color_format: str = "rgba32f", clock: str = DEFAULT_CLOCK, miss_causes: bool = False, **runtime):
+        self.ctx = get_context()
         hit_maps = hit_maps or miss_causes
+        self.spec = runtime_spec(variant, spec, **runtime)
+        self.clock = make_clock(clock, self.ctx)
         self.color_format = color_format
         self.variant = variant
         self.session = session
@@ -124,18 +146,9 @@ class CachedRenderer:
             for program in self.programs.values():
                 self.drawer.add_program(program)
             self.notes = self.drawer.notes
-            if hasattr(variant, "periods"):  # several nodes: one period each (a tuple)
-                period = tuple(variant.periods(period))
-            self.runtime = CacheRuntime(
-                self.ctx, self.programs, variant.algorithm, self.size, period=period, block=block,
-                refresh=refresh, seed=seed, payload_dtype="f4" if self._check_payload else variant.payload_dtype,
-                payload_components=variant.components, depth_epsilon=depth_epsilon,
-                clear_color=session_background(session), color_format=color_format,
-                blend=(getattr(variant, "amortized", None) or {}).get("lambda", 0.0),
-                phase_cycle=(getattr(variant, "amortized", None) or {}).get("cycle", 1),
-                depth_channel=getattr(variant, "depth_channel", None),
-                threshold=threshold, fast_period=fast_period, spread=spread,
-                payload_decode=getattr(variant, "payload_decode", None))
+            self.runtime = variant.runtime(
+                self.ctx, self.programs, self.size, self.spec, seed=seed, clear_color=session_background(session),
+                color_format=color_format, payload_dtype="f4" if self._check_payload else variant.payload_dtype)
             if window is not None:
                 self.runtime.set_window(window)
             self._classifier = None
@@ -158,6 +171,22 @@ class CachedRenderer:
     def period(self, value: int) -> None:
         self.runtime.period = value
 
+    def respec(self, spec: VariantSpec) -> None:
+        """Run the next frames with ``spec``'s runtime fields (periods, refresh, adaptive
+        threshold, blend; the passes stay: ValueError for a spec compiled otherwise) and an empty
+        cache: one renderer serves every period of a training run."""
+        if spec.compiled() != self.spec.compiled():
+            raise ValueError(f"{spec} needs other passes than this renderer's {self.spec.compiled()}")
+        rt = self.runtime
+        rt.period = spec.period
+        rt.set_refresh(mode=spec.refresh, block=spec.block)
+        rt.depth_epsilon = float(spec.depth_epsilon)
+        rt.blend = float(spec.blend)
+        if rt.adaptive:
+            rt.threshold, rt.fast_period, rt.spread = float(spec.threshold), int(spec.fast_period), float(spec.spread)
+        self.spec = spec
+        self.reset()
+
     def _settle_payload(self) -> None:
         """After the untimed first frames of a 16-bit or 8-bit payload request: if any covered
         pixel's payload does not fit (beyond ±65504 or overflowing for 16 bits; outside the
@@ -166,8 +195,7 @@ class CachedRenderer:
         frames are not checked."""
         self._check_payload = False
         rt = self.runtime
-        payloads = ([p[..., :c] for p, c in zip(rt.read_payloads(), rt.node_components)]
-                    if hasattr(rt, "read_payloads") else [rt.read_payload()[..., :rt.payload_components]])
+        payloads = [p[..., :c] for p, c in zip(rt.read_payloads(), rt.node_components)]
         covered = rt.read_depth() < 1.0
         if self.payload_dtype == "u8":
             offset, span = rt.payload_decode
@@ -230,13 +258,10 @@ class CachedRenderer:
         hit_box = {} if self.hit_maps else None
         codes = self._classifier.classify(self.drawer.draw) if self._classifier is not None else None
         with watchdog.frame(f"frame {index} of the cached variant"):
-            ctx.finish()
-            cpu_start = time.process_time()
-            start = time.perf_counter()
+            self.clock.start()
             stats = self._frame(hit_box)
-            ctx.finish()
-            ms = (time.perf_counter() - start) * 1000.0
-            cpu_ms = (time.process_time() - cpu_start) * 1000.0
+            ms = self.clock.stop()
+            cpu_ms = self.clock.cpu_ms
         self._last = index
         image = self.runtime.read_color()
         mask = self.runtime.read_depth() < 1.0
@@ -291,19 +316,18 @@ class CachedRenderer:
                 marks: list = []
 
                 def mark(stage):
-                    self.ctx.finish()
-                    marks.append((stage, time.perf_counter()))
+                    marks.append((stage, self.clock.mark()))
 
-                self.ctx.finish()
-                start = time.perf_counter()
+                self.clock.start()
+                start = self.clock.started
                 self.drawer.render_shadow_map()
                 stats = self.runtime.frame(self.drawer.draw, mark=mark if stages is not None else None)
-                self.ctx.finish()
-                end = time.perf_counter()
+                ms = self.clock.stop()
+                end = self.clock.end
                 self.runtime.read_color()
                 self.runtime.read_depth()
                 if i >= 2:
-                    times.append((end - start) * 1000.0)
+                    times.append(ms)
                     if stages is not None:
                         last = start
                         for stage, at in marks:
@@ -469,29 +493,26 @@ class Comparison:
         }
 
 
-def compare(variant, session, prepared: PreparedShader, frames, period=DEFAULT_PERIOD,
-            resolution: Optional[tuple[int, int]] = None, block: int = DEFAULT_BLOCK, refresh: str = DEFAULT_REFRESH,
-            depth_epsilon: float = DEFAULT_DEPTH_EPSILON, hit_maps: bool = False,
+def compare(variant, session, prepared: PreparedShader, frames, spec: Optional[VariantSpec] = None,
+            resolution: Optional[tuple[int, int]] = None, hit_maps: bool = False,
             on_frame: Optional[Callable[[FrameComparison, CachedFrame, object], None]] = None,
             window: Optional[tuple[int, int, int, int]] = None, color_format: str = "rgba32f",
-            threshold: Optional[float] = None, fast_period: int = DEFAULT_FAST_PERIOD,
-            spread: float = DEFAULT_SPREAD, miss_causes: bool = False) -> Comparison:
+            clock: str = DEFAULT_CLOCK, miss_causes: bool = False, **runtime) -> Comparison:
     """Render ``frames`` (consecutive indices) with the original and with ``variant``, alternating
     frame by frame, and compare them. ``on_frame(comparison_row, cached_frame, original_frame)``
     is called per frame (for progress bars and writing images). ``window``: both render only
     that rectangle of the frame (errors and times are then the window's). ``color_format``: the
     colour target both draw into (:mod:`rrcache.gl.formats`; ``rgba8`` as an application draws,
-    the error then being what it displays). ``threshold``, ``fast_period``, ``spread``: the
-    adaptive refresh of a variant compiled for it (:mod:`rrcache.runtime.adaptive`).
-    ``miss_causes``: each frame's misses sorted by cause (:mod:`rrcache.runtime.misses`; it
-    reads hit maps, so the times are not fair)."""
+    the error then being what it displays). ``spec`` (or the runtime keywords ``period=``,
+    ``threshold=`` …, :func:`runtime_spec`): what the cache runs with. ``clock``: the frame clock
+    both are timed with (:mod:`rrcache.harness.timing`). ``miss_causes``: each frame's misses
+    sorted by cause (:mod:`rrcache.runtime.misses`; it reads hit maps, so the times are not fair)."""
     result = Comparison()
     result.color_format = color_format
-    with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
-            CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
-                           depth_epsilon=depth_epsilon, hit_maps=hit_maps, window=window,
-                           color_format=color_format, threshold=threshold, fast_period=fast_period,
-                           spread=spread, miss_causes=miss_causes) as cached:
+    with Renderer(prepared, session, resolution, window=window, color_format=color_format, clock=clock) as original, \
+            CachedRenderer(variant, session, prepared, resolution, runtime_spec(variant, spec, **runtime),
+                           hit_maps=hit_maps, window=window, color_format=color_format, clock=clock,
+                           miss_causes=miss_causes) as cached:
         result.resolution = original.size
         result.notes = list(original.notes)
         for index in frames:

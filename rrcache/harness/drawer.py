@@ -8,8 +8,8 @@ model-view-projection for reprojection), the session's uniforms and samplers, an
 object, culling back faces unless the object is ``double_sided``.
 
 >>> from rrcache.gl import GLScope, build_program, get_context
->>> from rrcache.harness.prepare import prepare_file
->>> from rrcache.harness.vertex import vertex_source
+>>> from rrcache.compiler.prepared import prepare_file
+>>> from rrcache.compiler.vertex import vertex_source
 >>> from rrcache.session import load_session
 >>> ctx, scope = get_context(), GLScope()
 >>> session = load_session("sessions/marble.json")
@@ -35,8 +35,8 @@ from rrcache.gl.resources import GLScope
 from rrcache.gl.textures import texture_from_asset
 from rrcache.gl.uniforms import write_uniform
 from rrcache.harness.bindings import BUILTINS, BindingPlan, lookup, plan_bindings
-from rrcache.harness.prepare import PreparedShader
-from rrcache.harness.vertex import ATTRIBUTES
+from rrcache.compiler.prepared import PreparedShader
+from rrcache.compiler.vertex import ATTRIBUTES
 from rrcache.session.shadow import BIAS, light_view_projection
 
 #: the texture unit of the shadow map (session textures count up from 0; the cache uses 12-15)
@@ -79,7 +79,7 @@ def normal_matrix(model: np.ndarray) -> np.ndarray:
 def reprojection_matrix(mvp: np.ndarray, prev_mvp: np.ndarray) -> np.ndarray:
     """This frame's clip position → the previous frame's, for one object:
     ``prev_mvp @ inverse(mvp)`` in double precision (what a user's vertex shader multiplies
-    ``gl_Position`` by to find ``rr_prevClip``; see :mod:`rrcache.harness.user_vertex`).
+    ``gl_Position`` by to find ``rr_prevClip``; see :mod:`rrcache.compiler.user_vertex`).
 
     >>> m = np.diag([2.0, 2.0, 2.0, 1.0])
     >>> bool(np.allclose(reprojection_matrix(m, m), np.eye(4)))

@@ -25,6 +25,7 @@ from typing import Callable, Optional, Sequence
 
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.renderer import Renderer
+from rrcache.harness.timing import DEFAULT_CLOCK
 
 
 @dataclass
@@ -78,16 +79,21 @@ def probe_frames(indices: Sequence[int], count: int = 5) -> list[int]:
 
 
 def all_hit_limit(variant, session, prepared, frames: Sequence[int], resolution: Optional[tuple[int, int]] = None,
-                  repeats: int = 5, period: int = 16, block: int = 4, refresh: str = "random",
-                  depth_epsilon: float = 1e-3, window=None, color_format: str = "rgba32f",
-                  on_frame: Optional[Callable[[int], None]] = None) -> AllHitLimit:
+                  repeats: int = 5, window=None, color_format: str = "rgba32f",
+                  on_frame: Optional[Callable[[int], None]] = None, clock: str = DEFAULT_CLOCK,
+                  spec=None, **runtime) -> AllHitLimit:
     """Measure the all-hit limit of ``variant`` beside the original on ``frames`` (see the
     module docstring), at ``resolution`` (default: the session's), inside ``window`` if given,
-    both drawing into a ``color_format`` colour target. ``on_frame(index)`` after each frame."""
+    both drawing into a ``color_format`` colour target and timed with ``clock``
+    (:mod:`rrcache.harness.timing`); ``spec`` or the runtime keywords (``period=`` (default 16),
+    ``block=`` …) as for :class:`~rrcache.harness.cached.CachedRenderer`. ``on_frame(index)``
+    after each frame."""
     out = AllHitLimit()
-    with Renderer(prepared, session, resolution, window=window, color_format=color_format) as original, \
-            CachedRenderer(variant, session, prepared, resolution, period=period, block=block, refresh=refresh,
-                           depth_epsilon=depth_epsilon, window=window, color_format=color_format) as cached:
+    if spec is None:
+        runtime.setdefault("period", 16)
+    with Renderer(prepared, session, resolution, window=window, color_format=color_format, clock=clock) as original, \
+            CachedRenderer(variant, session, prepared, resolution, spec, window=window, color_format=color_format,
+                           clock=clock, **runtime) as cached:
         for index in frames:
             times: list[float] = []
             covered: list[int] = []

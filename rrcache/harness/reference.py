@@ -6,7 +6,7 @@ index), keeps it in memory and, when given a directory, also as ``.npy`` files (
 mask) so that a later run reuses them.
 
 >>> import tempfile
->>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.compiler.prepared import prepare_file
 >>> from rrcache.session import load_session
 >>> session = load_session("sessions/marble.json")
 >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
@@ -32,7 +32,7 @@ import numpy as np
 
 from rrcache.atomic import write_bytes
 from rrcache.files import read_bytes
-from rrcache.harness.prepare import PreparedShader
+from rrcache.compiler.prepared import PreparedShader
 from rrcache.harness.renderer import Renderer
 
 

@@ -6,8 +6,9 @@ renders frames into a colour target (RGBA32F by default; ``color_format``) plus 
 drawn, cleared to the session background. Per frame it returns a :class:`FrameResult`: the image
 (H×W×4 float32, row 0 = top), the covered pixels (where geometry was drawn: depth written), the
 samples that passed the depth test (an occlusion query: shaded fragments, overdraw included) and
-the wall time of the draws (``time.perf_counter()`` around clear, draws and ``ctx.finish()``,
-after one untimed warm-up draw of the program, since llvmpipe compiles on the first draw).
+the time of the draws (the frame clock of :mod:`rrcache.harness.timing` around clear and draws:
+by default wall time between two ``ctx.finish()``), after one untimed warm-up draw of the
+program, since llvmpipe compiles on the first draw.
 
 >>> from rrcache.session import load_session
 >>> session = load_session("sessions/marble.json")
@@ -34,8 +35,9 @@ from rrcache.gl.program import build_program
 from rrcache.gl.resources import GLScope
 from rrcache.gl.window import check_window, crop_rows
 from rrcache.harness.drawer import SceneDrawer
-from rrcache.harness.prepare import PreparedShader, load_user_vertex, prepare, prepare_file
-from rrcache.harness.vertex import vertex_for
+from rrcache.compiler.prepared import PreparedShader, load_user_vertex, prepare, prepare_file
+from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
+from rrcache.compiler.vertex import vertex_for
 
 #: bytes per pixel a renderer needs: RGBA32F colour and depth targets (20), the colour read back
 #: and flipped (32), the depth read back (4) and the coverage mask (1); checked before allocating
@@ -95,7 +97,7 @@ class Renderer:
     bottom left) renders only that rectangle of the frame, at full pixel density (scissor test);
     images and masks are then of the window's size.
 
-    >>> from rrcache.harness.prepare import prepare_file
+    >>> from rrcache.compiler.prepared import prepare_file
     >>> from rrcache.session import load_session
     >>> session = load_session("sessions/marble.json")
     >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
@@ -107,8 +109,10 @@ class Renderer:
 
     def __init__(self, prepared: PreparedShader, session, resolution: Optional[tuple[int, int]] = None,
                  cull_back_faces: Optional[bool] = None, ctx: Optional[moderngl.Context] = None,
-                 window: Optional[tuple[int, int, int, int]] = None, color_format: str = ERROR_FORMAT):
+                 window: Optional[tuple[int, int, int, int]] = None, color_format: str = ERROR_FORMAT,
+                 clock: str = DEFAULT_CLOCK):
         self.ctx = ctx or get_context()
+        self.clock = make_clock(clock, self.ctx)
         self.prepared = prepared
         self.color_format = color_format
         self._color_dtype = color_dtype(color_format)
@@ -165,9 +169,9 @@ class Renderer:
         self.fbo.use()
         self.fbo.viewport = (0, 0, *self.size)
         background = session_background(self.session)
-        ctx.finish()
-        cpu_start = time.process_time()
-        start = time.perf_counter()
+        clock = self.clock
+        clock.start()
+        start = clock.started
         if self.drawer.shadow_map is not None:  # the light's depth pass is part of the frame
             self.drawer.render_shadow_map()
             ctx.depth_func = "<"
@@ -175,19 +179,17 @@ class Renderer:
             self.fbo.viewport = (0, 0, *self.size)
         self.fbo.clear(*background, depth=1.0)
         if stages is not None:
-            ctx.finish()
-            cleared = time.perf_counter()
+            cleared = clock.mark()
         with self._query:
             self.drawer.draw(self.program)
-        ctx.finish()
-        end = time.perf_counter()
-        cpu_ms = (time.process_time() - cpu_start) * 1000.0
+        ms = clock.stop()
         samples = int(self._query.samples)
         if stages is not None:
+            end = clock.end
             stages.setdefault("clear", []).append((cleared - start) * 1000.0)
             stages.setdefault("draw", []).append((end - cleared) * 1000.0)
             stages.setdefault("queries", []).append((time.perf_counter() - end) * 1000.0)
-        return (end - start) * 1000.0, samples, cpu_ms
+        return ms, samples, clock.cpu_ms
 
     def render_frame(self, index: int, stages: Optional[dict] = None) -> FrameResult:
         """Render frame ``index`` (an int in ``0..session.frames-1``) and read it back.

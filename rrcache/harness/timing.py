@@ -1,4 +1,24 @@
-"""How far a timing can be trusted: the noise of frame times and the spread of a speed-up.
+"""The frame clock every timed site uses, and how far a timing can be trusted: the noise of frame
+times and the spread of a speed-up.
+
+**Clocks.** A :class:`FrameClock` times one frame's GL work: :meth:`~FrameClock.start` before the
+frame's first command, :meth:`~FrameClock.stop` after its last (the frame's ms; ``cpu_ms`` the
+process CPU time over the same span), :meth:`~FrameClock.mark` a stage boundary inside it
+(diagnostics: the GPU is waited for, so a staged frame is slower). Two clocks, picked by name
+(:data:`CLOCKS`, :func:`make_clock`; ``rrcache profile --clock``, recorded in the profile's
+settings), in the manner of moderngl-window's ``timers/``:
+
+- ``wall`` (:class:`WallClock`, the default): ``ctx.finish()``, then ``time.perf_counter()``
+  around the commands and a second ``ctx.finish()``. The only one that means anything on a
+  software rasterizer (llvmpipe runs the draws on the CPU; its timer queries say little).
+- ``gl-timer`` (:class:`GLTimerClock`): a GL ``TIME_ELAPSED`` query around the commands, the
+  GPU's own time for them, for real GPUs where the driver's queue makes wall time blur frames.
+
+>>> from types import SimpleNamespace
+>>> clock = WallClock(SimpleNamespace(finish=lambda: None))
+>>> clock.start(); ms = clock.stop()
+>>> ms >= 0.0, clock.cpu_ms >= 0.0, sorted(CLOCKS)
+(True, True, ['gl-timer', 'wall'])
 
 Speed-ups are ratios of median frame times measured side by side (the original and the variant
 alternating frame by frame). Two figures say how much such a number can move:
@@ -21,9 +41,98 @@ True
 from __future__ import annotations
 
 import math
-from typing import Sequence
+import time
+from typing import ClassVar, Sequence
 
 import numpy as np
+
+#: the clock a frame is timed with unless one is chosen
+DEFAULT_CLOCK = "wall"
+
+
+class FrameClock:
+    """Times one frame (see the module docstring). Subclasses set :attr:`name` and implement
+    :meth:`_begin` and :meth:`_end` (the frame's ms)."""
+
+    name: ClassVar[str] = ""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.cpu_ms = float("nan")
+        self._cpu = 0.0
+        #: wall-clock seconds (``perf_counter``) at the last start and stop: the stage marks' origin
+        self.started = self.end = 0.0
+
+    def start(self) -> None:
+        """Before the frame's first GL command: the GPU is idle when timing starts."""
+        self.ctx.finish()
+        self._cpu = time.process_time()
+        self.started = time.perf_counter()
+        self._begin()
+
+    def stop(self) -> float:
+        """After the frame's last GL command: the frame's ms (and :attr:`cpu_ms`)."""
+        ms = self._end()
+        self.cpu_ms = (time.process_time() - self._cpu) * 1000.0
+        return ms
+
+    def mark(self) -> float:
+        """A stage boundary (seconds on the wall clock, the GPU waited for): the stage
+        breakdowns of ``rrcache bench-cache --breakdown`` subtract consecutive marks."""
+        self.ctx.finish()
+        return time.perf_counter()
+
+    def _begin(self) -> None:
+        raise NotImplementedError
+
+    def _end(self) -> float:
+        raise NotImplementedError
+
+
+class WallClock(FrameClock):
+    """``perf_counter()`` between two ``ctx.finish()`` calls."""
+
+    name = "wall"
+
+    def _begin(self) -> None:
+        pass
+
+    def _end(self) -> float:
+        self.ctx.finish()
+        self.end = time.perf_counter()
+        return (self.end - self.started) * 1000.0
+
+
+class GLTimerClock(FrameClock):
+    """A GL ``TIME_ELAPSED`` query around the frame's commands (the GPU's time for them)."""
+
+    name = "gl-timer"
+
+    def __init__(self, ctx):
+        super().__init__(ctx)
+        self._query = ctx.query(time=True)
+
+    def _begin(self) -> None:
+        self._query.__enter__()
+
+    def _end(self) -> float:
+        self._query.__exit__(None, None, None)
+        self.ctx.finish()
+        self.end = time.perf_counter()
+        return float(self._query.elapsed) / 1e6
+
+
+#: clock name -> class: the one place a clock is declared
+CLOCKS: dict[str, type] = {WallClock.name: WallClock, GLTimerClock.name: GLTimerClock}
+
+
+def make_clock(name: str, ctx) -> FrameClock:
+    """The clock called ``name`` (:data:`CLOCKS`) on ``ctx``; ValueError naming the known ones."""
+    try:
+        cls = CLOCKS[name or DEFAULT_CLOCK]
+    except KeyError:
+        raise ValueError(f"clock must be one of {', '.join(sorted(CLOCKS))}, not {name!r}") from None
+    return cls(ctx)
 
 #: relative frame-time noise above which a timing is called unreliable
 UNRELIABLE_NOISE = 0.1

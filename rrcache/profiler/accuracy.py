@@ -24,12 +24,14 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from rrcache import kinds
 from rrcache.errors import RRCacheError
-from rrcache.harness.cached import CachedRenderer
-from rrcache.harness.renderer import Renderer
+from rrcache.harness.execute import Bench, LocalExecutor
+from rrcache.profiler.jobs import Meter, RunShapes
 from rrcache.profiler.plan import Plan
-from rrcache.profiler.train import _Meter, _error_run, _timing_run, timing_frame_indices
-from rrcache.profiles.choice import load_work
+from rrcache.profiler.train import timing_frame_indices
+from rrcache.choice import load_work
+from rrcache.runtime.spec import VariantSpec
 
 DEFAULT_PERIODS = (6, 14, 30)
 #: at most this many front nodes are measured (the front's nodes spread over its time range)
@@ -125,7 +127,6 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
              progress: Optional[Callable] = None) -> AccuracyReport:
     """Measure ``nodes`` (default :func:`nodes_that_matter`) of ``profile`` at ``periods`` and
     compare with the models' predictions (see the module docstring)."""
-    from rrcache.pipeline import variant_for
     from rrcache.profiles.inputs import check_inputs
 
     check_inputs(profile)  # what profile.json names is the profiled shader, before anything reads it
@@ -147,45 +148,41 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
                            hint="give trained node ids (profile.json lists them)")
     work, session = load_work(profile)
     plan = Plan.from_json(profile.plan or {})
-    full = tuple(int(v) for v in session.resolution)
-    train_frames = list(range(settings.frames))
+    train_frames = plan.error_frames(settings.frames)  # the profile's error frames (rrcache.profiler.plan)
     timing = timing_frame_indices(session.frames, settings.timing_frames)
-    meter = _Meter(progress, len(train_frames) * (1 + len(nodes) * len(periods)) + 3 * len(timing) * len(nodes) * len(periods))
+    meter = Meter(progress, len(train_frames) * (1 + len(nodes) * len(periods)) + 3 * len(timing) * len(nodes) * len(periods))
     report = AccuracyReport(periods, nodes, chosen_by=chosen_by)
-    with Renderer(work.prepared, session, settings.resolution, window=plan.error_window) as renderer:
-        refs = []
-        for i in train_frames:
-            refs.append(renderer.render_frame(i))
-            meter.step("reference", f"frame {i}")
-    with Renderer(work.prepared, session, full, window=plan.timing_window,
-                  color_format=settings.timing_format) as original:
-        for nid in nodes:
-            node = profile.node(nid)
-            report.training_r2[nid] = node.error_r2
-            variant = variant_for(work, nid, profile.algorithm)
-            common = settings.cache_options()
-            measured = {}
-            with CachedRenderer(variant, session, work.prepared, settings.resolution, period=periods[0],
-                                window=plan.error_window, **common) as cached:
-                for p in periods:
-                    run, _ = _error_run(cached, nid, p, refs, meter)
-                    measured[p] = [run.mean_error]
-            with CachedRenderer(variant, session, work.prepared, full, period=periods[0],
-                                window=plan.timing_window, color_format=settings.timing_format, **common) as cached:
-                for p in periods:
-                    frames = _timing_run(cached, original, nid, p, timing, meter)
-                    counted = sum(f.hits + f.misses for f in frames)
-                    measured[p] += [statistics.median(f.ms for f in frames),
-                                    sum(f.hits for f in frames) / counted if counted else 0.0,
-                                    counted / max(1, len(frames))]
-            i = index[nid]
-            for p in periods:
-                error, ms, rate, covered = measured[p]
-                predicted_ms = float(table.T[i, p - 1])
-                if plan.timing_window is not None:
-                    # timed in a window: the prediction for the window's covered pixels
-                    overhead = float(table.t_overhead[i])
-                    predicted_ms = overhead + (predicted_ms - overhead) * covered / table.pixels
-                report.points.append(AccuracyPoint(nid, p, float(table.E[i, p - 1]), float(error),
-                                                   predicted_ms, float(ms), float(rate)))
+    shapes = RunShapes.of(settings, session, plan, timing)
+    kind = kinds.get("cache")
+    runs = [shapes.run("reference", None, ("reference",), "reference frames")]
+    for nid in nodes:  # each node's held-out periods: error runs, then timing runs (one variant serves all)
+        runs += [shapes.run(measure, spec.with_runtime(periods=(p,)), ("node", nid, p), f"{nid} Δn={p}")
+                 for measure in ("error", "timing") for p in periods
+                 for spec in [VariantSpec(kind.name, (nid,), profile.algorithm, profile.filter,
+                                          **settings.cache_options())]]
+    with Bench(work, session) as bench:
+        results = list(LocalExecutor(bench, on_frame=meter.on_frame()).run(runs))
+    measured = {}
+    for result in results[1:]:
+        _, nid, p = result.spec.key
+        if result.spec.measure == "error":
+            measured[(nid, p)] = [result.steady_error]
+        else:
+            frames = result.frames
+            counted = sum((f.hits or 0) + (f.misses or 0) for f in frames)
+            measured[(nid, p)] += [statistics.median(f.ms for f in frames),
+                                   sum(f.hits or 0 for f in frames) / counted if counted else 0.0,
+                                   counted / max(1, len(frames))]
+    for nid in nodes:
+        report.training_r2[nid] = profile.node(nid).error_r2
+        i = index[nid]
+        for p in periods:
+            error, ms, rate, covered = measured[(nid, p)]
+            predicted_ms = float(table.T[i, p - 1])
+            if plan.timing_window is not None:
+                # timed in a window: the prediction for the window's covered pixels
+                overhead = float(table.t_overhead[i])
+                predicted_ms = overhead + (predicted_ms - overhead) * covered / table.pixels
+            report.points.append(AccuracyPoint(nid, p, float(table.E[i, p - 1]), float(error),
+                                               predicted_ms, float(ms), float(rate)))
     return report

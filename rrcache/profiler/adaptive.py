@@ -9,8 +9,8 @@ times in the settings' timing format over the first stretch of them. A threshold
 like Δn: the measured points (error, time ratio) join the selection's own point, and the
 fastest point within the selection's level (predicted-PSNR level: measured PSNR ≥ ``min_psnr``;
 error level: measured error ≤ ``max_error``) stands. So an adaptive choice replaces a fixed one
-only where it was *measured* faster at the same level; the measurements are not stored in the
-profile store (a resumed profile measures them again).
+only where it was *measured* faster at the same level; the points are kept in the profile store
+(the adaptive kind's table, :mod:`rrcache.kinds.adaptive`), and a resumed profile reuses them.
 
 :func:`sweep` is the measurement alone (the command line's ``rrcache profile --adaptive`` and
 the docs' equal-time comparisons use it); :func:`extend` the hook :func:`rrcache.profiler.run.
@@ -19,11 +19,14 @@ profile` calls after validation.
 from __future__ import annotations
 
 import statistics
+import time
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
 from rrcache.gl.formats import ERROR_FORMAT
+from rrcache.runs import RunSpec
 from rrcache.runtime.adaptive import DEFAULT_FAST_PERIOD
+from rrcache.runtime.spec import VariantSpec
 from rrcache.selection import AdaptiveNode, CachedNode, Selection
 
 #: thresholds measured by default (in the cached value's units: a colour or an occlusion in [0, 1])
@@ -57,31 +60,38 @@ class AdaptivePoint:
         return AdaptiveNode(self.node, int(self.period), float(self.threshold), int(self.fast_period), text=text)
 
 
-def sweep(work, session, node: str, period: int, thresholds: Sequence[float], frames, timed_frames=None,
-          fast_period: int = DEFAULT_FAST_PERIOD, algorithm: str = "three-pass", filter: Optional[str] = None,
-          cache_options: Optional[dict] = None, window=None, resolution=None, timing_format: str = "rgba8",
-          repeats: int = 1, on_frame=None) -> list[AdaptivePoint]:
-    """Measure node ``node`` with adaptive refresh at each of ``thresholds`` (max age ``period``)
-    beside the original: the error over ``frames`` (exact colour), the time over
-    ``timed_frames`` (default: the first :data:`TIMED_FRAMES` of ``frames``) ``repeats`` times."""
-    from rrcache.harness.cached import compare
-    from rrcache.pipeline import variant_for
-
-    frames = list(frames)
-    timed = list(timed_frames) if timed_frames is not None else frames[:max(2, min(TIMED_FRAMES, len(frames)))]
-    variant = variant_for(work, node, algorithm, filter=filter, adaptive=True)
-    common = dict(cache_options or {}, period=int(period), window=window, resolution=resolution,
-                  fast_period=int(fast_period), on_frame=on_frame)
+def sweep(executor, spec: VariantSpec, thresholds: Sequence[float], frames, timed_frames=None, resolution=None,
+          window=None, timing_format: str = "rgba8", repeats: int = 1, clock: str = "wall") -> list[AdaptivePoint]:
+    """Measure ``spec`` (an ``adaptive`` :class:`~rrcache.runtime.spec.VariantSpec`: its node, max
+    age, fast period, algorithm and filter) at each of ``thresholds`` beside the original, as
+    :class:`~rrcache.runs.RunSpec` runs (``compare``) on ``executor``: the error over ``frames``
+    (exact colour), the time over ``timed_frames`` (default: the first :data:`TIMED_FRAMES` of
+    ``frames``) ``repeats`` times, at ``resolution`` (default: the session's) inside ``window``."""
+    frames = tuple(frames)
+    timed = tuple(timed_frames) if timed_frames is not None else frames[:max(2, min(TIMED_FRAMES, len(frames)))]
+    size = tuple(resolution) if resolution is not None else tuple(executor.bench.session.resolution)
+    node, period = spec.nodes[0], spec.periods[0]
+    runs = []
+    for threshold in thresholds:
+        at = spec.with_runtime(threshold=float(threshold))
+        label = f"{node} adaptive ≥{threshold:g}"
+        runs.append(RunSpec("compare", at, frames, size, window, ERROR_FORMAT, clock,
+                            ("adaptive", float(threshold), "error"), f"{label} error"))
+        runs += [RunSpec("compare", at, timed, size, window, timing_format, clock,
+                         ("adaptive", float(threshold), "timing", r), f"{label} timing [{r + 1}/{repeats}]")
+                 for r in range(max(1, int(repeats)))]
+    results: dict = {}
+    for result in executor.run(runs):  # in any order (an executor may finish them so)
+        results.setdefault(result.spec.key[1], {})[result.spec.key[2:]] = result
     points = []
     for threshold in thresholds:
-        exact = compare(variant, session, work.prepared, frames, color_format=ERROR_FORMAT, threshold=float(threshold),
-                        **common)
-        runs = [compare(variant, session, work.prepared, timed, color_format=timing_format,
-                        threshold=float(threshold), **common) for _ in range(max(1, int(repeats)))]
-        ratio = statistics.median(r.ms_per_frame / r.original_ms_per_frame for r in runs)
-        points.append(AdaptivePoint(node, int(period), float(threshold), int(fast_period), float(exact.mean_error),
-                                    float(min(exact.psnr, PSNR_CAP)), float(ratio), float(exact.hit_rate),
-                                    tuple(float(r.speedup) for r in runs)))
+        got = results[float(threshold)]
+        exact = got[("error",)]
+        timing = [got[("timing", r)] for r in range(max(1, int(repeats)))]
+        ratio = statistics.median(r.ms / r.original_ms for r in timing)
+        points.append(AdaptivePoint(node, int(period), float(threshold), int(spec.fast_period), exact.steady_error,
+                                    exact.steady_psnr, float(ratio), float(exact.hit_rate),
+                                    tuple(float(r.original_ms / r.ms) for r in timing)))
     return points
 
 
@@ -110,30 +120,69 @@ def best_at_level(selection: Selection, points: Sequence[AdaptivePoint]) -> Opti
 
 
 def extend(prof, work, session, settings, thresholds: Sequence[float], fast_period: int = DEFAULT_FAST_PERIOD,
-           window=None) -> list[Selection]:
+           window=None, store=None, executor=None) -> list[Selection]:
     """The profile's selections, each replaced by its node's adaptive variant where one was
     measured faster at the same level (see the module docstring); ``prof.adaptive_points`` keeps
-    every point measured (per node and period)."""
+    every point measured (per node and period). With ``store``, the points are kept there (the
+    adaptive kind's ``adaptive_point`` table, through the collector) and a resumed profile takes
+    the stored ones instead of measuring them again. The runs go to ``executor`` (default: in
+    this process)."""
+    from rrcache.harness.execute import Bench, LocalExecutor
+    from rrcache.profiler.collect import Collector
+
     frames = list(range(settings.validation_frames or session.frames))
     measured: dict = {}
+    own = executor is None
     out = []
-    for sel in prof.selections:
-        part = sel.parts[0] if len(sel.parts) == 1 else None
-        if not isinstance(part, CachedNode) or sel.measured_speedup is None:
-            out.append(sel)
-            continue
-        key = (part.node, int(part.period))
-        if key not in measured:
-            measured[key] = sweep(work, session, part.node, int(part.period), thresholds, frames,
-                                  fast_period=fast_period, algorithm=sel.algorithm or "three-pass",
-                                  cache_options=settings.cache_options(), window=window,
-                                  timing_format=settings.timing_format)
-        best = best_at_level(sel, measured[key])
-        if best is None:
-            out.append(sel)
-            continue
-        out.append(sel.replace(parts=(best.part(part.text),), measured_error=best.error, measured_psnr=best.psnr,
-                               measured_speedup=best.speedup, speedups=best.speedups, hit_rate=best.hit_rate,
-                               measured_ms=None, fallback=None))
+    try:
+        for sel in prof.selections:
+            part = sel.parts[0] if len(sel.parts) == 1 else None
+            if not isinstance(part, CachedNode) or sel.measured_speedup is None:
+                out.append(sel)
+                continue
+            key = (part.node, int(part.period))
+            algorithm = sel.algorithm or "three-pass"
+            if key not in measured:
+                stored = _stored(store, part.node, int(part.period), thresholds, fast_period, algorithm)
+                todo = [t for t in thresholds if float(t) not in stored]
+                if todo:
+                    if executor is None:
+                        executor = LocalExecutor(Bench(work, session))
+                    spec = VariantSpec("adaptive", (part.node,), algorithm, work.filter, periods=(int(part.period),),
+                                       fast_period=int(fast_period), **settings.cache_options())
+                    start = time.perf_counter()
+                    new = sweep(executor, spec, todo, frames, window=window, timing_format=settings.timing_format,
+                                clock=settings.clock)
+                    seconds = (time.perf_counter() - start) / max(1, len(new))
+                    for point in new:
+                        stored[point.threshold] = point
+                        if store is not None:
+                            Collector(store).add_adaptive(point, algorithm, seconds)
+                measured[key] = [stored[float(t)] for t in thresholds]
+            best = best_at_level(sel, measured[key])
+            if best is None:
+                out.append(sel)
+                continue
+            # its time: the point's ratio to the original, on the original's time as validation measured it
+            ms = best.time_ratio * sel.measured_original_ms if sel.measured_original_ms else None
+            out.append(sel.replace(parts=(best.part(part.text),), measured_error=best.error, measured_psnr=best.psnr,
+                                   measured_speedup=best.speedup, speedups=best.speedups, hit_rate=best.hit_rate,
+                                   measured_ms=ms, fallback=None))
+    finally:
+        if own and executor is not None:
+            executor.close()
     prof.adaptive_points = [p for pts in measured.values() for p in pts]
     return out
+
+
+def _stored(store, node: str, period: int, thresholds, fast_period: int, algorithm: str) -> dict:
+    """Threshold → the stored :class:`AdaptivePoint` of ``node`` at ``period`` (none without a store)."""
+    if store is None:
+        return {}
+    wanted = {float(t) for t in thresholds}
+    return {float(r["threshold"]): AdaptivePoint(node, period, float(r["threshold"]), int(r["fast_period"]),
+                                                 float(r["error"]), float(r["psnr"]), float(r["time_ratio"]),
+                                                 float(r["hit_rate"]), tuple(r["speedups"]))
+            for r in store.adaptive_points(node)
+            if int(r["period"]) == period and int(r["fast_period"]) == int(fast_period)
+            and r["algorithm"] == algorithm and float(r["threshold"]) in wanted}

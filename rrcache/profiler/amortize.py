@@ -37,19 +37,18 @@ import statistics
 import time
 from typing import Optional
 
-import numpy as np
 
-from rrcache.errors import GLSLError, RRCacheError
-from rrcache.harness.cached import CachedRenderer
-from rrcache.harness.metrics import mean_l2, psnr
-from rrcache.harness.renderer import Renderer
+from rrcache import kinds
 from rrcache.compiler.amortize import HISTORIES
+from rrcache.compiler.slots import PAYLOAD_COMPONENTS
+from rrcache.errors import GLSLError, RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.model.amortize import TRAIN_BLENDS, fit_amortized_time, fit_error, training_samples
-from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn, timed_beside, timing_frame_indices
-from rrcache.profiles import amortize as data
+from rrcache.profiler.collect import Collector
+from rrcache.profiler.events import ProgressFn
+from rrcache.profiler.jobs import Meter, RunShapes
+from rrcache.profiler.train import timing_frame_indices
 from rrcache.profiles.amortize import EstimatorProfile, HistoryRuns
-from rrcache.selection import PAYLOAD_COMPONENTS
-from rrcache.runtime import DEFAULT_PERIOD
 
 
 def _record(est) -> EstimatorProfile:
@@ -101,11 +100,12 @@ def estimator_table(work):
 
 
 def train_estimators(work, session, settings, store, result, progress: Optional[ProgressFn] = None,
-                     clock=time.perf_counter) -> list[EstimatorProfile]:
+                     clock=time.perf_counter, executor=None) -> list[EstimatorProfile]:
     """Train every estimator of ``work`` the budget allows, each history at its m (module
     docstring), and return their records, trained or with a ``note`` saying why not. ``result``
     is the nodes' :class:`~rrcache.profiler.train.TrainingResult` (its plan, algorithm and
-    original time)."""
+    original time). The runs go to ``executor`` (default: in this process), their results to the
+    store through the :class:`~rrcache.profiler.collect.Collector`."""
     table = estimator_table(work)
     if table is None:
         return []
@@ -119,57 +119,48 @@ def train_estimators(work, session, settings, store, result, progress: Optional[
             r.note = "not trained: the profile stopped before training (see its verdict)"
         return records
     algorithm = plan.algorithm
-    frames = list(range(settings.frames))
     timing = timing_frame_indices(session.frames, settings.timing_frames)
-    full = tuple(int(v) for v in session.resolution)
-    state = {"done": 0, "total": 0}
-
-    def step(detail: str, n: int = 1) -> None:
-        state["done"] += n
-        state["total"] = max(state["total"], state["done"])
-        if progress is not None:
-            progress(ProgressEvent("amortize", state["done"], state["total"], detail))
-
-    refs = None
-    for k, (est, rec) in enumerate(zip(found, records)):
-        if est.samples < 2:
-            rec.note = "not trained: a loop of one term has nothing to amortize"
-            continue
-        if est.components > 4:
-            rec.note = f"not trained: its accumulators need {est.components} payload components (at most 4)"
-            continue
-        spent = store.spent_s() + data.spent_s(store)
-        started = any(data.rows(store, est.id, kind, store_history(history, payload))
-                      for kind in ("error", "timing") for history in HISTORIES
-                      for payload in {"f4", _payload(est, history)})
-        if k > 0 and not started and spent >= settings.budget_s:
-            rec.note = "not reached within the training budget (--budget)"
-            continue
-        rec.slots = _slots_record(est)
-        plans = [(history, training_samples(int(est.samples), history, int(est.components))) for history in HISTORIES]
-        plans = [(history, ms_list) for history, ms_list in plans if ms_list]
-        state["total"] += sum(len(ms_list) * (len(TRAIN_BLENDS) * len(frames) + 3 * len(timing))
-                              for _, ms_list in plans)
-        for history, ms_list in plans:
-            target = rec.runs(history)
-            payload = _payload(est, history)
-            try:
-                if refs is None and _missing_errors(store, est.id, ms_list, store_history(history, payload)):
-                    state["total"] += len(frames)  # the reference frames, rendered once for all
-                    refs = _references(work, session, settings, plan, frames, step)
-                try:
-                    _runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, timing, full, step,
-                          clock, history, payload)
-                except _PayloadFallback as err:  # the 8-bit range did not hold on the GPU: train in floats
-                    payload = target.payload = "f4"
-                    if progress is not None:
-                        progress(ProgressEvent("amortize", state["done"], state["total"], f"{err}; slots in 32 bits"))
-                    _runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, timing, full, step,
-                          clock, history, payload)
-            except RRCacheError as err:  # a variant that does not compile or run: say why, go on
-                target.note = f"not trained: {err}"
+    shapes = RunShapes.of(settings, session, plan, timing)
+    meter = Meter(progress)
+    own = executor is None
+    executor = executor or LocalExecutor(Bench(work, session))
+    stage = _Stage(executor, Collector(store), store, shapes, settings, algorithm, meter)
+    try:
+        for k, (est, rec) in enumerate(zip(found, records)):
+            if est.samples < 2:
+                rec.note = "not trained: a loop of one term has nothing to amortize"
                 continue
-            _fit(target, store, result.original_ms, est.id, int(est.samples), history, store_history(history, payload))
+            if est.components > 4:
+                rec.note = f"not trained: its accumulators need {est.components} payload components (at most 4)"
+                continue
+            spent = store.spent_s() + store.amortize_spent_s()
+            started = any(store.amortize_rows(est.id, kind, store_history(history, payload))
+                          for kind in ("error", "timing") for history in HISTORIES
+                          for payload in {"f4", _payload(est, history)})
+            if k > 0 and not started and spent >= settings.budget_s:
+                rec.note = "not reached within the training budget (--budget)"
+                continue
+            rec.slots = _slots_record(est)
+            plans = [(history, training_samples(int(est.samples), history, int(est.components)))
+                     for history in HISTORIES]
+            for history, ms_list in [(h, m) for h, m in plans if m]:
+                target = rec.runs(history)
+                payload = _payload(est, history)
+                try:
+                    try:
+                        stage.train(est, ms_list, history, payload)
+                    except _PayloadFallback as err:  # the 8-bit range did not hold on the GPU: train in floats
+                        payload = target.payload = "f4"
+                        meter.step("amortize", f"{err}; slots in 32 bits", 0)
+                        stage.train(est, ms_list, history, payload)
+                except RRCacheError as err:  # a variant that does not compile or run: say why, go on
+                    target.note = f"not trained: {err}"
+                    continue
+                _fit(target, store, result.original_ms, est.id, int(est.samples), history,
+                     store_history(history, payload))
+    finally:
+        if own:
+            executor.close()
     return records
 
 
@@ -178,111 +169,51 @@ class _PayloadFallback(RRCacheError):
     terms' range): no row was stored, the history trains again in floats."""
 
 
-def _runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, timing, full, step, clock,
-          history: str, payload: str) -> None:
-    """One history's error and timing runs in ``payload`` (those not stored yet)."""
-    _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock, history, payload)
-    _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock, history,
-                 payload)
+class _Stage:
+    """One history's runs of an estimator: planned as RunSpecs (the amortize kind's:
+    :meth:`rrcache.kinds.amortize.AmortizeKind.training`), those not stored yet executed, each
+    result collected; the reference frames of the error runs first."""
 
+    def __init__(self, executor, collector, store, shapes, settings, algorithm, meter):
+        self.executor, self.collector, self.store, self.shapes = executor, collector, store, shapes
+        self.settings, self.algorithm, self.meter = settings, algorithm, meter
+        self.refs = False
 
-def _settled(cached, payload: str) -> None:
-    """Raise :class:`_PayloadFallback` when ``cached`` (after its first frame) did not keep ``payload``."""
-    if cached.payload_dtype != payload:
-        raise _PayloadFallback(cached.payload_note or f"the cache kept {cached.payload_dtype}, not {payload}")
+    def train(self, est, ms_list, history: str, payload: str) -> None:
+        key = store_history(history, payload)
+        have = {(r["samples"], round(r["blend"], 6)) for r in self.store.amortize_rows(est.id, "error", key)}
+        errors = [(m, [lam for lam in TRAIN_BLENDS if (m, round(lam, 6)) not in have]) for m in ms_list]
+        errors = [(m, lams) for m, lams in errors if lams]
+        timed_have = {r["samples"] for r in self.store.amortize_rows(est.id, "timing", key)}
+        timed = [m for m in ms_list if m not in timed_have] if self.shapes.timing_frames else []
+        kind = kinds.get("amortize")
+        runs = []
+        for measure, spec, run_key in kind.training((est.id, history, payload, errors, timed), self.settings,
+                                                     self.algorithm):
+            label = _label(est, spec.samples, history, payload) + (f" λ={spec.blend:g}" if measure == "error"
+                                                                  else " timing")
+            runs.append(self.shapes.run(measure, spec, run_key, label, strict_payload=True))
+        if not runs:
+            return
+        if errors and not self.refs:  # the reference frames, rendered once for every estimator
+            runs.insert(0, self.shapes.run("reference", None, ("reference",), "reference frames"))
+            self.refs = True
+        self.meter.grow(sum(r.cost for r in runs))
+        for result in self.executor.run(runs, on_frame=self.meter.on_frame("amortize")):
+            if result.spec.measure == "reference":
+                continue
+            if not result.complete:  # the 8-bit range did not hold: nothing of it stored
+                raise _PayloadFallback(next((n for n in result.notes if "outside the range" in n or "beyond" in n),
+                                            f"the cache kept {result.payload}, not {payload}"))
+            self.collector.add(result)
 
 
 def _payload(est, history: str) -> str:
     return slots_payload(est) if history == "slots" else "f4"
 
 
-def _missing_errors(store, eid: str, ms_list, history: str = "blend") -> bool:
-    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, eid, "error", history)}
-    return any((m, round(lam, 6)) not in have for m in ms_list for lam in TRAIN_BLENDS)
-
-
-def _references(work, session, settings, plan, frames, step) -> list:
-    refs = []
-    with Renderer(work.prepared, session, settings.resolution, window=plan.error_window) as renderer:
-        for index in frames:
-            refs.append(renderer.render_frame(index))
-            step(f"reference frame {index}")
-    return refs
-
-
-def _variant(work, est, algorithm: str, m: int, history: str = "blend", payload: str = "f4"):
-    from rrcache.compiler.amortize import instance_amortized
-
-    return instance_amortized(work.shader, est.id, algorithm, samples=m, blend=0.0, history=history,
-                              payload_dtype=payload, vertex=work.vertex)
-
-
 def _label(est, m: int, history: str, payload: str = "f4") -> str:
     return f"{est.id} m={m}" + (" slots" if history == "slots" else "") + ("" if payload == "f4" else f" {payload}")
-
-
-def _error_runs(work, session, settings, store, plan, algorithm, est, ms_list, refs, step, clock,
-                history: str = "blend", payload: str = "f4") -> None:
-    key = store_history(history, payload)
-    have = {(r["samples"], round(r["blend"], 6)) for r in data.rows(store, est.id, "error", key)}
-    for m in ms_list:
-        todo = [lam for lam in TRAIN_BLENDS if (m, round(lam, 6)) not in have]
-        if not todo:
-            continue
-        built = clock()
-        with CachedRenderer(_variant(work, est, algorithm, m, history, payload), session, work.prepared, settings.resolution,
-                            period=DEFAULT_PERIOD, window=plan.error_window, **settings.cache_options()) as cached:
-            extra = clock() - built
-            for lam in todo:
-                start = clock()
-                cached.runtime.blend = float(lam)
-                cached.reset()
-                errs, psnrs, hits, misses = [], [], 0, 0
-                for i, ref in enumerate(refs):
-                    got = cached.render_frame(ref.index)
-                    _settled(cached, payload)
-                    step(f"{_label(est, m, history, payload)} λ={lam:g}")
-                    if i == 0:
-                        continue  # the first frame has no cache
-                    errs.append(float(mean_l2(got.image, ref.image, ref.mask)[0]))
-                    psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
-                    hits += int(got.hits or 0)
-                    misses += int(got.misses or 0)
-                errs = errs or [0.0]
-                psnrs = psnrs or [PSNR_CAP]
-                rate = hits / (hits + misses) if hits + misses else 0.0
-                wall = clock() - start + extra
-                extra = 0.0
-                data.add_rows(store, [(est.id, key, "error", int(m), float(lam), -1, float(np.mean(errs)),
-                                       float(np.mean(psnrs)), rate, hits, misses, 0.0, 0.0, wall)])
-
-
-def _timing_runs(work, session, settings, store, plan, algorithm, est, ms_list, timing, full, step, clock,
-                 history: str = "blend", payload: str = "f4") -> None:
-    key = store_history(history, payload)
-    have = {r["samples"] for r in data.rows(store, est.id, "timing", key)}
-    todo = [m for m in ms_list if m not in have]
-    if not todo or not timing:
-        return
-    fmt = settings.timing_format
-    with Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt) as original:
-        for m in todo:
-            start = clock()
-            with CachedRenderer(_variant(work, est, algorithm, m, history, payload), session, work.prepared, full,
-                                period=DEFAULT_PERIOD, window=plan.timing_window, color_format=fmt,
-                                **settings.cache_options()) as cached:
-                # (the renderer's first frame draws every phase program once, untimed: a phase's
-                # first draw compiles it, 100-300 ms on a 1 ms shader)
-                out = []
-                for index in timing:
-                    got, ref = timed_beside(cached, original, index)
-                    _settled(cached, payload)
-                    out.append((index, got, ref.ms))
-                    step(f"{_label(est, m, history, payload)} timing", 3)
-            wall = (clock() - start) / max(1, len(out))
-            data.add_rows(store, [(est.id, key, "timing", int(m), 0.0, int(index), 0.0, 0.0, 0.0,
-                                   int(got.hits or 0), int(got.misses or 0), float(got.ms), float(ref_ms), wall)
-                                  for index, got, ref_ms in out])
 
 
 def _fit(rec, store, original_ms: float, estimator: str, total: int, history: str = "blend",
@@ -290,8 +221,8 @@ def _fit(rec, store, original_ms: float, estimator: str, total: int, history: st
     """The models of one history of an estimator from its stored runs (module docstring, step
     3; ``key``: the store's history key, :func:`store_history`), into ``rec`` (the
     :class:`EstimatorProfile` for ``blend``, its :class:`HistoryRuns` for ``slots``)."""
-    errors = data.rows(store, estimator, "error", key or history)
-    timed = data.rows(store, estimator, "timing", key or history)
+    errors = store.amortize_rows(estimator, "error", key or history)
+    timed = store.amortize_rows(estimator, "timing", key or history)
     if not errors or not timed:
         rec.note = "not trained: runs missing"
         return

@@ -34,7 +34,8 @@ def measure_ceiling(work, session, settings, node, algorithms, timing_frames, pi
     frames = probe_frames(timing_frames, PROBE_FRAMES)
     period = settings.timing_periods[len(settings.timing_periods) // 2]
     common = dict(period=period, block=settings.block, refresh=settings.refresh,
-                  depth_epsilon=settings.depth_epsilon, color_format=settings.timing_format, repeats=REPEATS)
+                  depth_epsilon=settings.depth_epsilon, color_format=settings.timing_format, repeats=REPEATS,
+                  clock=settings.clock)
     full = tuple(int(v) for v in session.resolution)
     results, noise = {}, []
     for algorithm in algorithms:

@@ -24,8 +24,9 @@ from __future__ import annotations
 import math
 import statistics
 
-from rrcache.harness.cached import CachedRenderer
-from rrcache.harness.renderer import Renderer
+from rrcache.gl.formats import ERROR_FORMAT
+from rrcache.runs import RunSpec
+from rrcache.runtime.spec import VariantSpec
 
 #: the filters ``auto`` chooses between, the default first
 CANDIDATES = ("bilinear", "plane")
@@ -39,36 +40,35 @@ def decision_periods(settings) -> tuple:
     return tuple(sorted({p[0], p[len(p) // 2], p[-1]}))
 
 
-def choose_filter(work, session, settings, node_id: str, algorithm: str, original, timing: list, plan,
-                  meter, timing_run, error_run) -> tuple[str, dict]:
+def choose_filter(settings, node_id: str, algorithm: str, shapes, executor, meter=None) -> tuple[str, dict]:
     """Measure the :data:`CANDIDATES` on ``node_id`` and return ``(filter, {filter: [{"period",
     "time" (the median time as a fraction of the original's), "error", "psnr"}, ...]})`` (module
-    docstring). ``original`` is the timed original renderer; ``timing_run``/``error_run`` the
-    profiler's runs."""
+    docstring), as :class:`~rrcache.runs.RunSpec` runs on ``executor`` (``shapes``: the profile's
+    :class:`~rrcache.profiler.jobs.RunShapes`; ``meter`` counts the progress)."""
     periods = decision_periods(settings)
-    frames = list(range(min(ERROR_FRAMES, settings.frames)))
-    full = tuple(int(v) for v in session.resolution)
-    with Renderer(work.prepared, session, settings.resolution, window=plan.error_window) as renderer:
-        refs = []
-        for i in frames:
-            refs.append(renderer.render_frame(i))
-            meter.step("filter", f"reference frame {i}")
-    measured: dict = {}
+    frames = tuple(range(min(ERROR_FRAMES, settings.frames)))
+    runs = []
     for filter_ in CANDIDATES:
-        variant = _variant(work, node_id, algorithm, filter_)
-        points = []
-        with CachedRenderer(variant, session, work.prepared, settings.resolution, period=periods[0],
-                            window=plan.error_window, **settings.cache_options()) as cached:
-            runs = {p: error_run(cached, f"{node_id} {filter_}", p, refs, meter)[0] for p in periods}
-        with CachedRenderer(variant, session, work.prepared, full, period=periods[0], window=plan.timing_window,
-                            color_format=settings.timing_format, **settings.cache_options()) as cached:
-            for p in periods:
-                timed = timing_run(cached, original, f"{node_id} {filter_}", p, timing, meter)
-                points.append({"period": int(p), "error": float(runs[p].mean_error), "psnr": float(runs[p].psnr),
-                               "time": float(statistics.median(t.ms / t.original_ms for t in timed
-                                                               if t.original_ms > 0))})
-        measured[filter_] = points
-    return pick(measured), measured
+        spec = VariantSpec("cache", (node_id,), algorithm, filter_, **settings.cache_options())
+        for p in periods:
+            key = ("filter", filter_, int(p))
+            runs.append(shapes.run("timing", spec.with_runtime(periods=(p,)), key, f"{node_id} {filter_} Δn={p}"))
+            # the error as the error runs measure it, beside the original frame by frame
+            runs.append(RunSpec("compare", spec.with_runtime(periods=(p,)), frames, shapes.resolution,
+                                shapes.error_window, ERROR_FORMAT, shapes.clock, key, f"{node_id} {filter_} Δn={p}"))
+    if meter is not None:
+        meter.grow(sum(r.cost for r in runs))
+    measured: dict = {f: {int(p): {"period": int(p)} for p in periods} for f in CANDIDATES}
+    on_frame = meter.on_frame("filter") if meter is not None else None
+    for result in executor.run(runs, on_frame=on_frame):  # in any order
+        _, filter_, p = result.spec.key
+        entry = measured[filter_][p]
+        if result.spec.measure == "timing":
+            entry["time"] = float(statistics.median(r.ms / r.original_ms for r in result.frames if r.original_ms > 0))
+        else:
+            entry["error"], entry["psnr"] = float(result.steady_error), float(result.steady_psnr)
+    points = {f: [measured[f][int(p)] for p in periods] for f in CANDIDATES}
+    return pick(points), points
 
 
 def pick(measured: dict) -> str:
@@ -107,16 +107,3 @@ def _error_at(points: list, time: float) -> float:
             w = (time - lo["time"]) / span if span > 0 else 0.0
             return math.exp(a + w * (b - a))
     return last["error"]
-
-
-def steps(settings, timing: list) -> int:
-    """The progress steps :func:`choose_filter` takes."""
-    frames = min(ERROR_FRAMES, settings.frames)
-    n = len(decision_periods(settings))
-    return frames + len(CANDIDATES) * n * (frames + 3 * len(timing))
-
-
-def _variant(work, node_id, algorithm, filter_):
-    from rrcache.pipeline import variant_for
-
-    return variant_for(work, node_id, algorithm, filter=filter_)

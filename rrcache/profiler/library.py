@@ -55,12 +55,14 @@ def _sha256(path: str) -> Optional[str]:
         return None
 
 
-def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings) -> tuple[Optional[str], bool]:
+def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings,
+                 workers: int = 1) -> tuple[Optional[str], bool]:
     """Why the finished profile ``prof`` is not the profile of ``entry`` with ``settings`` now,
     and whether it must start over: (None, False) when it is current; (reason, True) when a
     shader file, the session, a keyed setting, the defines or the vertex shader differ (its store
     holds another shader's runs); (reason, False) when only settings that change no measurement
-    (the budget, validation, the levels) differ, so that it resumes from its store."""
+    (the budget, validation, the levels) differ, so that it resumes from its store. ``workers``:
+    the error-run workers it would be profiled with now (:mod:`rrcache.profiler.capacity`)."""
     from rrcache.session import load_session
 
     if not prof.shader_files:
@@ -85,7 +87,9 @@ def stale_reason(prof, entry: LibraryEntry, settings: TrainingSettings) -> tuple
         user = load_user_vertex(vertex, session, prof.defines, all_include_dirs(entry.include_dirs, session))
         if user.hash != prof.vertex_hash:
             return "the vertex shader changed", True
-    resolved = settings.resolved(session)
+    from rrcache.profiler.capacity import scaled
+
+    resolved = scaled(settings, session, workers)[0].resolved(session)
     if resolved.key_json() != prof.settings.key_json():
         return "settings that change the measurements differ", True
     if resolved.to_json() != prof.settings.to_json():
@@ -119,13 +123,13 @@ def _write(folder: Path, rows: list[dict], entries: list[LibraryEntry]) -> None:
 def profile_library(entries: list[LibraryEntry], out_dir, settings: Optional[TrainingSettings] = None,
                     manifest_settings: Optional[dict] = None, progress=None,
                     announce: Optional[Callable[[str], None]] = None, fresh: bool = False,
-                    plots: bool = True, executor=None) -> list[dict]:
+                    plots: bool = True, cluster=None) -> list[dict]:
     """Profile every entry into ``out_dir`` (see the module docstring) and return the summary's
     rows, in the entries' order. ``settings`` are the library's (the command line's),
     ``manifest_settings`` the manifest's keys over them; each entry's own ``settings`` come
     last. ``progress`` receives each profile's progress events, ``announce`` a line as each
     entry starts and ends. ``fresh`` starts every profile over (each store moved aside).
-    ``executor`` runs the profiles' runs (None: in this process). A ``KeyboardInterrupt``
+    ``cluster`` (:mod:`rrcache.cluster`) makes the profiles' runs (None: in this process). A ``KeyboardInterrupt``
     records the entry in flight as interrupted, writes the summary and propagates."""
     from rrcache.profiler.run import profile
     from rrcache.profiles.document import JSON_NAME, load_profile
@@ -149,7 +153,7 @@ def profile_library(entries: list[LibraryEntry], out_dir, settings: Optional[Tra
                 if not fresh and (folder / JSON_NAME).exists():
                     try:
                         done = load_profile(folder)
-                        why, restart = stale_reason(done, entry, chosen)
+                        why, restart = stale_reason(done, entry, chosen, cluster.capacity if cluster else 1)
                         prof = done if why is None else None
                     except RRCacheError as err:
                         why = f"its profile.json is not readable ({err})"
@@ -159,9 +163,9 @@ def profile_library(entries: list[LibraryEntry], out_dir, settings: Optional[Tra
                 else:
                     say(f"{tag}: profiling {entry.shader} over {entry.session} ({why}"
                         f"{'; starting over' if restart and not fresh else ''})")
-                    extra = {"executor": executor} if executor is not None else {}
                     prof = profile(entry.shader, entry.session, folder, chosen, entry.defines, progress, fresh=restart,
-                                   plots=plots, include_dirs=entry.include_dirs, vertex=entry.vertex, **extra)
+                                   plots=plots, include_dirs=entry.include_dirs, vertex=entry.vertex,
+                                   executor=cluster)
                     wall = prof.precompute_s if prof.precompute_s is not None else time.perf_counter() - started
                 report = folder / "report.html"
                 row = profile_row(prof, entry.name, entry.name, f"{entry.name}/report.html" if report.exists() else None,

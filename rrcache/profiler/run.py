@@ -24,8 +24,10 @@ import warnings
 from pathlib import Path
 from typing import Mapping, Optional
 
+from rrcache import kinds
 from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.glsl.frontend import file_records
 from rrcache.profiler.lock import LOCK_NAME, StoreLock
 from rrcache.harness.timing import UNRELIABLE_NOISE
@@ -35,6 +37,7 @@ from rrcache.profiles.document import JSON_NAME, NodeProfile, Profile, _fit_json
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import STORE_NAME, ProfileStore, StoreKey
 from rrcache.selection import Selection
+from rrcache.choice import write as choice_write
 
 
 def default_out_dir(shader_path, session_path) -> Path:
@@ -49,7 +52,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None) -> Profile:
+            vertex=None, adaptive=None, executor=None, max_flip: Optional[float] = None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -59,7 +62,15 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     objects. A ``KeyboardInterrupt`` leaves the store consistent (every finished run stays) and
     propagates. ``adaptive`` (thresholds): after validation, each selection's node is measured
     with adaptive refresh at these thresholds and replaced where that was measured faster at the
-    same level (:mod:`rrcache.profiler.adaptive`).
+    same level (:mod:`rrcache.profiler.adaptive`). ``executor``: a callable ``(work, session) ->
+    executor`` making what runs the training's :class:`~rrcache.runs.RunSpec` s (its
+    ``run(specs, on_frame=None)`` yields a :class:`~rrcache.runs.RunResult` per spec, in any order;
+    ``close()``); default: in this process (:class:`~rrcache.harness.execute.LocalExecutor`). A
+    factory with a ``capacity`` (runs made at once: a Dask cluster's workers,
+    :class:`rrcache.cluster.client.Cluster`) buys a larger default plan
+    (:mod:`rrcache.profiler.capacity`); an executor with a ``record(capacity)`` has it kept in
+    ``Profile.cluster``. ``max_flip``: a fifth level, ``flip``, of mean FLIP at most this
+    (:func:`rrcache.profiler.validate.flip_level`; docs/levels.md).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -70,8 +81,9 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
-                prof = _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots,
-                                include_dirs, wait, vertex, adaptive, caught)
+                prof = _profile(shader_path, session_path, out_dir, settings, caught, defines=defines,
+                                progress=progress, fresh=fresh, plots=plots, include_dirs=include_dirs, wait=wait,
+                                vertex=vertex, adaptive=adaptive, executor=executor, max_flip=max_flip)
             finally:
                 raised = list(caught)
     finally:
@@ -80,15 +92,23 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     return prof
 
 
-def _profile(shader_path, session_path, out_dir, settings, defines, progress, fresh, plots, include_dirs, wait,
-             vertex, adaptive, caught: list) -> Profile:
+def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defines, progress, fresh, plots,
+             include_dirs, wait, vertex, adaptive, executor, max_flip: Optional[float] = None) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
 
     session = load_session(session_path)
     work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex)
-    resolved = (settings or TrainingSettings()).resolved(session)
+    settings = settings or TrainingSettings()
+    capacity = None
+    if executor is not None and getattr(executor, "capacity", None):
+        # an executor that makes several runs at once buys a larger default plan: more training
+        # frames and more nodes (rrcache.profiler.capacity)
+        from rrcache.profiler.capacity import scaled
+
+        settings, capacity = scaled(settings, session, int(executor.capacity))
+    resolved = settings.resolved(session)
     from rrcache.profiler.amortize import estimator_table
 
     estimator_table(work)  # a malformed '#pragma rrcache estimator': said before anything is trained
@@ -101,32 +121,49 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
     try:
         store = ProfileStore.open(out / STORE_NAME, key, fresh=fresh)
         started = time.time()
+        compiled = sum(kinds.compile_counts().values())
+        make_executor, runner = executor, None
         try:
             store.begin_run()
-            if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
-                from rrcache.profiler.terms import scores_for
+            verdict = None
+            if not work.table.nodes:  # nothing a cache can hold: the answer is the original, why, its frame time
+                result, verdict = _original_only(work, session, resolved), no_node_verdict(work)
+                runner = None
+            else:
+                if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
+                    from rrcache.profiler.terms import scores_for
 
-                scores = scores_for(work, session, store, progress)
-                if scores:
-                    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
-                                            term_scores=scores)
-            result = train(work, session, resolved, store, progress)
-            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+                    scores = scores_for(work, session, store, progress)
+                    if scores:
+                        work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
+                                                term_scores=scores)
+                # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+                # the original's reference frames rendered once
+                runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
+                result = train(work, session, resolved, store, progress, executor=runner)
+            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out, verdict)
             prof.term_scores = dict(work.term_scores)
-            prof.sets = _sets(prof, work, session, resolved, store, progress)
-            # amortized sampling: the estimators' models, on the same front as the nodes
-            from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress)
-            prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+            if runner is not None:
+                prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
+                # amortized sampling: the estimators' models, on the same front as the nodes
+                from rrcache.profiler.amortize import train_estimators
+                prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
+                runner.close()  # validation renders side by side with its own renderers
+            prof.selections = _selections(prof, work, session, resolved, result, store, progress, max_flip)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
                 prof.selections = extend(prof, work, session, resolved, tuple(adaptive),
-                                         window=result.plan.timing_window if result.plan is not None else None)
+                                         window=result.plan.timing_window if result.plan is not None else None,
+                                         store=store, executor=runner)
             prof.warnings = list(dict.fromkeys(str(w.message) for w in caught))
             _write_outputs(prof, out, work, plots)
+            # how many variants this invocation compiled (each at most once: the compile cache)
+            prof.counts = dict(prof.counts, compiles=sum(kinds.compile_counts().values()) - compiled)
             store.end_run("done")
             _add_times(prof, store, time.time() - started)
+            if hasattr(runner, "record"):  # where the runs were made (a Dask cluster's workers)
+                prof.cluster = runner.record(capacity)
             prof.write(out)
         except KeyboardInterrupt:
             _end_quietly(store, "interrupted")
@@ -134,6 +171,9 @@ def _profile(shader_path, session_path, out_dir, settings, defines, progress, fr
         except BaseException:
             _end_quietly(store, "failed")
             raise
+        finally:
+            if runner is not None:
+                runner.close()
         store.close()
     finally:
         lock.release()
@@ -162,9 +202,10 @@ def _add_times(prof: Profile, store, run_wall_s: float) -> None:
 
 
 def _assemble(work, session, shader_path, session_path, settings, result: TrainingResult, store,
-              out: Path) -> Profile:
+              out: Path, verdict: Optional[dict] = None) -> Profile:
     """The profile of a training result, before its selections (read back from its own
-    document, so that what the run goes on with is what a reader gets)."""
+    document, so that what the run goes on with is what a reader gets); ``verdict``: the answer
+    when nothing was trained for a reason other than the ceiling's."""
     by_id = {n.id: n for n in work.table.nodes}
     nodes = []
     for nid in result.order:
@@ -204,7 +245,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         hit_fit=_fit_json(hit), overhead_ms=result.overhead_ms, original_ms=result.original_ms,
         pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts),
         ceiling=result.ceiling.to_json() if result.ceiling is not None else None,
-        verdict=_verdict(result.ceiling) if result.stopped else None,
+        verdict=verdict if verdict is not None else (_verdict(result.ceiling) if result.stopped else None),
         timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE,
         psnr_offset_db=_psnr_offset(store, settings, result))
     prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
@@ -212,12 +253,12 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
     return prof
 
 
-def _sets(prof: Profile, work, session, settings, store, progress) -> list:
+def _sets(prof: Profile, work, session, settings, store, progress, executor=None) -> list:
     """The sets of several cached nodes predicted to improve the front, the few picked trained
     (:mod:`rrcache.profiler.sets`)."""
     from rrcache.profiler.sets import train_sets
 
-    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets)
+    return train_sets(prof, work, session, settings, store, progress, max_sets=settings.max_sets, executor=executor)
 
 
 def _psnr_offset(store, settings, result: TrainingResult) -> float:
@@ -246,7 +287,8 @@ def _psnr_offset(store, settings, result: TrainingResult) -> float:
     return coverage_offset_db(train_covered, train_area, check_covered, check_area)
 
 
-def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
+def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress,
+                max_flip: Optional[float] = None) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
     (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
     if not result.trained:
@@ -260,12 +302,19 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
                           window=result.plan.timing_window if result.plan is not None else None,
                           candidates=prof.front_candidates)
     measured = validator.run(choices)
+    if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first
+        from rrcache.profiler.validate import flip_level
+
+        flip = flip_level(prof, validator, float(max_flip))
+        store.add_validation(flip)
+        measured.append(flip)
     if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
                                result.plan.timing_window if result.plan is not None else None)
     prof.calibration = calibration_record(validator)
+    prof.measured = [s.replace(files=None) for s in validator.measured.values()]
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured
@@ -294,8 +343,63 @@ def _verdict(ceiling) -> dict:
             "reason": ceiling.reason(), "changes": ceiling.changes()}
 
 
+def _original_only(work, session, settings) -> TrainingResult:
+    """The training result of a shader with nothing to train: the original's frame time (the
+    median over the timing frames at full resolution) and covered pixels, nothing else."""
+    import statistics
+
+    from rrcache.harness.renderer import Renderer
+    from rrcache.profiler.train import timing_frame_indices
+
+    full = tuple(int(v) for v in session.resolution)
+    with Renderer(work.prepared, session, full, color_format=settings.timing_format) as renderer:
+        frames = [renderer.render_frame(i) for i in timing_frame_indices(session.frames, settings.timing_frames)]
+    result = TrainingResult(order=[], trained=[], untrained=[], stopped=True)
+    if frames:
+        result.original_ms = float(statistics.median(f.ms for f in frames))
+        result.pixels = float(statistics.mean(f.covered_pixels for f in frames))
+    return result
+
+
+def no_node_verdict(work) -> dict:
+    """The answer for a shader with no value a cache can hold (``work.table.nodes`` empty): keep
+    the original, why (the analysis's reasons, counted) and what would change it. A shader whose
+    every per-pixel value depends on the screen position (a Book of Shaders sketch of
+    ``gl_FragCoord``) is said to be one.
+
+    >>> from types import SimpleNamespace as NS
+    >>> table = NS(nodes=[], excluded=[NS(reason="screen")] * 3 + [NS(reason="uniform")], shader=None)
+    >>> no_node_verdict(NS(table=table))["answer"]
+    'keep the original shader: every value it computes per pixel depends on the screen position (gl_FragCoord), which a surface cache cannot hold'
+    """
+    from collections import Counter
+
+    counts = Counter(x.reason for x in work.table.excluded)
+    per_pixel = {r: n for r, n in counts.items() if r not in ("uniform", "type", "duplicate")}
+    listed = ", ".join(f"{n} {r}" for r, n in counts.most_common())
+    if per_pixel and set(per_pixel) <= {"screen", "derivative"} and counts.get("screen"):
+        answer = ("keep the original shader: every value it computes per pixel depends on the screen position "
+                  "(gl_FragCoord), which a surface cache cannot hold")
+        reason = (f"a reverse reprojection cache keeps values of surface points and fetches them where the surface "
+                  f"was last frame; every value this shader computes per pixel is a function of the pixel's "
+                  f"position on the screen, so none of them belongs to a surface (the analysis left out {listed})")
+    elif counts:
+        answer = "keep the original shader: none of the values it computes can be cached"
+        reason = f"the analysis left every value out ({listed}; 'rrcache nodes SHADER --all' says why for each)"
+    else:
+        answer = "keep the original shader: it computes no value a cache could hold"
+        reason = "its colour comes from inputs and constants alone"
+    return {"choice": "original", "ceiling": None, "min_gain": None, "answer": answer, "reason": reason,
+            "changes": ["compute the costly values from surface inputs (v_position, v_objectPosition, v_texcoord, "
+                        "v_normal) rather than gl_FragCoord: a reprojection cache follows surfaces as they move",
+                        "a screen-space effect is better served by rendering it at a lower resolution or caching it "
+                        "in a screen-space texture of your own",
+                        "'rrcache nodes SHADER --all' lists every value left out and the reason"]}
+
+
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
-    """The shader files of each selection, then (with ``plots``) the plots and the report."""
+    """The shader files of each selection, then (with ``plots``) the plots, the report's frames
+    (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
     kept = []
     # every file by rrcache.atomic's rule: a link placed in the folder (optimized -> elsewhere) is
     # refused, never followed, and the old files of a selection are removed only inside it
@@ -303,17 +407,20 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         for sel in prof.selections:
             with optimized.folder(sel.label) as folder:
                 folder.remove_files()
-                prof.write_variant(sel, folder, work=work)
+                choice_write(prof, sel, folder, work=work)
             kept.append(sel.replace(files=f"optimized/{sel.label}"))
-        if prof.verdict is not None:  # stopped before training: nothing to plot or report
+        answered = prof.verdict is not None  # stopped before training: nothing to plot, the answer to report
+        if answered:
             with optimized.folder("original") as folder:
-                prof.write_variant(Selection.original(float(prof.original_ms or 0.0)), folder)
-            plots = False
+                choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), folder)
     prof.selections = kept
     prof.path = out
     if plots:
+        from rrcache.profiler.frames import write_frames
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
-        prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_report(prof, out, work=work)
+        if not answered:
+            prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
+            write_frames(prof, out, work)
+        write_report(prof, out)

@@ -18,7 +18,7 @@ After the single nodes are trained and fitted (:mod:`rrcache.profiler.train`), :
 The stage spends at most what is left of ``settings.budget_s`` or :data:`SET_SHARE` of it,
 whichever is more (so a profile whose nodes spent the budget still tries its best set), and
 stops before a set that would not fit at the seconds the last one took. What it trained is kept
-in the store (``meta('sets')``), so a resumed profile does not train it again, and in
+in the store (its ``set_run`` table, :mod:`rrcache.kinds.nodes`), so a resumed profile does not train it again, and in
 ``profile.json`` (``sets``); :meth:`rrcache.profiles.Profile.select` and ``select_psnr`` then
 return a trained set where it was measured faster than the single-node choice at the level, and
 validation measures it beside the original as any selection (a set measured slower than the
@@ -26,21 +26,21 @@ original falls back along the single-node front).
 """
 from __future__ import annotations
 
-import json
 import statistics
 import time
 from typing import Optional
 
 import numpy as np
 
+from rrcache import kinds
 from rrcache.errors import RRCacheError
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.model.sets import DEFAULT_MAX_SETS, TRAIN_MARGIN, SetOption, pick, search
-from rrcache.profiler.train import PSNR_CAP, ProgressEvent
+from rrcache.profiler.collect import Collector
+from rrcache.profiler.jobs import Meter, RunShapes
 
 #: the share of the training budget the set stage may spend even when the nodes spent it all
 SET_SHARE = 0.15
-#: the store's meta key of the trained sets
-META_KEY = "sets"
 
 
 def feeds(table, ids: list[str]) -> set[tuple[int, int]]:
@@ -130,7 +130,7 @@ def plan_sets(prof, work, max_sets: int = DEFAULT_MAX_SETS) -> tuple[list[SetOpt
 
 
 def train_sets(prof, work, session, settings, store, progress=None, max_sets: int = DEFAULT_MAX_SETS,
-               clock=time.perf_counter) -> list[SetOption]:
+               clock=time.perf_counter, executor=None) -> list[SetOption]:
     """Predict, pick and train the sets (see the module docstring); returns every set predicted
     to improve the front, the trained ones with their measurements. Nothing when ``max_sets`` is
     0, fewer than two nodes were trained or the ceiling stopped the profile."""
@@ -138,19 +138,22 @@ def train_sets(prof, work, session, settings, store, progress=None, max_sets: in
         return []
     options, picked = plan_sets(prof, work, max_sets)
     allowance = max(settings.budget_s - store.spent_s(), SET_SHARE * settings.budget_s)
-    train_options(prof, work, session, settings, store, picked, progress, allowance, clock)
+    train_options(prof, work, session, settings, store, picked, progress, allowance, clock, executor)
     return options
 
 
 def train_options(prof, work, session, settings, store, options: list[SetOption], progress=None,
-                  allowance: float = float("inf"), clock=time.perf_counter) -> list[SetOption]:
-    """Train each of ``options`` (in place; see :class:`_Runner`) unless the store holds it
+                  allowance: float = float("inf"), clock=time.perf_counter, executor=None) -> list[SetOption]:
+    """Train each of ``options`` (in place; see :func:`train_set`) unless the store holds it
     already (then its stored figures are taken) or the seconds spent so far plus the last set's
     would pass ``allowance`` (then ``note`` says so); a set the compiler refuses gets its reason
-    in ``note``. Every outcome is kept in the store. Returns ``options``."""
-    stored = {(tuple(d["nodes"]), tuple(d["periods"])): SetOption.from_json(d) for d in _stored(store)}
+    in ``note``. Every outcome is kept in the store (``set_run``, through the collector). The
+    runs go to ``executor`` (default: in this process). Returns ``options``."""
+    stored = {(tuple(d["nodes"]), tuple(d["periods"])): SetOption.from_json(d) for d in store.set_runs()}
     spent, last = 0.0, 0.0
-    runner: Optional[_Runner] = None
+    own = executor is None
+    collector = Collector(store)
+    meter = Meter(progress)
     try:
         for option in options:
             key = (tuple(option.nodes), tuple(option.periods))
@@ -164,119 +167,58 @@ def train_options(prof, work, session, settings, store, options: list[SetOption]
             if spent + last > allowance:
                 option.note = "not trained: the training budget (--budget) was spent"
                 continue
-            if runner is None:
-                runner = _Runner(prof, work, session, settings, progress)
+            if executor is None:
+                executor = LocalExecutor(Bench(work, session))
             start = clock()
             try:
-                runner.train(option)
+                train_set(prof, settings, session, option, executor, meter)
             except RRCacheError as err:  # a nest the compiler refuses, a target budget
                 option.note = f"not trained: {err.message}"
             last = clock() - start
             spent += last
             option.trained_s = last if option.trained else None
             stored[key] = option
-            _store(store, list(stored.values()))
+            collector.add_set(option.to_json())
     finally:
-        if runner is not None:
-            runner.release()
+        if own and executor is not None:
+            executor.close()
     return options
 
 
-def _stored(store) -> list[dict]:
-    raw = store.meta().get(META_KEY)
-    try:
-        data = json.loads(raw) if raw else []
-    except ValueError:
-        return []
-    return [d for d in data if isinstance(d, dict) and "nodes" in d and "periods" in d]
+def train_set(prof, settings, session, option: SetOption, executor, meter: Meter) -> None:
+    """A set's error run (over the training frames in the error window, against the original)
+    and timing run (each timing frame beside the original), planned by the nodes kind
+    (:meth:`rrcache.kinds.nodes.NodesKind.training`) and run by ``executor``; the figures into
+    ``option``."""
+    from rrcache.profiler.plan import Plan
+    from rrcache.profiler.train import timing_frame_indices
 
-
-def _store(store, options: list[SetOption]) -> None:
-    store.set_meta(META_KEY, json.dumps([o.to_json() for o in options]))
-
-
-class _Runner:
-    """The renderers the set runs share: the original's reference frames in the error window
-    (rendered once) and the original at full resolution for the timing frames."""
-
-    def __init__(self, prof, work, session, settings, progress):
-        from rrcache.harness.renderer import Renderer
-        from rrcache.profiler.plan import Plan
-        from rrcache.profiler.train import timing_frame_indices
-
-        self.prof, self.work, self.session, self.settings, self.progress = prof, work, session, settings, progress
-        self.plan = Plan.from_json(prof.plan) if prof.plan else None
-        self.error_window = self.plan.error_window if self.plan is not None else None
-        self.timing_window = self.plan.timing_window if self.plan is not None else None
-        self.full = tuple(int(v) for v in session.resolution)
-        self.timing = timing_frame_indices(session.frames, settings.timing_frames)
-        with Renderer(work.prepared, session, settings.resolution, window=self.error_window) as renderer:
-            self.refs = [renderer.render_frame(i) for i in range(settings.frames)]
-        self.original = Renderer(work.prepared, session, self.full, window=self.timing_window,
-                                 color_format=settings.timing_format)
-
-    def _step(self, detail: str, done: int, total: int) -> None:
-        if self.progress is not None:
-            self.progress(ProgressEvent("sets", done, total, detail))
-
-    def train(self, option: SetOption) -> None:
-        from rrcache.harness.cached import CachedRenderer
-        from rrcache.harness.metrics import mean_l2, psnr
-        from rrcache.pipeline import variant_for_nodes
-
-        variant = variant_for_nodes(self.work, option.nodes, self.prof.algorithm)
-        periods = tuple(option.periods)
-        label = option.describe()
-        total = len(self.refs) + 3 * len(self.timing)
-        errors, psnrs, hits, counted = [], [], np.zeros(len(periods)), 0
-        with CachedRenderer(variant, self.session, self.work.prepared, self.settings.resolution, period=periods,
-                            window=self.error_window, **self.settings.cache_options()) as cached:
-            cached.reset()
-            for k, ref in enumerate(self.refs):
-                got = cached.render_frame(ref.index)
-                err, _ = mean_l2(got.image, ref.image, ref.mask)
-                if k > 0:  # the first frame has no cache
-                    errors.append(float(err))
-                    psnrs.append(min(float(psnr(got.image, ref.image)), PSNR_CAP))
-                    rates = _node_hits(cached, got)
-                    if rates is not None:
-                        hits += rates
-                        counted += 1
-                self._step(f"{label} error", k + 1, total)
-        ratios = []
-        with CachedRenderer(variant, self.session, self.work.prepared, self.full, period=periods,
-                            window=self.timing_window, color_format=self.settings.timing_format,
-                            **self.settings.cache_options()) as cached:
-            for k, index in enumerate(self.timing):
-                ref = self.original.render_frame(index)
-                cached.reset()
-                cached.render_frame(index - 1)
-                got = cached.render_frame(index)
-                if ref.ms > 0:
-                    ratios.append(got.ms / ref.ms)
-                self._step(f"{label} timing", len(self.refs) + 3 * (k + 1), total)
-        if not errors or not ratios:
-            raise RRCacheError("too few frames to train a set", "settings",
-                               hint="profile with --frames >= 2 and --timing-frames >= 1")
-        option.trained = True
-        option.trained_error = float(np.mean(errors))
-        option.trained_psnr = float(np.mean(psnrs))
-        option.trained_ms = float(statistics.median(ratios)) * float(self.prof.original_ms)
-        option.trained_hit_rates = [float(v) for v in (hits / counted)] if counted else []
-
-    def release(self) -> None:
-        self.original.release()
-
-
-def _node_hits(cached, frame) -> Optional[np.ndarray]:
-    """Per node, the share of the covered pixels whose entry reprojected and was not refreshed
-    (the runtime's per-node hit counts when it has them)."""
-    per_node = getattr(cached.runtime, "node_hit_rates", None)
-    if callable(per_node):
-        return np.asarray(per_node(), dtype=np.float64)
-    if frame.hits is None or not frame.covered_pixels:
-        return None
-    return np.full(len(cached.runtime.period), frame.hits / frame.covered_pixels)
+    plan = Plan.from_json(prof.plan) if prof.plan else None
+    shapes = RunShapes.of(settings, session, plan, timing_frame_indices(session.frames, settings.timing_frames))
+    label = option.describe()
+    runs = [shapes.run(measure, spec, key, f"{label} {measure}")
+            for measure, spec, key in kinds.get("nodes").training((option.nodes, option.periods), settings,
+                                                                  prof.algorithm, prof.filter)]
+    meter.grow(sum(r.cost for r in runs))
+    errors, psnrs, hits, counted, ratios = [], [], np.zeros(len(option.periods)), 0, []
+    for result in executor.run(runs, on_frame=meter.on_frame("sets")):
+        if result.spec.measure == "error":
+            for row in result.frames[1:]:  # the first frame has no cache
+                errors.append(float(row.error))
+                psnrs.append(float(row.psnr))
+                if row.hits is not None and row.covered:  # each node's share: the frame's hit rate
+                    hits += row.hits / row.covered
+                    counted += 1
+        else:
+            ratios = [row.ms / row.original_ms for row in result.frames if row.original_ms > 0]
+    if not errors or not ratios:
+        raise RRCacheError("too few frames to train a set", "settings",
+                           hint="profile with --frames >= 2 and --timing-frames >= 1")
+    option.trained = True
+    option.trained_error = float(np.mean(errors))
+    option.trained_psnr = float(np.mean(psnrs))
+    option.trained_ms = float(statistics.median(ratios)) * float(prof.original_ms)
+    option.trained_hit_rates = [float(v) for v in (hits / counted)] if counted else []
 
 
 def single_choices(prof) -> dict:

@@ -5,10 +5,12 @@ holds, and fits the models from what is stored:
 
 0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profiler.order`
    (too-cheap nodes skipped, the rest diversity first). The original is timed at full resolution
-   on the timing frames, and from that time the windows of :mod:`rrcache.profiler.plan` are
-   chosen (once; kept in the store). With ``algorithm="auto"`` the three-pass and two-pass
-   variants of the first node are timed beside the original (:func:`choose_algorithm`) and the
-   faster serves the whole profile (kept in the plan too).
+   on the timing frames, and the windows and error frames of :mod:`rrcache.profiler.plan` are
+   chosen (once; kept in the store). With ``algorithm="auto"`` the ceiling's per-algorithm
+   limits decide which algorithm serves the whole profile when they differ beyond their noise;
+   else the three-pass and two-pass variants of the first node are timed beside the original
+   (:func:`choose_algorithm`) and the faster serves when the difference exceeds its noise, else
+   the higher ceiling (kept in the plan too, with the reason).
 1. **Reference frames.** The original shader over the training frames inside the error window
    (full pixel density), rendered once and kept in memory for the run.
 2. **Error runs.** Per node one :class:`~rrcache.harness.cached.CachedRenderer` inside the same
@@ -49,62 +51,35 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from rrcache import kinds
 from rrcache.errors import GLError, RRCacheError
-from rrcache.harness.cached import CachedRenderer
-from rrcache.harness.metrics import mean_l2, psnr
+from rrcache.harness.execute import Bench, LocalExecutor
 from rrcache.harness.renderer import Renderer
-from rrcache.pipeline import ShaderWork, variant_for
+from rrcache.pipeline import ShaderWork
 from rrcache.model.ceiling import Ceiling
 from rrcache.profiler.ceiling import measure_ceiling
-from rrcache.profiler.filters import choose_filter, steps as filter_steps
+from rrcache.profiler.filters import choose_filter
 from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                     shader_inputs, signature)
-from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
-                                   coverage_map,
-                                   fraction_for, place_window)
+from rrcache.profiler.plan import Plan, algorithm_by_ceiling, algorithm_by_timing, make_plan as _make_plan
 from rrcache.profiles.settings import TrainingSettings
-from rrcache.profiles.store import ErrorFrame, ErrorRun, ProfileStore, TimingFrame
+from rrcache.profiler.collect import Collector
+from rrcache.profiler.jobs import Group, Meter, RunPlan, RunShapes
+from rrcache.profiles.store import ProfileStore
+from rrcache.runs import PSNR_CAP, RunSpec  # noqa: F401 (PSNR_CAP re-exported)
+from rrcache.runtime.spec import VariantSpec
 
 #: a ceiling below ``min_gain`` but within this factor of it is measured a second time
 CEILING_RECHECK = 1.3
 #: the resolution of the overhead measurement
 OVERHEAD_SIZE = (8, 8)
-PSNR_CAP = 100.0
 
 
-@dataclass
-class ProgressEvent:
-    """Sent to the ``progress`` callback: ``stage`` (``reference``, ``error``, ``timing``,
-    ``overhead``, ``validate``), frames rendered ``done`` of ``total`` planned (the plan shrinks
-    when the budget stops the training), and a short ``detail`` (node and period)."""
-
-    stage: str
-    done: int
-    total: int
-    detail: str = ""
+from rrcache.profiler.events import ProgressEvent, ProgressFn  # noqa: F401 (re-exported)
 
 
-ProgressFn = Callable[[ProgressEvent], None]
-
-
-class _Meter:
-    def __init__(self, progress: Optional[ProgressFn], total: int):
-        self.progress, self.total, self.done = progress, max(0, total), 0
-
-    def step(self, stage: str, detail: str = "", n: int = 1) -> None:
-        self.done += n
-        self.total = max(self.total, self.done)
-        if self.progress is not None:
-            self.progress(ProgressEvent(stage, self.done, self.total, detail))
-
-    def shrink(self, by: int, stage: str = "train", detail: str = "budget spent") -> None:
-        self.total = max(self.done, self.total - by)
-        if self.progress is not None:
-            self.progress(ProgressEvent(stage, self.done, self.total, detail))
-
-    def grow(self, by: int) -> None:
-        self.total += by
+_Meter = Meter  # (the training's progress: rrcache.profiler.jobs.Meter)
 
 
 @dataclass
@@ -162,19 +137,11 @@ def training_order(work: ShaderWork, session, settings: TrainingSettings) -> Tra
     return TrainingOrder(diversity_order(keep, signatures), skipped, signatures)
 
 
-def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames: list[int]) -> Plan:
-    """Choose the error and timing windows (:mod:`rrcache.profiler.plan`) for a shader whose
-    full frame costs ``original_ms``, placed over the coverage of ``frames``."""
-    full = tuple(int(v) for v in session.resolution)
-    at_full = tuple(settings.resolution) == full
-    error_fraction = settings.error_window if settings.error_window is not None else \
-        fraction_for(original_ms, ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION)
-    timing_fraction = 1.0 if original_ms <= TIMING_TARGET_MS else fraction_for(original_ms, TIMING_TARGET_MS, 1.0)
-    need = (at_full and error_fraction < 1.0) or timing_fraction < 1.0
-    coverage = coverage_map(work.prepared, session, frames[::max(1, len(frames) // 16)], Renderer) if need else None
-    error_window = place_window(coverage, full, error_fraction) if at_full and error_fraction < 1.0 else None
-    timing_window = place_window(coverage, full, timing_fraction) if timing_fraction < 1.0 else None
-    return Plan(error_window, timing_window, float(original_ms))
+def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames=None) -> Plan:
+    """Choose the error and timing windows and the error frames (:func:`rrcache.profiler.plan.make_plan`:
+    sized from the original's CPU time, which load moves little) for a shader whose full frame
+    measured ``original_ms``. ``frames`` is ignored (the plan chooses the error frames)."""
+    return _make_plan(work, session, settings, original_ms, Renderer)
 
 
 def timing_frame_indices(session_frames: int, count: int) -> list[int]:
@@ -192,68 +159,31 @@ def timing_frame_indices(session_frames: int, count: int) -> list[int]:
     return sorted({int(round(x)) for x in np.linspace(1, session_frames - 1, count)})
 
 
-def _error_run(cached: CachedRenderer, node_id: str, period: int, refs: list, meter: _Meter) -> tuple[ErrorRun, list]:
-    start = time.perf_counter()
-    cached.period = period
-    cached.reset()
-    frames: list[ErrorFrame] = []
-    for ref in refs:
-        got = cached.render_frame(ref.index)
-        err, left_out = mean_l2(got.image, ref.image, ref.mask)
-        frames.append(ErrorFrame(ref.index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP),
-                                 int(got.hits), int(got.misses), int(got.covered_pixels), int(left_out)))
-        meter.step("error", f"{node_id} Δn={period}")
-    steady = frames[1:] or frames
-    hits, misses = sum(f.hits for f in steady), sum(f.misses for f in steady)
-    run = ErrorRun(node_id, int(period), float(np.mean([f.mean_error for f in steady])),
-                   float(np.mean([f.psnr for f in steady])), hits / (hits + misses) if hits + misses else 0.0,
-                   hits, misses, sum(f.covered for f in steady), len(frames), time.perf_counter() - start)
-    return run, frames
-
-
-def timed_beside(cached: CachedRenderer, original: Renderer, index: int):
-    """(cached frame, original frame) of frame ``index``: the original just before, and the cache
-    restarted and filled by frame ``index - 1`` so that frame ``index`` is a steady frame."""
-    ref = original.render_frame(index)
-    cached.reset()
-    cached.render_frame(index - 1)
-    return cached.render_frame(index), ref
-
-
-def _timing_run(cached: CachedRenderer, original: Renderer, node_id: str, period: int, indices: list[int],
-                meter: _Meter) -> list[TimingFrame]:
-    cached.period = period
-    out = []
-    for index in indices:
-        got, ref = timed_beside(cached, original, index)
-        out.append(TimingFrame(index, int(got.hits), int(got.misses), float(got.ms), float(ref.ms)))
-        meter.step("timing", f"{node_id} Δn={period}", 3)
-    return out
-
-
 #: what ``algorithm="auto"`` chooses from: one-pass is left out (its dynamic branch runs in
 #: lock-step across SIMD lanes on llvmpipe: 1.1x on Marble, never the fastest)
 AUTO_CANDIDATES = ("three-pass", "two-pass")
 
 
-def choose_algorithm(work: ShaderWork, session, settings: TrainingSettings, node_id: str, original: Renderer,
-                     timing: list[int], window, meter: _Meter) -> tuple[str, dict]:
+def choose_algorithm(settings: TrainingSettings, node_id: str, shapes: RunShapes, executor,
+                     meter: Optional[Meter] = None) -> tuple[str, dict, dict]:
     """Time the :data:`AUTO_CANDIDATES` variants of ``node_id`` on the timing frames at the
     middle timing period, each frame beside the original as the timing runs are, and return the
-    faster and each one's median time as a fraction of the original's. The three-pass
+    faster median, each one's median time as a fraction of the original's and each one's
+    per-frame fractions (whether their difference exceeds its noise is
+    :func:`rrcache.profiler.plan.algorithm_by_timing`'s to say; profiles decide from the
+    ceiling's limits first, :func:`rrcache.profiler.plan.algorithm_by_ceiling`). The three-pass
     algorithm is the paper's choice for GPUs, where a pass over the geometry is cheap and
     multiple render targets are not; on llvmpipe the geometry is set up on one thread, and the
     two-pass variant, one pass over the geometry fewer, measured 8-10% faster on Marble."""
     period = settings.timing_periods[len(settings.timing_periods) // 2]
-    full = tuple(int(v) for v in session.resolution)
-    fractions = {}
-    for algorithm in AUTO_CANDIDATES:
-        variant = variant_for(work, node_id, algorithm)
-        with CachedRenderer(variant, session, work.prepared, full, period=period, window=window,
-                            color_format=settings.timing_format, **settings.cache_options()) as cached:
-            frames = _timing_run(cached, original, f"{node_id} {algorithm}", period, timing, meter)
-        fractions[algorithm] = float(statistics.median(f.ms / f.original_ms for f in frames if f.original_ms > 0))
-    return min(fractions, key=fractions.get), fractions
+    runs = [shapes.run("timing", VariantSpec("cache", (node_id,), algorithm, periods=(period,),
+                                             **settings.cache_options()),
+                       ("auto", algorithm), f"{node_id} {algorithm} Δn={period}") for algorithm in AUTO_CANDIDATES]
+    fractions, ratios = {}, {}
+    for result in executor.run(runs, on_frame=meter.on_frame() if meter is not None else None):  # kept in the plan
+        ratios[result.spec.key[1]] = [r.ms / r.original_ms for r in result.frames if r.original_ms > 0]
+        fractions[result.spec.key[1]] = float(statistics.median(ratios[result.spec.key[1]]))
+    return min(fractions, key=fractions.get), fractions, ratios
 
 
 def _node_complete(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
@@ -261,16 +191,14 @@ def _node_complete(store: ProfileStore, node_id: str, settings: TrainingSettings
             and all(store.has_timing_run(node_id, p) for p in settings.timing_periods))
 
 
-def _node_started(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
-    return (any(store.has_error_run(node_id, p) for p in settings.periods)
-            or any(store.has_timing_run(node_id, p) for p in settings.timing_periods))
-
-
 def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore,
-          progress: Optional[ProgressFn] = None, clock: Callable[[], float] = time.perf_counter) -> TrainingResult:
+          progress: Optional[ProgressFn] = None, clock: Callable[[], float] = time.perf_counter,
+          executor=None) -> TrainingResult:
     """Measure what ``store`` lacks for ``work`` over ``session`` with the *resolved*
     ``settings`` (:meth:`TrainingSettings.resolved`), then fit the models (see the module
-    docstring). Returns a :class:`TrainingResult`."""
+    docstring). The runs go to ``executor`` (default: in this process,
+    :class:`~rrcache.harness.execute.LocalExecutor`), their results to the store through the
+    :class:`~rrcache.profiler.collect.Collector`. Returns a :class:`TrainingResult`."""
     start = clock()
     if not work.table.nodes:
         raise RRCacheError("the shader has no cacheable node to train", str(work.shader.path or "<shader>"),
@@ -283,7 +211,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                            hint="'rrcache nodes SHADER' says why in its algorithms column; profile with "
                                 "--algorithm auto, three-pass or two-pass")
     ids = [n.id for n in order.nodes]
-    train_frames = list(range(settings.frames))
+    train_frames: list[int] = []  # the plan's error frames, once the plan is known
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     full = tuple(int(v) for v in session.resolution)
 
@@ -304,35 +232,31 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 + (len(timing) if need_overhead else 0))
 
     # the training is planned once the ceiling has said whether it happens, and for which nodes
-    meter = _Meter(progress, len(timing) if need_ref_timing else 0)
-    budget_stopped = False
+    meter = Meter(progress, len(timing) if need_ref_timing else 0)
     refused: dict[str, str] = {}  # node -> why the driver refused its variant
     notes = dict(order.skipped)
-
-    original: Optional[Renderer] = None
-    timed_original: Optional[Renderer] = None
+    collector = Collector(store)
+    bench = None
+    if executor is None:
+        bench = Bench(work, session)
+        executor = LocalExecutor(bench)
+    shapes = RunShapes.of(settings, session, None, timing)
     ceiling: Optional[Ceiling] = None
+    budget_stopped = False
     fmt = settings.timing_format
     try:
-        original = Renderer(work.prepared, session, full, color_format=fmt)
-        if need_ref_timing:
-            rows = []
-            for index in timing:
-                got = original.render_frame(index)
-                rows.append((index, got.ms, got.covered_pixels))
-                meter.step("reference", f"timing frame {index}")
-            store.add_reference_timing(rows)
+        if need_ref_timing:  # the original alone at full resolution, on the timing frames
+            for result in executor.run([RunSpec("timing", None, tuple(timing), full, None, fmt, settings.clock,
+                                                ("reference-timing",), "timing frames")], on_frame=meter.on_frame()):
+                collector.add(result)
         stored_plan = store.plan()
         if stored_plan is None:
-            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()),
-                             train_frames)
+            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()))
             store.set_plan(plan.to_json())
         else:
             plan = Plan.from_json(stored_plan)
-        if plan.timing_window is not None:
-            original.release()
-            original = Renderer(work.prepared, session, full, window=plan.timing_window, color_format=fmt)
-        timed_original = original
+        train_frames[:] = plan.error_frames(settings.frames)
+        shapes = RunShapes.of(settings, session, plan, timing)
         if order.nodes and len(timing) > 0:
             ceiling = _ceiling_of_a_compiling_node(work, session, settings, store, plan, order, timing, meter,
                                                    refused)
@@ -368,19 +292,25 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         meter.grow(training_total())
         if plan.algorithm is None:
             if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
-                meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
-                plan.algorithm, plan.algorithm_times = choose_algorithm(
-                    work, session, settings, order.nodes[0].id, timed_original, timing, plan.timing_window, meter)
+                # the ceiling's per-algorithm limits decide when they differ beyond their noise;
+                # else a timing of the first node, when its difference exceeds its noise
+                chosen, why = algorithm_by_ceiling(ceiling.algorithms if ceiling is not None else {},
+                                                   ceiling.noise if ceiling is not None else 0.0)
+                if chosen is None:
+                    meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
+                    _, plan.algorithm_times, ratios = choose_algorithm(settings, order.nodes[0].id, shapes, executor,
+                                                                       meter)
+                    chosen, why = algorithm_by_timing(ratios, ceiling.algorithm if ceiling is not None
+                                                      else settings.fixed_algorithm)
+                plan.algorithm, plan.algorithm_reason = chosen, why
             else:
                 plan.algorithm = settings.fixed_algorithm
             store.set_plan(plan.to_json())
         algorithm = plan.algorithm
         if plan.filter is None:
             if settings.filter == "auto" and order.nodes and len(timing) > 0:
-                meter.grow(filter_steps(settings, timing))
-                plan.filter, plan.filter_times = choose_filter(work, session, settings, order.nodes[0].id, algorithm,
-                                                               timed_original, timing, plan, meter, _timing_run,
-                                                               _error_run)
+                plan.filter, plan.filter_times = choose_filter(settings, order.nodes[0].id, algorithm, shapes,
+                                                               executor, meter)
             else:
                 plan.filter = DEFAULT_FILTER if settings.filter == "auto" else settings.filter
             store.set_plan(plan.to_json())
@@ -388,71 +318,48 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         # the selections' files) uses the profile's filter
         work.filter = plan.filter
 
-        refs = []
-        if need_refs:
-            with Renderer(work.prepared, session, settings.resolution, window=plan.error_window) as renderer:
-                for index in train_frames:
-                    refs.append(renderer.render_frame(index))
-                    meter.step("reference", f"frame {index}")
-            store.add_reference({r.index: r.covered_pixels for r in refs})
+        if need_refs:  # the original over the training frames in the error window, once for every run
+            for result in executor.run([shapes.run("reference", None, ("reference",), "reference frames")],
+                                       on_frame=meter.on_frame()):
+                collector.add(result)
+        # per node its error runs (one compiled variant serves every period: the period is the
+        # runtime's) and its timing runs; a started node is finished, none started past the budget
+        kind = kinds.get("cache")
+        groups = [Group(nid, [shapes.run(measure, spec, key, f"{nid} Δn={key[2]}")
+                              for measure, spec, key in kind.training(nid, settings, algorithm, work.filter)])
+                  for nid in ids]
+        runs = RunPlan(groups, done=lambda r: store.has_node_run(r.measure, r.key[1], r.key[2]),
+                       budget=settings.budget_s, spent=store.spent_s,
+                       completed=lambda: sum(1 for n in ids if _node_complete(store, n, settings)))
+        runs.tail = len(timing) if need_overhead else 0
 
-        for node in order.nodes:
-            nid = node.id
-            if not todo_error[nid] and not todo_timing[nid]:
-                continue
-            if not _node_started(store, nid, settings) and store.spent_s() >= settings.budget_s:
-                budget_stopped = True
-                meter.shrink(len(todo_error[nid]) * len(train_frames) + len(todo_timing[nid]) * 3 * len(timing))
-                continue
-            # one compiled variant serves every period: the period is the runtime's (set per run)
-            variant = variant_for(work, nid, algorithm)
-            errors_done = False
-            try:
-                if todo_error[nid]:
-                    built = clock()
-                    with CachedRenderer(variant, session, work.prepared, settings.resolution,
-                                        period=todo_error[nid][0], window=plan.error_window,
-                                        **settings.cache_options()) as cached:
-                        compile_s = clock() - built
-                        for period in todo_error[nid]:
-                            run, frames = _error_run(cached, nid, period, refs, meter)
-                            run.wall_s += compile_s
-                            compile_s = 0.0
-                            store.add_error_run(run, frames)
-                errors_done = True
-                if todo_timing[nid]:
-                    built = clock()
-                    with CachedRenderer(variant, session, work.prepared, full, period=todo_timing[nid][0],
-                                        window=plan.timing_window, color_format=fmt, **settings.cache_options()) as cached:
-                        compile_s = clock() - built
-                        for period in todo_timing[nid]:
-                            t0 = clock()
-                            frames = _timing_run(cached, timed_original, nid, period, timing, meter)
-                            store.add_timing_run(nid, period, frames, clock() - t0 + compile_s)
-                            compile_s = 0.0
-            except GLError as err:
-                if not _driver_refused(err):
-                    raise
-                # the driver refuses this node's variant (it failed to compile: none of its runs was
-                # stored): the node is dropped with the reason, and training goes on with the next
-                refused[nid] = _dropped(err)
-                meter.shrink((0 if errors_done else len(todo_error[nid]) * len(train_frames))
-                             + len(todo_timing[nid]) * 3 * len(timing))
-                todo_error[nid], todo_timing[nid] = [], []
-                continue
-            _plan_within_budget(meter, store, settings, order.nodes, node, todo_error, todo_timing,
-                                len(train_frames), len(timing))
+        def refuse(group, err) -> bool:
+            # the driver refuses this node's variant (it failed to compile: none of its runs was
+            # stored): the node is dropped with the reason, and training goes on with the next
+            if not isinstance(err, GLError) or not _driver_refused(err):
+                return False
+            refused[group.name] = _dropped(err)
+            return True
+
+        runs.execute(executor, collector, meter, on_error=refuse)
+        budget_stopped = bool(runs.skipped)
+
+        trained = [i for i in ids if _node_complete(store, i, settings)]
+        if trained and need_overhead and timing:
+            # the cached pipeline's frame time with almost nothing covered
+            spec = VariantSpec("cache", (trained[0],), algorithm, work.filter, periods=(settings.timing_periods[-1],),
+                               **settings.cache_options())
+            overhead = RunSpec("overhead", spec, tuple(timing), OVERHEAD_SIZE, None, fmt, settings.clock,
+                               ("overhead", trained[0]), f"{trained[0]} at {OVERHEAD_SIZE[0]}×{OVERHEAD_SIZE[1]}")
+            for result in executor.run([overhead], on_frame=meter.on_frame()):
+                collector.add(result)
     finally:
-        if original is not None:
-            original.release()
+        if bench is not None:
+            bench.close()
 
-    trained = [i for i in ids if _node_complete(store, i, settings)]
     for i in ids:
         if i not in trained:
             notes[i] = refused.get(i, "not reached within the training budget (--budget)")
-    if trained and need_overhead:
-        _measure_overhead(work, session, settings, store, trained[0], timing, meter, plan.algorithm)
-
     skipped_ids = _skipped_ids(work, order)
     result = TrainingResult(order=ids + skipped_ids, trained=trained,
                             untrained=[i for i in ids + skipped_ids if i not in trained],
@@ -462,26 +369,6 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
     result.wall_s = clock() - start
     result.spent_s = store.spent_s()
     return result
-
-
-def _plan_within_budget(meter: _Meter, store: ProfileStore, settings: TrainingSettings, nodes, last, todo_error,
-                        todo_timing, n_frames: int, n_timing: int) -> None:
-    """After each trained node, plan only the nodes the budget is expected to reach (at the mean
-    seconds per node stored so far), so that the progress's total and ETA are those of the run
-    that will happen, not of every node in the order."""
-    done_nodes = sum(1 for n in nodes if _node_complete(store, n.id, settings))
-    spent = store.spent_s()
-    if not done_nodes or spent <= 0:
-        return
-    per_node_s = spent / done_nodes
-    index = [n.id for n in nodes].index(last.id)
-    rest = [n.id for n in nodes[index + 1:] if todo_error[n.id] or todo_timing[n.id]]
-    fit = max(0, int((settings.budget_s - spent) / per_node_s) + 1) if per_node_s > 0 else len(rest)
-    per_node = len(settings.periods) * n_frames + len(settings.timing_periods) * 3 * n_timing
-    planned = sum(len(todo_error[n]) * n_frames + len(todo_timing[n]) * 3 * n_timing for n in rest)
-    expected = min(len(rest), fit) * per_node
-    tail = n_timing if store.overhead() is None else 0  # the overhead measurement still to come
-    meter.total = max(meter.done, meter.done + min(planned, expected) + tail)
 
 
 def _driver_refused(err: GLError) -> bool:
@@ -554,19 +441,6 @@ def _prune(work: ShaderWork, order: TrainingOrder, ceiling: Ceiling, settings: T
             out[n.id] = (f"its best case ({best:.2f}× with every pixel hitting, from its {n.cost / top:.0%} "
                          f"of the static cost and the measured ceiling) is below --min-gain {settings.min_gain:.2f}×")
     return out
-
-
-def _measure_overhead(work, session, settings, store, node_id, timing, meter, algorithm: str) -> None:
-    variant = variant_for(work, node_id, algorithm)
-    times = []
-    with CachedRenderer(variant, session, work.prepared, OVERHEAD_SIZE, period=settings.timing_periods[-1],
-                        color_format=settings.timing_format, **settings.cache_options()) as cached:
-        for index in timing:
-            cached.reset()
-            cached.render_frame(index - 1)
-            times.append(cached.render_frame(index).ms)
-            meter.step("overhead", f"{node_id} at {OVERHEAD_SIZE[0]}×{OVERHEAD_SIZE[1]}")
-    store.set_overhead(node_id, OVERHEAD_SIZE, len(times), statistics.median(times))
 
 
 def _original_times(store: ProfileStore, nodes, settings: TrainingSettings) -> dict[int, list[float]]:

@@ -11,43 +11,16 @@ offers (:func:`rrcache.compiler.amortize.instance_amortized`): the paper's runni
 sums kept apart, where they fit: :func:`rrcache.selection.slots_fit`; the record's ``slots``
 key, a :class:`HistoryRuns`; a document without it loads as blend only).
 
-The runs are kept in the store in a table of their own, ``amortize_run`` (created when first
-written, so stores made before it still open; the store's schema is otherwise unchanged), keyed
-by history (a table written before the ``history`` column reads as blend rows, and is rebuilt
-with the column, its rows ``blend``, before it is first written again): one row per error run (kind ``error``: mean error and PSNR against the original over the training
+The runs are kept in the store's ``amortize_run`` table (the amortize kind's, part of the store's
+one schema: :mod:`rrcache.kinds.amortize`, :mod:`rrcache.profiles.store`), keyed by history: one
+row per error run (kind ``error``: mean error and PSNR against the original over the training
 frames after the first, hit rate) or timed frame (kind ``timing``: the frame's ms, the original's
 ms beside it, hits and misses). Rerunning a profile skips what is stored, as for nodes.
 """
 from __future__ import annotations
 
-import sqlite3
 from dataclasses import dataclass, field
 from typing import Optional
-
-from rrcache.errors import RRCacheError
-
-AMORTIZE_TABLE = """
-CREATE TABLE IF NOT EXISTS amortize_run (
-    estimator TEXT NOT NULL,
-    history TEXT NOT NULL DEFAULT 'blend',
-    kind TEXT NOT NULL,
-    samples INTEGER NOT NULL,
-    blend REAL NOT NULL,
-    frame INTEGER NOT NULL,
-    mean_error REAL NOT NULL,
-    psnr REAL NOT NULL,
-    hit_rate REAL NOT NULL,
-    hits INTEGER NOT NULL,
-    misses INTEGER NOT NULL,
-    ms REAL NOT NULL,
-    original_ms REAL NOT NULL,
-    wall_s REAL NOT NULL,
-    PRIMARY KEY (estimator, history, kind, samples, blend, frame)
-)"""
-#: the columns a row is given in (:func:`add_rows`); the table of stores written before the
-#: slots history has them all but ``history`` (its rows are the blend history's)
-COLUMNS = ("estimator", "history", "kind", "samples", "blend", "frame", "mean_error", "psnr", "hit_rate", "hits",
-           "misses", "ms", "original_ms", "wall_s")
 
 
 def _r(default=None, minimum=None, maximum=None, factory=None):
@@ -154,79 +127,13 @@ class EstimatorProfile:
 
 
 # ---------------------------------------------------------------------- the store's table
-def _columns(store) -> list[str]:
-    return [r[1] for r in store.conn.execute("PRAGMA table_info(amortize_run)").fetchall()]
-
-
-def _migrate(store) -> None:
-    """A table written before the slots history (no ``history`` column, and a primary key
-    without it) rebuilt with the column, its rows the blend history's, in one transaction;
-    run before the first write, so reading an old store never changes it."""
-    conn = store.conn
-    conn.execute("BEGIN IMMEDIATE")
-    try:
-        conn.execute("ALTER TABLE amortize_run RENAME TO amortize_run_old")
-        conn.execute(AMORTIZE_TABLE)
-        old = [c for c in COLUMNS if c != "history"]
-        conn.execute(f"INSERT INTO amortize_run ({', '.join(old)}, history) "
-                     f"SELECT {', '.join(old)}, 'blend' FROM amortize_run_old")
-        conn.execute("DROP TABLE amortize_run_old")
-        conn.execute("COMMIT")
-    except BaseException:
-        if conn.in_transaction:
-            conn.execute("ROLLBACK")
-        raise
-
-
-def _ensure(store) -> None:
-    if has_table(store):
-        if "history" not in _columns(store):
-            try:
-                _migrate(store)
-            except sqlite3.Error as err:
-                raise RRCacheError(f"cannot add the history column to the amortize_run table: {err}", str(store.path),
-                                   hint="free some disk space or make the folder writable, then run the profile "
-                                        "again") from None
-        return
-    store.conn.execute(AMORTIZE_TABLE)
-    store.conn.commit()
-
-
-def has_table(store) -> bool:
-    return store.conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'amortize_run'"
-                              ).fetchone() is not None
-
-
-def add_rows(store, rows: list[tuple]) -> None:
-    """Rows of ``amortize_run`` (in :data:`COLUMNS` order, the history second), in one
-    transaction through the store's writer (a full disk is refused there with what to do)."""
-    _ensure(store)
-    store._write([(f"INSERT OR REPLACE INTO amortize_run ({', '.join(COLUMNS)}) VALUES "
-                   f"({', '.join('?' * len(COLUMNS))})", tuple(r)) for r in rows])
-
-
+# (the table is the amortize kind's, rrcache.kinds.amortize; the store reads and writes it)
 def rows(store, estimator: str, kind: str, history: str = "blend") -> list[dict]:
-    """The stored rows of ``estimator`` of ``kind`` (``error`` or ``timing``) and ``history``
-    (``blend`` or ``slots``; a store written before the history column has blend rows only)."""
-    if not has_table(store):
-        return []
-    try:
-        if "history" not in _columns(store):
-            if history != "blend":
-                return []
-            cur = store.conn.execute("SELECT *, 'blend' AS history FROM amortize_run WHERE estimator = ? AND kind = ? "
-                                     "ORDER BY samples, blend, frame", (estimator, kind))
-        else:
-            cur = store.conn.execute("SELECT * FROM amortize_run WHERE estimator = ? AND kind = ? AND history = ? "
-                                     "ORDER BY samples, blend, frame", (estimator, kind, history))
-        names = [d[0] for d in cur.description]
-        return [dict(zip(names, r)) for r in cur.fetchall()]
-    except sqlite3.DatabaseError:
-        return []
+    """The stored rows of ``estimator`` of ``kind`` and ``history``
+    (:meth:`rrcache.profiles.store.ProfileStore.amortize_rows`)."""
+    return store.amortize_rows(estimator, kind, history)
 
 
 def spent_s(store) -> float:
-    """Seconds the stored amortization runs took (they count against the training budget)."""
-    if not has_table(store):
-        return 0.0
-    return float(store.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM amortize_run").fetchone()[0])
+    """Seconds the stored amortization runs took (:meth:`~rrcache.profiles.store.ProfileStore.amortize_spent_s`)."""
+    return store.amortize_spent_s()

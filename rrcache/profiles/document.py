@@ -34,6 +34,8 @@ from typing import Any, Optional
 
 from rrcache import atomic
 from rrcache.errors import RRCacheError, printable
+from rrcache.model import choose as _choose
+from rrcache.model.choose import speedup_range  # noqa: F401 (re-exported)
 from rrcache.jsonable import finite_json
 from rrcache.model.sets import SetOption
 from rrcache.profiles.amortize import SLOTS_PAYLOADS, EstimatorProfile
@@ -44,7 +46,7 @@ from rrcache.selection import AmortizedLoop, Selection, parts_from_json
 PROFILE_VERSION = 2
 JSON_NAME = "profile.json"
 #: the labels of the selections a profile keeps, from the smallest error threshold up
-LABELS = ("e1", "e2", "e3", "e4")
+LABELS = _choose.LABELS
 
 _HINT = "the file is damaged, edited or from another rrcache version; run 'rrcache profile' again"
 
@@ -183,6 +185,10 @@ class Profile:
     #: predictions' error on them, ``raw`` and ``calibrated`` (as each was predicted when it was
     #: measured): ``{"n", "mean", "worst"}`` of |predicted − measured| dB. Empty before validation.
     calibration: dict = field(default_factory=dict)
+    #: every choice validation measured, shipped or refused at a level, with its measured figures
+    #: (``rrcache select`` and the explorer answer from these where they can:
+    #: :mod:`rrcache.profiles.measured`)
+    measured: list[Selection] = field(default_factory=list)
     #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
     #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
     #: was measured faster at the level
@@ -194,6 +200,9 @@ class Profile:
     #: texture it could not decode ...), in order; :func:`rrcache.profiles.notices.run_warnings`
     #: adds the ones its measurements imply
     warnings: list[str] = field(default_factory=list)
+    #: the Dask cluster the runs were made on (rrcache.cluster.executor.DaskExecutor.record: workers, hosts,
+    #: what their capacity bought, the hosts of the timed runs); None: made in one process
+    cluster: Optional[dict] = None
     path: Optional[Path] = field(default=None, compare=False, metadata={"document": False})
 
     def __post_init__(self):
@@ -258,62 +267,14 @@ class Profile:
         return self._table
 
     def select(self, max_error: float) -> Selection:
-        """The choice predicted fastest with error ≤ ``max_error``, from the models only: a
-        :class:`~rrcache.selection.Selection` with this profile's algorithm and the node's
-        expression (no part: the original shader).
+        """:func:`rrcache.model.choose.select` of this profile."""
+        return _choose.select(self, max_error)
 
-        >>> choice = load_profile("marble-marble.rrprofile").select(0.01)   # doctest: +SKIP
-        """
-        from rrcache.model import select as model_select
 
-        try:
-            level = float(max_error)
-        except (TypeError, ValueError):
-            level = float("nan")
-        if not math.isfinite(level) or level < 0:
-            raise RRCacheError(f"{max_error!r} is not an error threshold", "--max-error",
-                               hint="give a mean RGB L2 error >= 0, e.g. 0.01 (profile.json lists the e1..e4 levels)")
-        if self.verdict is not None:  # the ceiling answered before training: the original
-            return Selection.original(float(self.original_ms), algorithm=self.algorithm, max_error=level)
-        choice = self._with_sets(self.adopt(model_select(self.table, level), max_error=level), max_error=level)
-        return self._amortized_or(choice, max_error=level)
-
-    def _with_sets(self, choice: Selection, max_error=None, min_psnr=None) -> Selection:
-        """``choice``, or the trained set (:attr:`sets`) admissible at the level and measured
-        faster in training (:func:`rrcache.model.sets.better`), with the choice's level."""
-        from rrcache.model.sets import better
-
-        found = better(choice, self.sets, float(self.original_ms), max_error=max_error, min_psnr=min_psnr)
-        if found is None:
-            return choice
-        return found.selection(float(self.original_ms), label=choice.label, max_error=choice.max_error,
-                               min_psnr=choice.min_psnr, algorithm=self.algorithm).with_texts(self.texts())
-
-    def _amortized_or(self, choice: Selection, max_error=None, min_psnr=None) -> Selection:
-        """``choice`` (the nodes' or a set's, adopted), or the amortized option predicted faster
-        at the same level, adopted with ``choice``'s label and level."""
-        rival = self._rival(choice, max_error=max_error, min_psnr=min_psnr)
-        if rival is choice:
-            return choice
-        bound = choice.max_error
-        if min_psnr is not None:
-            bound = max(self._estimator_psnr(rival).max_error(min_psnr), 0.0)
-        return self.adopt(rival, label=choice.label, max_error=bound, min_psnr=choice.min_psnr)
 
     def threshold_selections(self, labels=LABELS) -> list[Selection]:
-        """The labelled choices at the profile's levels (``settings.levels``), predicted only:
-        ``psnr`` (the default): predicted PSNR ≥ 45, 40, 35, 30 dB against the original
-        (:data:`rrcache.model.psnr.DEFAULT_LEVELS_DB`; :meth:`select_psnr`); ``relative``: the
-        paper's ε1…ε4, error thresholds spread over the errors seen (:func:`rrcache.model.thresholds`)."""
-        from rrcache.model import select as model_select, thresholds
-        from rrcache.model.psnr import DEFAULT_LEVELS_DB
-
-        if self.settings.levels == "psnr":
-            return [self.select_psnr(db).replace(label=label) for label, db in zip(labels, DEFAULT_LEVELS_DB)]
-        levels = [float(t) for t in thresholds(self.table, len(labels))]
-        return [self._amortized_or(self._with_sets(self.adopt(model_select(self.table, level), label=label,
-                                                              max_error=level), max_error=level), max_error=level)
-                for label, level in zip(labels, levels)]
+        """:func:`rrcache.model.choose.threshold_selections` of this profile."""
+        return _choose.threshold_selections(self, labels=labels)
 
     def psnr_fits(self) -> list:
         """The PSNR model of each trained node (:func:`rrcache.model.psnr.fit_psnr` on its
@@ -337,115 +298,39 @@ class Profile:
         return Calibration.from_json(self.calibration)
 
     def select_psnr(self, min_psnr: float) -> Selection:
-        """The choice predicted fastest whose predicted PSNR against the original is ≥
-        ``min_psnr`` dB (:func:`rrcache.model.psnr.select_min_psnr`), from the models only; its
-        ``max_error`` is the largest error its node may have at that PSNR."""
-        from rrcache.model.psnr import select_min_psnr
-
-        try:
-            level = float(min_psnr)
-        except (TypeError, ValueError):
-            level = float("nan")
-        if not math.isfinite(level):
-            raise RRCacheError(f"{min_psnr!r} is not a PSNR", "--min-psnr", hint="give decibels, e.g. 40")
-        if self.verdict is not None:
-            return Selection.original(float(self.original_ms), algorithm=self.algorithm, min_psnr=level,
-                                      max_error=0.0, exact=True, predicted_psnr_uncertainty=0.0)
-        fits = self.psnr_fits()
-        choice = select_min_psnr(self.table, fits, level)
-        bound = 0.0
-        if choice.parts:
-            bound = max(fits[self.table.node_ids.index(choice.node)].max_error(level), 0.0)
-        choice = self._with_sets(self.adopt(choice, min_psnr=level, max_error=bound), min_psnr=level)
-        # an amortized estimator predicted faster at this level stands instead
-        return self._amortized_or(choice, min_psnr=level)
+        """:func:`rrcache.model.choose.select_psnr` of this profile."""
+        return _choose.select_psnr(self, min_psnr)
 
     def adopt(self, choice: Selection, **changes) -> Selection:
-        """``choice`` (from the models) as this profile runs it: its algorithm, the nodes'
-        expressions, the predictions' uncertainty (:meth:`predictions`) and ``changes`` (label,
-        max_error …)."""
-        chosen = choice.with_texts(self.texts()).replace(algorithm=self.algorithm, **changes)
-        return chosen.replace(**self.predictions(chosen))
+        """:func:`rrcache.model.choose.adopt` of this profile."""
+        return _choose.adopt(self, choice, **changes)
 
     def predictions(self, choice: Selection) -> dict:
-        """The predicted PSNR of ``choice`` with its uncertainty (the PSNR rule's residual, the
-        error model's leave-one-out error and the error's spread over the training frames:
-        :func:`rrcache.model.psnr.prediction_uncertainty`), the predicted speed-up's range
-        (:func:`speedup_range`: the performance fit's residual and the timing noise), ``exact`` (the original's image: PSNR ∞, kept as null) and ``visible_artifacts``
-        (predicted PSNR below 30 dB)."""
-        from rrcache.model.psnr import VISIBLE_DB, predicted_psnr
+        """:func:`rrcache.model.choose.predictions` of this profile."""
+        return _choose.predictions(self, choice)
 
-        if not choice.parts or not choice.predicted_error > 0:  # exact: PSNR ∞ (null in JSON)
-            return {"predicted_psnr": None, "predicted_psnr_uncertainty": 0.0, "exact": True,
-                    "visible_artifacts": False,
-                    "predicted_speedup_range": (choice.predicted_speedup, choice.predicted_speedup)}
-        if isinstance(choice.parts[0], AmortizedLoop):
-            runs = self.estimator(choice.parts[0].estimator).runs(choice.parts[0].history)
-            value, spread = predicted_psnr(self._estimator_psnr(choice), choice.predicted_error)
-            rms = float((runs.time_fit if runs is not None else {}).get("rms") or 0.0)
-        else:
-            trained = [n.id for n in self.trained_nodes]
-            i = trained.index(choice.node)
-            fit = self.psnr_fits()[i]
-            value, spread = predicted_psnr(fit, choice.predicted_error, *self._psnr_terms(i, choice.period, fit))
-            rms = float(self.trained_nodes[i].perf_fit.get("residual_rms") or 0.0)
-        ms = float(choice.predicted_ms)
-        span = speedup_range(float(self.original_ms), ms, rms, float(self.timing_noise or 0.0))
-        out = {"predicted_psnr": value if math.isfinite(value) else None,
-               "predicted_psnr_uncertainty": spread if math.isfinite(spread) else None, "exact": False,
-               "visible_artifacts": bool(value < VISIBLE_DB), "predicted_speedup_range": span}
-        cal = self.calibrated()
-        if cal.points and not isinstance(choice.parts[0], AmortizedLoop) and math.isfinite(value):
-            # psnr_fits carries the node's calibration shift: say how much, and widen the ± by its spread
-            out["calibration_db"] = cal.shift(choice.node)
-            if math.isfinite(spread):
-                out["predicted_psnr_uncertainty"] = math.hypot(spread, cal.spread)
-        return out
-
-    def _psnr_terms(self, i: int, period, fit) -> tuple[float, float]:
-        """(leave-one-out dB, frame spread) of trained node ``i`` at refresh ``period``
-        (:func:`rrcache.model.psnr.prediction_uncertainty`): the spread of the training run at the
-        trained period nearest ``period``."""
-        from rrcache.model.psnr import loo_db
-
-        node = self.trained_nodes[i]
-        if node.id not in self._loo:
-            self._loo[node.id] = loo_db(node.periods, node.errors, fit.b)
-        spread = 0.0
-        if node.frame_spreads and len(node.frame_spreads) == len(node.periods) and period is not None:
-            j = min(range(len(node.periods)), key=lambda k: abs(node.periods[k] - period))
-            spread = float(node.frame_spreads[j])
-        return self._loo[node.id], spread
 
     def front_candidates(self, choice: Selection) -> list[Selection]:
-        """The options that could stand in for ``choice`` at its level when it measures slower
-        than the original: the predicted Pareto front's points admissible at the level (error ≤
-        ``max_error``, or predicted PSNR ≥ ``min_psnr``) and predicted faster than the original,
-        fastest first, ``choice`` itself left out."""
-        from rrcache.model import pareto_front
-        from rrcache.model.amortize import front as amortized_front
+        """:func:`rrcache.model.choose.front_candidates` of this profile."""
+        return _choose.front_candidates(self, choice)
 
-        fits = self.psnr_fits() if choice.min_psnr is not None else None
-        ids = [n.id for n in self.trained_nodes]
-        out = []
-        for point in pareto_front(self.table):
-            if point.node is None or not point.predicted_ms < self.original_ms or point.period < 2:
-                continue
-            if fits is not None:
-                ok = fits[ids.index(point.node)].predict(point.predicted_error) >= choice.min_psnr
-            else:
-                ok = point.predicted_error <= (choice.max_error or 0.0)
-            if not ok:
-                continue
-            option = self.table.option(ids.index(point.node) * self.table.max_period + point.period - 1)
-            if option.key == choice.key:
-                continue
-            out.append(self.adopt(option, label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr))
-        out += [self.adopt(option, label=choice.label, max_error=choice.max_error, min_psnr=choice.min_psnr)
-                for option in amortized_front(self._admissible(max_error=choice.max_error if fits is None else None,
-                                                               min_psnr=choice.min_psnr))
-                if option.key != choice.key]
-        return sorted(out, key=lambda s: s.predicted_ms)
+    def uncovered_share(self) -> float:
+        """The share of the validation frames the error runs did not cover (``plan``'s
+        ``error_segments``; a plan without them trained on the first ``settings.frames``).
+
+        >>> p = Profile("s", "t", "", "", TrainingSettings(frames=64, validation_frames=150), "two-pass", [])
+        >>> round(p.uncovered_share(), 3)
+        0.573
+        """
+        total = self.settings.validation_frames
+        if not total:
+            return 0.0
+        segments = (self.plan or {}).get("error_segments")
+        if segments:
+            covered = {i for start, n in segments for i in range(int(start), int(start) + int(n))}
+        else:
+            covered = set(range(int(self.settings.frames or 0)))
+        return 1.0 - len(covered & set(range(int(total)))) / float(total)
 
     # ------------------------------------------------------------------ amortized sampling
     def estimator(self, estimator_id: str) -> EstimatorProfile:
@@ -456,47 +341,12 @@ class Profile:
                            hint="the profile lists its estimators in profile.json")
 
     def amortized_options(self) -> list[Selection]:
-        """Every (estimator, history, m, λ) the trained estimators' models predict
-        (:meth:`rrcache.model.amortize.AmortizeModel.options`: the blend history's and, where
-        they fit and were trained, the slots history's), on the same error-against-time axes as
-        the cached nodes' options."""
-        if not self.original_ms:
-            return []
-        out = []
-        for est in self.estimators:
-            for model in est.models():
-                out.extend(model.options(float(self.original_ms)))
-        return out
+        """:func:`rrcache.model.choose.amortized_options` of this profile."""
+        return _choose.amortized_options(self)
 
-    def _admissible(self, max_error=None, min_psnr=None) -> list[Selection]:
-        from rrcache.model.amortize import admissible
 
-        if max_error is None and min_psnr is None:
-            return []
-        return admissible(self.amortized_options(), float(self.original_ms or 0.0), max_error, min_psnr)
 
-    def _rival(self, choice: Selection, max_error=None, min_psnr=None) -> Selection:
-        """``choice`` (the nodes' best at a level), or the amortized option predicted faster
-        than it at the same level."""
-        options = self._admissible(max_error, min_psnr)
-        if options and options[0].predicted_ms < choice.predicted_ms:
-            return options[0]
-        return choice
 
-    def _estimator_psnr(self, choice: Selection):
-        part = choice.parts[0]
-        model = self.estimator(part.estimator).model(part.history)
-        return model.psnr if model is not None else None
-
-    def write_variant(self, choice: Selection, out_dir, work=None) -> list[str]:
-        """Write the shader files of ``choice`` into ``out_dir``: the variant's passes and
-        ``manifest.json`` (recording the period and every cache option it runs with); for the
-        original shader only a ``manifest.json`` saying so. The shader is loaded again (unless
-        ``work`` is the profiled one) and must still have the profiled hash
-        (:func:`rrcache.profiles.choice.write`, the one writer of a profile's choices)."""
-        from rrcache.profiles.choice import write
-
-        return write(self, choice, out_dir, work)
 
     # ------------------------------------------------------------------ the document
     def to_json(self) -> dict:
@@ -533,31 +383,6 @@ class Profile:
         return f"Profile({self.shader!r}, {len(self.trained_nodes)}/{len(self.nodes)} nodes trained, {ms})"
 
 
-def speedup_range(original_ms: float, predicted_ms: float, residual_ms: float, noise: float) -> tuple:
-    """The range of a predicted speed-up ``original_ms / predicted_ms``: the performance fit's
-    residual (ms) on the predicted time and the timing noise (the original's relative spread
-    over repeated timings of the same frame, :attr:`Profile.timing_noise`), in quadrature, as a
-    relative error k of the predicted time: (S / (1 + k), S / (1 − k)); () when k ≥ 1 (no finite
-    upper bound). On a loaded machine (noise 0.37) a fresh-clone Marble e1 was predicted 2.9×
-    (4.58× before the original's time was taken from the same timing runs) and measured 2.48×:
-    the range with the noise, 2.1–4.9×, holds it; the residual's alone did not.
-
-    >>> [round(x, 2) for x in speedup_range(100.0, 50.0, 5.0, 0.0)]
-    [1.82, 2.22]
-    >>> [round(x, 2) for x in speedup_range(100.0, 50.0, 5.0, 0.3)]
-    [1.52, 2.92]
-    >>> speedup_range(100.0, 50.0, 60.0, 0.0)
-    ()
-    """
-    if not predicted_ms > 0 or not math.isfinite(original_ms):
-        return ()
-    k = math.hypot(residual_ms / predicted_ms, noise if math.isfinite(noise) else 0.0)
-    if k >= 1.0:
-        return ()
-    return (original_ms / (predicted_ms * (1.0 + k)), original_ms / (predicted_ms * (1.0 - k)))
-
-
-# ---------------------------------------------------------------------- the declared shape
 def _document_fields(cls):
     return [f for f in dataclasses.fields(cls) if f.metadata.get("document", True)]
 
@@ -788,8 +613,12 @@ def filter_text(chosen: str, times) -> str:
 
 
 def algorithm_line(prof: Profile) -> str:
-    """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
-    0.377, three-pass 0.41 of the original's time)'."""
+    """The profile's algorithm, and with ``auto`` how it was decided: 'two-pass (auto, from the
+    ceiling: two-pass 1.47× against three-pass 0.85× ...)', or what a timing measured
+    ('two-pass (auto: two-pass 0.377, three-pass 0.41 of the original's time)')."""
+    reason = (prof.plan or {}).get("algorithm_reason")
+    if prof.settings.algorithm == "auto" and reason:
+        return f"{prof.algorithm} (auto, from {reason})"
     times = prof.algorithm_times or {}
     if prof.settings.algorithm != "auto" or not times:
         return prof.algorithm

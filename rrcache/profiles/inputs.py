@@ -16,6 +16,7 @@ machine's files. So a file the document names is opened only if it is what the d
 """
 from __future__ import annotations
 
+import json
 import os
 
 from rrcache.errors import RRCacheError, printable
@@ -55,6 +56,20 @@ def shader_source(prof) -> str:
                            "not the profiled one, so none of it is shown)", printable(path),
                            hint="run 'rrcache profile' again, or restore the file")
     return got.data.decode("utf-8", "replace")
+
+
+def session_document(prof) -> dict:
+    """The profile's session file as JSON (a ``.json`` file, read by the rule within the
+    document budget), for the figures a report shows of it; :class:`RRCacheError` when it is not
+    one (nothing of its content is quoted)."""
+    from rrcache.budgets import budget
+
+    path = _named(prof, "session", prof.session, (".json",))
+    try:
+        return json.loads(read_file(path, budget.document_bytes).data)
+    except (Refused, ValueError):
+        raise RRCacheError("the session the profile names cannot be read as JSON", printable(path),
+                           hint=_HINT) from None
 
 
 def check_inputs(prof) -> None:

@@ -7,9 +7,10 @@ refresh pattern, depth epsilon, validation frames) are hashed into the key of th
 ``budget_s`` and ``validate`` only decide how much is done, so they are left out of the key and
 may change between a run and its resumption.
 
-The error is measured over the first ``frames`` consecutive frames (default 64: the steady state
-of the largest paper period, 50, plus 14 frames) at the session's full resolution, inside a
-window of the frame chosen from the original's cost (:mod:`rrcache.profiler.plan`), or at an
+The error is measured over ``frames`` frames of the session (default 150: all of a session of
+up to 150 frames, as validation measures it; a longer one in segments spread over it,
+:func:`rrcache.profiler.plan.error_segments`) at the session's full resolution, inside a window
+of the frame chosen from the original's CPU time (:mod:`rrcache.profiler.plan`), or at an
 explicit reduced ``resolution`` (errors are then larger: the resampling blur grows with the
 pixel size). The times are measured on ``timing_frames`` frames at the session's full
 resolution.
@@ -34,6 +35,7 @@ from typing import Optional
 
 from rrcache.errors import RRCacheError
 from rrcache.gl.formats import COLOR_FORMATS
+from rrcache.harness.timing import CLOCKS, DEFAULT_CLOCK
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH,
                              FILTERS, REFRESH_MODES)
 
@@ -47,8 +49,9 @@ DEFAULT_ALGORITHM = "three-pass"
 DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
 #: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
 DEFAULT_TIMING_PERIODS = (2, 8, 50)
-#: consecutive frames of the error runs when the session has that many
-DEFAULT_TRAINING_FRAMES = 64
+#: frames of the error runs when the session has that many (all of a session up to this long,
+#: as validation measures; rrcache.profiler.plan)
+DEFAULT_TRAINING_FRAMES = 150
 #: the fields that do not change a measurement (left out of the store key)
 UNKEYED = ("budget_s", "validate", "min_saving", "min_gain", "levels", "max_sets")
 #: how the four selection levels are chosen
@@ -85,8 +88,8 @@ class TrainingSettings:
     - ``error_window``: the share of the frame's area the error runs render (1: all of it);
       None: chosen from the original's cost (:mod:`rrcache.profiler.plan`). Only at the
       session's resolution.
-    - ``frames``: the first N consecutive session frames of the error runs; None: 64 (or all,
-      when the session is shorter).
+    - ``frames``: N frames of the error runs, spread over the session in segments
+      (:func:`rrcache.profiler.plan.error_segments`); None: 150 (all of a shorter session).
     - ``timing_frames``: L, the frames timed per node and timing period (spread evenly).
     - ``timing_periods``: the periods at which each node is timed.
     - ``algorithm``, ``block``, ``refresh``, ``depth_epsilon``: the cache's own settings.
@@ -110,6 +113,10 @@ class TrainingSettings:
       largest error seen).
     - ``max_sets``: at most this many sets of several cached nodes, each at its own period, are
       trained after the single nodes (:mod:`rrcache.profiler.sets`); 0 trains none.
+    - ``clock``: the frame clock of every timed run (:data:`rrcache.harness.timing.CLOCKS`):
+      ``wall`` (the default; wall time around ``ctx.finish()``) or ``gl-timer`` (GL timer
+      queries, for real GPUs). Keyed (another clock measures other times), except at its
+      default, so stores trained before the clock was recorded keep their key.
     - ``filter``: the cache's hit test and payload reconstruction; ``auto`` (the default)
       measures ``bilinear`` against ``plane`` on the first node to train and keeps ``plane``
       where it was faster at about the same PSNR (:mod:`rrcache.profiler.filters`; the choice is
@@ -138,6 +145,8 @@ class TrainingSettings:
     levels: str = "psnr"
     #: the sets of cached nodes (k >= 2) the set stage trains at most (rrcache.profiler.sets); 0: none
     max_sets: int = 3
+    #: the frame clock of the timed runs (rrcache.harness.timing.CLOCKS)
+    clock: str = DEFAULT_CLOCK
     #: the cache's hit test and payload reconstruction: ``auto`` measures ``bilinear`` against
     #: ``plane`` on the first node (rrcache.profiler.filters), or one of rrcache.runtime.glsl.FILTERS
     filter: str = "auto"
@@ -202,6 +211,8 @@ class TrainingSettings:
             raise _fail("max_sets", f"{self.max_sets!r} is not a count of sets in [0, 64]", "the default is 3; 0 trains none")
         if self.levels not in LEVEL_KINDS:
             raise _fail("levels", f"unknown levels {self.levels!r}", f"one of {', '.join(LEVEL_KINDS)}")
+        if self.clock not in CLOCKS:
+            raise _fail("clock", f"unknown frame clock {self.clock!r}", f"one of {', '.join(sorted(CLOCKS))}")
         if self.filter not in FILTER_CHOICES:
             raise _fail("filter", f"unknown filter {self.filter!r}", f"one of {', '.join(FILTER_CHOICES)}")
         if self.timing_format not in COLOR_FORMATS:
@@ -273,6 +284,8 @@ class TrainingSettings:
     def key_json(self) -> str:
         """The canonical JSON of the keyed fields (everything but :data:`UNKEYED`)."""
         data = {k: v for k, v in self.to_json().items() if k not in UNKEYED}
+        if data.get("clock") == DEFAULT_CLOCK:  # as stores written before the clock was a setting
+            del data["clock"]
         if data.get("filter") == "auto":  # the default keys as before it existed: older stores resume
             del data["filter"]
         if not data.get("measure_terms"):

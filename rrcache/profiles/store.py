@@ -1,8 +1,15 @@
 """The profile store: a versioned SQLite file of every training measurement.
 
-In the manner of coverage.py's data file: the schema is one commented string (:data:`SCHEMA`), a
-``meta`` table names what the file belongs to, and nothing in a file is trusted before it is
-checked. A store is keyed by (shader hash, session hash, settings hash, rrcache version); opening
+In the manner of coverage.py's data file: the schema is one commented string
+(:data:`rrcache.profiles.schema.SCHEMA`: the store's own tables and each kind of choice's,
+:attr:`rrcache.kinds.base.Kind.tables`, put together there, with the upgrades), a ``meta`` table names what the file belongs to, and nothing in a file is trusted before it
+is checked. Opening a store to write upgrades an older schema in place, in one transaction
+(schema 1: a validation's node and period in two columns; schema 2: the set stage's record in
+``meta('sets')`` and an amortization table made when first written, perhaps without its history
+column); reading one (:func:`read_store`) changes nothing.
+
+Only the collector of a profile's runs writes the measurements (:mod:`rrcache.profiler.collect`:
+``add_node_result``, ``add_amortize_result``, ``add_set_run``, ``add_adaptive_point`` …). A store is keyed by (shader hash, session hash, settings hash, rrcache version); opening
 it with another key is refused with the differences named (use another ``--out``, or ``--fresh``,
 which moves the old file aside as ``profile.sqlite.bak``). A damaged file (``PRAGMA
 integrity_check``) or a foreign SQLite file (no ``meta`` table, or another schema) is refused too.
@@ -27,187 +34,12 @@ from typing import Iterable, Optional
 from rrcache.atomic import OutputFolder
 from rrcache.errors import RRCacheError
 from rrcache.files import Refused, open_file
+from rrcache.profiles.schema import (StoreKey, _FRESH_HINT, _JSON_META, _KEYS, _MIGRATIONS, _RANGES,  # noqa: F401
+                                     _SIDE_FILES, _STORED_RANGES, _TABLES, _TEXT_KEYS,
+                                     _VALIDATION_COLUMNS, AMORTIZE_COLUMNS, BASE_SCHEMA, READABLE, SCHEMA,
+                                     SCHEMA_VERSION, STORE_NAME, _columns, _count, _kinds_schema, _out_of_range,
+                                     _refuse, _set_records, _statements, _table_name, _upgrade)
 from rrcache.selection import Selection, parts_from_json, parts_to_json
-
-SCHEMA_VERSION = 2
-#: the files SQLite keeps beside the store (write-ahead log, shared memory, rollback journal)
-_SIDE_FILES = ("-wal", "-shm", "-journal")
-#: the store's file name in a profile folder
-STORE_NAME = "profile.sqlite"
-
-SCHEMA = """\
--- rrcache profile store; the schema version is in meta('schema_version').
---
--- meta: what the file belongs to. Keys: schema_version, rrcache_version, shader_hash,
---   session_hash, settings_json, settings_hash, created, updated (unix seconds); and, once the
---   first run has chosen them, plan: JSON of the error and timing windows (rrcache.profiler.plan),
---   kept so that a resumed run renders exactly what the first one did.
---   sets: JSON of the sets of cached nodes the set stage trained (rrcache.profiler.sets).
-CREATE TABLE meta (
-    key TEXT PRIMARY KEY,
-    value TEXT NOT NULL
-);
-
--- run_log: one row per `profile` invocation; the counters say what it computed and what it
---   found already stored (a resumed run skips every stored run). status: running, done,
---   interrupted, failed.
-CREATE TABLE run_log (
-    id INTEGER PRIMARY KEY AUTOINCREMENT,
-    started REAL NOT NULL,
-    finished REAL,
-    status TEXT NOT NULL,
-    error_runs_computed INTEGER NOT NULL DEFAULT 0,
-    error_runs_skipped INTEGER NOT NULL DEFAULT 0,
-    timing_runs_computed INTEGER NOT NULL DEFAULT 0,
-    timing_runs_skipped INTEGER NOT NULL DEFAULT 0
-);
-
--- reference: the original shader over the training frames at the training resolution
---   (covered pixels per frame); its images are kept in memory only.
-CREATE TABLE reference_frame (
-    frame INTEGER PRIMARY KEY,
-    covered INTEGER NOT NULL
-);
-
--- error_run: one node cached at one refresh period, rendered over the training frames in order
---   from an empty cache. mean_error is the mean over the frames after the first (which has no
---   cache) of each frame's mean RGB L2 error over covered pixels; hit_rate = hits / (hits +
---   misses) over the same frames. wall_s: seconds the run took (counts against the budget).
-CREATE TABLE error_run (
-    node TEXT NOT NULL,
-    period INTEGER NOT NULL,
-    mean_error REAL NOT NULL,
-    psnr REAL NOT NULL,
-    hit_rate REAL NOT NULL,
-    hits INTEGER NOT NULL,
-    misses INTEGER NOT NULL,
-    covered INTEGER NOT NULL,
-    frames INTEGER NOT NULL,
-    wall_s REAL NOT NULL,
-    run_id INTEGER NOT NULL REFERENCES run_log(id),
-    PRIMARY KEY (node, period)
-);
-
--- error_frame: the frames of an error run (psnr is capped at 100 dB for identical frames).
-CREATE TABLE error_frame (
-    node TEXT NOT NULL,
-    period INTEGER NOT NULL,
-    frame INTEGER NOT NULL,
-    mean_error REAL NOT NULL,
-    psnr REAL NOT NULL,
-    hits INTEGER NOT NULL,
-    misses INTEGER NOT NULL,
-    covered INTEGER NOT NULL,
-    left_out INTEGER NOT NULL,
-    PRIMARY KEY (node, period, frame)
-);
-
--- timing_run / timing_frame: one node at one timing period over the L timing frames at the
---   session's full resolution. Each timed frame follows one untimed warm-up frame (the one
---   before it) and is timed right after the original on the same frame (original_ms), so that
---   machine noise touches both alike.
-CREATE TABLE timing_run (
-    node TEXT NOT NULL,
-    period INTEGER NOT NULL,
-    wall_s REAL NOT NULL,
-    run_id INTEGER NOT NULL REFERENCES run_log(id),
-    PRIMARY KEY (node, period)
-);
-CREATE TABLE timing_frame (
-    node TEXT NOT NULL,
-    period INTEGER NOT NULL,
-    frame INTEGER NOT NULL,
-    hits INTEGER NOT NULL,
-    misses INTEGER NOT NULL,
-    ms REAL NOT NULL,
-    original_ms REAL NOT NULL,
-    PRIMARY KEY (node, period, frame)
-);
-
--- reference_timing: the original's ms per frame on the timing frames (full resolution),
---   measured once before any node, with the covered pixels M.
-CREATE TABLE reference_timing (
-    frame INTEGER PRIMARY KEY,
-    ms REAL NOT NULL,
-    covered INTEGER NOT NULL
-);
-
--- overhead: the cached pipeline's frame time with almost nothing covered (the variant of
---   `node` rendered at a tiny resolution; geometry still processed): median ms over `frames`.
-CREATE TABLE overhead (
-    id INTEGER PRIMARY KEY CHECK (id = 1),
-    node TEXT NOT NULL,
-    width INTEGER NOT NULL,
-    height INTEGER NOT NULL,
-    frames INTEGER NOT NULL,
-    ms REAL NOT NULL
-);
-
--- validation: a selection (label e1..e4 at max_error) rendered beside the original at full
---   resolution; predicted figures from the models, measured ones from the render. parts: what is
---   cached, as the JSON list of rrcache.selection.parts_to_json ([] = the original shader:
---   nothing rendered, error 0, speed-up 1); algorithm: the cache algorithm it ran with.
-CREATE TABLE validation (
-    label TEXT PRIMARY KEY,
-    max_error REAL NOT NULL,
-    parts TEXT NOT NULL,
-    algorithm TEXT,
-    predicted_error REAL NOT NULL,
-    predicted_ms REAL NOT NULL,
-    predicted_speedup REAL NOT NULL,
-    measured_error REAL NOT NULL,
-    measured_psnr REAL NOT NULL,
-    measured_ms REAL NOT NULL,
-    measured_original_ms REAL NOT NULL,
-    measured_speedup REAL NOT NULL,
-    hit_rate REAL NOT NULL,
-    frames INTEGER NOT NULL
-);
-"""
-
-_VALIDATION_COLUMNS = ("label", "max_error", "parts", "algorithm", "predicted_error", "predicted_ms",
-                       "predicted_speedup", "measured_error", "measured_psnr", "measured_ms", "measured_original_ms",
-                       "measured_speedup", "hit_rate", "frames")
-
-_TABLES = ("meta", "run_log", "reference_frame", "error_run", "error_frame", "timing_run", "timing_frame",
-           "reference_timing", "overhead", "validation")
-
-
-@dataclass(frozen=True)
-class StoreKey:
-    """What a store belongs to; two stores with different keys never mix measurements."""
-
-    shader_hash: str
-    session_hash: str
-    settings_hash: str
-    rrcache_version: str
-    settings_json: str = "{}"
-
-    def compare(self, meta: dict) -> list[str]:
-        """The differences against a store's ``meta`` rows, in words (empty: the same key)."""
-        names = (("shader_hash", "shader"), ("session_hash", "session"), ("settings_hash", "training settings"),
-                 ("rrcache_version", "rrcache version"))
-        out = []
-        for field_name, words in names:
-            mine, theirs = getattr(self, field_name), meta.get(field_name)
-            if mine != theirs:
-                if field_name == "settings_hash":
-                    out.append(f"the {words} differ ({_settings_diff(self.settings_json, meta.get('settings_json'))})")
-                elif field_name == "rrcache_version":
-                    out.append(f"the {words} differs (stored {theirs}, running {mine})")
-                else:
-                    out.append(f"the {words} differs (hash stored {str(theirs)[:12]}, now {mine[:12]})")
-        return out
-
-
-def _settings_diff(mine: str, theirs: Optional[str]) -> str:
-    try:
-        a, b = json.loads(mine), json.loads(theirs or "{}")
-    except ValueError:
-        return "unreadable stored settings"
-    keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
-    return ", ".join(f"{k}: stored {b.get(k)!r}, now {a.get(k)!r}" for k in keys) or "same values, other hash"
-
 
 @dataclass
 class ErrorRun:
@@ -241,73 +73,6 @@ class TimingFrame:
     misses: int
     ms: float
     original_ms: float
-
-
-_INF = float("inf")
-_REAL, _INT = "number", "integer"
-#: the columns a stored row must keep in range: (kind, low, high); None: no bound
-_RANGES: dict[str, dict[str, tuple]] = {
-    "error_run": {"period": (_INT, 1, None), "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None),
-                  "hit_rate": (_REAL, 0.0, 1.0), "hits": (_INT, 0, None), "misses": (_INT, 0, None),
-                  "covered": (_INT, 0, None), "frames": (_INT, 0, None), "wall_s": (_REAL, 0.0, None)},
-    "error_frame": {"frame": (_INT, 0, None), "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None),
-                    "hits": (_INT, 0, None), "misses": (_INT, 0, None), "covered": (_INT, 0, None),
-                    "left_out": (_INT, 0, None)},
-    "timing_frame": {"period": (_INT, 1, None), "frame": (_INT, 0, None), "hits": (_INT, 0, None),
-                     "misses": (_INT, 0, None), "ms": (_REAL, 0.0, None), "original_ms": (_REAL, 0.0, None)},
-    "reference_timing": {"frame": (_INT, 0, None), "ms": (_REAL, 0.0, None), "covered": (_INT, 0, None)},
-    "overhead": {"width": (_INT, 1, None), "height": (_INT, 1, None), "frames": (_INT, 1, None),
-                 "ms": (_REAL, 0.0, None)},
-    "validation": {"max_error": (_REAL, 0.0, None), "period": (_INT, 1, None), "predicted_error": (_REAL, 0.0, None),
-                   "predicted_ms": (_REAL, 0.0, None), "predicted_speedup": (_REAL, 0.0, None),
-                   "measured_error": (_REAL, 0.0, None), "measured_psnr": (_REAL, None, None),
-                   "measured_ms": (_REAL, 0.0, None), "measured_original_ms": (_REAL, 0.0, None),
-                   "measured_speedup": (_REAL, 0.0, None), "hit_rate": (_REAL, 0.0, 1.0), "frames": (_INT, 0, None)},
-}
-#: what :meth:`ProfileStore.check_stored` checks besides :data:`_RANGES` when a run resumes on a
-#: store: the tables of no reader's range check, and the columns that key a run
-_STORED_RANGES: dict[str, dict[str, tuple]] = {
-    "reference_frame": {"frame": (_INT, 0, None), "covered": (_INT, 0, None)},
-    "timing_run": {"period": (_INT, 1, None), "wall_s": (_REAL, 0.0, None)},
-    "amortize_run": {"samples": (_INT, 1, None), "blend": (_REAL, 0.0, 1.0), "frame": (_INT, -1, None),
-                     "mean_error": (_REAL, 0.0, None), "psnr": (_REAL, None, None), "hit_rate": (_REAL, 0.0, 1.0),
-                     "hits": (_INT, 0, None), "misses": (_INT, 0, None), "ms": (_REAL, 0.0, None),
-                     "original_ms": (_REAL, 0.0, None), "wall_s": (_REAL, 0.0, None)},
-}
-#: the text columns that name what a row is about (never empty)
-_TEXT_KEYS = {"error_run": ("node",), "error_frame": ("node",), "timing_run": ("node",), "timing_frame": ("node",),
-              "overhead": ("node",), "validation": ("label", "parts"), "amortize_run": ("estimator", "kind")}
-#: the meta keys that hold JSON (a store's own records of the run)
-_JSON_META = ("plan", "sets", "validation_figures")
-#: the columns that name a row in an error message
-_KEYS = ("node", "period", "frame", "label", "estimator", "samples")
-
-
-def _out_of_range(value, kind: str, low, high) -> Optional[str]:
-    """Why ``value`` does not fit (None: it fits). NULL is allowed only where the schema allows
-    it (``validation.node/period``: the original shader)."""
-    if value is None:
-        return None if kind == _INT else "is missing"
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return f"is not {'an' if kind[0] in 'aeiou' else 'a'} {kind}"
-    if kind == _INT and not isinstance(value, int):
-        return "is not an integer"
-    if isinstance(value, float) and value != value:
-        return "is not a number (NaN)"
-    if isinstance(value, float) and value in (_INF, -_INF) and not (low is None and high is None):
-        return "is infinite"
-    if low is not None and value < low:
-        return f"is below {low}"
-    if high is not None and value > high:
-        return f"is above {high}"
-    return None
-
-
-def _refuse(path: Path, message: str, hint: str) -> RRCacheError:
-    return RRCacheError(message, str(path), hint=hint)
-
-
-_FRESH_HINT = "use another --out folder, or --fresh to move this file aside as profile.sqlite.bak"
 
 
 class ProfileStore:
@@ -398,7 +163,7 @@ class ProfileStore:
         try:
             conn.execute("PRAGMA journal_mode=WAL")
             conn.execute("BEGIN")
-            for statement in _statements(SCHEMA):
+            for statement in _statements(BASE_SCHEMA + _kinds_schema()):
                 conn.execute(statement)
             now = repr(time.time())
             meta = {"schema_version": str(SCHEMA_VERSION), "rrcache_version": key.rrcache_version,
@@ -426,9 +191,8 @@ class ProfileStore:
         except sqlite3.DatabaseError as err:
             raise _refuse(path, f"an SQLite file that is not a profile store ({err})", _FRESH_HINT) from None
         version = meta.get("schema_version")
-        if version in _MIGRATIONS and "validation" in tables:
-            _MIGRATIONS[version](self.conn)
-            version = str(SCHEMA_VERSION)
+        while version in _MIGRATIONS and "validation" in tables:
+            version = _upgrade(self.path, self.conn, version)
         if version != str(SCHEMA_VERSION):
             raise _refuse(path, f"profile store schema {version!r}, this rrcache reads schema {SCHEMA_VERSION}"
                           if version else "an SQLite file that is not a profile store (no schema version)", _FRESH_HINT)
@@ -440,6 +204,14 @@ class ProfileStore:
             raise _refuse(path, "the profile store was made for other inputs: " + "; ".join(differences), _FRESH_HINT)
         self.check_stored(meta)
         self.conn.execute("PRAGMA journal_mode=WAL")
+        self._kind_tables()
+
+    def _kind_tables(self) -> None:
+        """The tables of a kind registered since the store was made (a plug-in), created empty."""
+        have = {r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        wanted = [st for st in _statements(_kinds_schema()) if _table_name(st) not in have]
+        if wanted:
+            self._write([(st, ()) for st in wanted])
 
     # ------------------------------------------------------------------ transactions
     def _write(self, statements: Iterable[tuple[str, tuple]]) -> sqlite3.Cursor:
@@ -469,6 +241,12 @@ class ProfileStore:
                           "free disk space or make the folder writable; what was stored before is kept, "
                           "and running the same command again resumes") from None
         return last
+
+    def write(self, statements: Iterable[tuple[str, tuple]]) -> None:
+        """Run ``statements`` (SQL, arguments) in one transaction: how a kind of choice's
+        collector writes its own table (:meth:`rrcache.kinds.base.Kind.collect`); a failed write
+        is refused as every write is."""
+        self._write(list(statements))
 
     def begin_run(self) -> int:
         """Log the start of a ``profile`` invocation; its id tags what it computes."""
@@ -516,10 +294,12 @@ class ProfileStore:
         self._write([("INSERT OR REPLACE INTO reference_timing VALUES (?, ?, ?)", (int(f), float(ms), int(c)))
                      for f, ms, c in rows])
 
-    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float) -> None:
-        """One timing run and its frames, in one transaction."""
+    def add_timing_run(self, node: str, period: int, frames: list[TimingFrame], wall_s: float,
+                       host: Optional[str] = None) -> None:
+        """One timing run and its frames (``host``: the machine that timed it), in one transaction."""
         rid = self._rid()
-        statements = [("INSERT INTO timing_run VALUES (?, ?, ?, ?)", (node, int(period), float(wall_s), rid))]
+        statements = [("INSERT INTO timing_run(node, period, wall_s, run_id, host) VALUES (?, ?, ?, ?, ?)",
+                       (node, int(period), float(wall_s), rid, host))]
         statements += [("INSERT INTO timing_frame VALUES (?, ?, ?, ?, ?, ?, ?)",
                         (node, int(period), f.frame, f.hits, f.misses, f.ms, f.original_ms)) for f in frames]
         statements.append(("UPDATE run_log SET timing_runs_computed = timing_runs_computed + 1 WHERE id = ?", (rid,)))
@@ -686,6 +466,100 @@ class ProfileStore:
                                  algorithm=algorithm).with_measurement(*figures[3:]))
         return out
 
+    # ------------------------------------------------------------------ the kinds' runs
+    def add_node_result(self, result) -> None:
+        """A node's error or timing run (a :class:`rrcache.runs.RunResult` keyed ``("node", id,
+        period)``): the run and its frames, in one transaction."""
+        _, node, period = result.spec.key
+        rows = result.frames
+        if result.spec.measure == "error":
+            frames = [ErrorFrame(r.frame, float(r.error), float(r.psnr), _count(r.hits), _count(r.misses),
+                                 int(r.covered), int(r.left_out)) for r in rows]
+            steady = frames[1:] or frames
+            hits, misses = sum(f.hits for f in steady), sum(f.misses for f in steady)
+            run = ErrorRun(node, int(period), float(sum(f.mean_error for f in steady) / max(1, len(steady))),
+                           float(sum(f.psnr for f in steady) / max(1, len(steady))),
+                           hits / (hits + misses) if hits + misses else 0.0, hits, misses,
+                           sum(f.covered for f in steady), len(frames), float(result.wall_s))
+            self.add_error_run(run, frames)
+        else:
+            self.add_timing_run(node, int(period), [TimingFrame(r.frame, _count(r.hits), _count(r.misses), float(r.ms),
+                                                                float(r.original_ms)) for r in rows],
+                                float(result.wall_s), result.host)
+
+    def has_node_run(self, measure: str, node: str, period: int) -> bool:
+        return (self.has_error_run if measure == "error" else self.has_timing_run)(node, period)
+
+    def add_amortize_rows(self, rows: list[tuple]) -> None:
+        """Rows of ``amortize_run`` (in :data:`AMORTIZE_COLUMNS` order), in one transaction."""
+        self._write([(f"INSERT OR REPLACE INTO amortize_run ({', '.join(AMORTIZE_COLUMNS)}) VALUES "
+                      f"({', '.join('?' * len(AMORTIZE_COLUMNS))})", tuple(r)) for r in rows])
+
+    def amortize_rows(self, estimator: str, kind: str, history: str = "blend") -> list[dict]:
+        """The stored ``amortize_run`` rows of ``estimator`` of ``kind`` (``error`` or ``timing``)
+        and ``history`` (``blend``, ``slots``, ``slots/u8``; a schema-2 table without the history
+        column has blend rows only)."""
+        if not self._has_table("amortize_run"):
+            return []
+        try:
+            if "history" not in _columns(self.conn, "amortize_run"):
+                if history != "blend":
+                    return []
+                cur = self.conn.execute("SELECT *, 'blend' AS history FROM amortize_run WHERE estimator = ? AND "
+                                        "kind = ? ORDER BY samples, blend, frame", (estimator, kind))
+            else:
+                cur = self.conn.execute("SELECT * FROM amortize_run WHERE estimator = ? AND kind = ? AND history = ? "
+                                        "ORDER BY samples, blend, frame", (estimator, kind, history))
+            names = [d[0] for d in cur.description]
+            return [dict(zip(names, r)) for r in cur.fetchall()]
+        except sqlite3.DatabaseError as err:
+            raise _refuse(self.path, f"the profile store is damaged ({err})", _FRESH_HINT) from None
+
+    def amortize_spent_s(self) -> float:
+        """Seconds the stored amortization runs took (they count against the training budget)."""
+        if not self._has_table("amortize_run"):
+            return 0.0
+        return float(self.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM amortize_run").fetchone()[0])
+
+    def add_set_run(self, record: dict) -> None:
+        """The set stage's record of one set (``nodes``, ``periods``, the prediction and what its
+        runs measured: :meth:`rrcache.model.sets.SetOption.to_json`), replacing an earlier one."""
+        self._write([("INSERT OR REPLACE INTO set_run(nodes, periods, record) VALUES (?, ?, ?)",
+                      (json.dumps(list(record["nodes"])), json.dumps([int(p) for p in record["periods"]]),
+                       json.dumps(record)))])
+
+    def set_runs(self) -> list[dict]:
+        """The set stage's records (a schema-2 store's from ``meta('sets')``)."""
+        if not self._has_table("set_run"):
+            return _set_records(self.meta().get("sets"))
+        out = []
+        for (raw,) in self.conn.execute("SELECT record FROM set_run ORDER BY rowid"):
+            out.extend(_set_records(f"[{raw}]"))
+        return out
+
+    def add_adaptive_point(self, point, algorithm: str, wall_s: float) -> None:
+        """One measured adaptive threshold (:class:`rrcache.profiler.adaptive.AdaptivePoint`)."""
+        self._write([("INSERT OR REPLACE INTO adaptive_point VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                      (point.node, int(point.period), float(point.threshold), int(point.fast_period), algorithm,
+                       float(point.error), float(point.psnr), float(point.time_ratio), float(point.hit_rate),
+                       json.dumps([float(v) for v in point.speedups]), float(wall_s)))])
+
+    def adaptive_points(self, node: Optional[str] = None) -> list[dict]:
+        """The stored adaptive points (of ``node``), by node, period and threshold."""
+        if not self._has_table("adaptive_point"):
+            return []
+        cur = self.conn.execute("SELECT * FROM adaptive_point" + (" WHERE node = ?" if node else "")
+                                + " ORDER BY node, period, threshold", (node,) if node else ())
+        names = [d[0] for d in cur.description]
+        rows = [dict(zip(names, r)) for r in cur.fetchall()]
+        for r in rows:
+            r["speedups"] = tuple(json.loads(r["speedups"]))
+        return rows
+
+    def _has_table(self, name: str) -> bool:
+        return self.conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?",
+                                 (name,)).fetchone() is not None
+
     def spent_s(self) -> float:
         """Training seconds stored so far (error and timing runs): what the budget has spent."""
         a = self.conn.execute("SELECT COALESCE(SUM(wall_s), 0) FROM error_run").fetchone()[0]
@@ -724,41 +598,6 @@ class ProfileStore:
         self.close()
 
 
-def _migrate_1(conn: sqlite3.Connection) -> None:
-    """Schema 1 → 2 in one transaction: the validation rows' ``node``/``period`` columns become
-    ``parts`` (the algorithm was not recorded: NULL)."""
-    conn.execute("BEGIN IMMEDIATE")
-    try:
-        old = conn.execute("SELECT label, max_error, node, period, predicted_error, predicted_ms, predicted_speedup, "
-                           "measured_error, measured_psnr, measured_ms, measured_original_ms, measured_speedup, "
-                           "hit_rate, frames FROM validation").fetchall()
-        conn.execute("DROP TABLE validation")
-        table = SCHEMA[SCHEMA.index("CREATE TABLE validation"):]
-        conn.execute(table[:table.index(";")])
-        for label, max_error, node, period, *figures in old:
-            parts = [] if node is None else [{"kind": "cache", "node": node, "period": int(period)}]
-            conn.execute(f"INSERT INTO validation({', '.join(_VALIDATION_COLUMNS)}) VALUES "
-                         f"({', '.join('?' * len(_VALIDATION_COLUMNS))})",
-                         (label, max_error, json.dumps(parts), None, *figures))
-        conn.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
-        conn.execute("COMMIT")
-    except BaseException:
-        if conn.in_transaction:
-            conn.execute("ROLLBACK")
-        raise
-
-
-#: older schema version -> the function that upgrades a store in place (schema 1 kept a
-#: validation's node and period in two columns; schema 2 keeps its parts)
-_MIGRATIONS = {"1": _migrate_1}
-
-
-def _statements(script: str) -> list[str]:
-    """The statements of :data:`SCHEMA` (comments dropped)."""
-    lines = [line for line in script.splitlines() if not line.lstrip().startswith("--")]
-    return [s.strip() for s in "\n".join(lines).split(";") if s.strip()]
-
-
 def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     """Open an existing store read-only-ish, without a key check (for reports and tests); a file
     that is not a store raises :class:`RRCacheError`."""
@@ -772,10 +611,9 @@ def read_store(path: "str | os.PathLike[str]") -> ProfileStore:
     try:
         tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
         version = dict(conn.execute("SELECT key, value FROM meta")).get("schema_version") if "meta" in tables else None
-        if version in _MIGRATIONS and "validation" in tables:
-            _MIGRATIONS[version](conn)
-            version = str(SCHEMA_VERSION)
-        if version != str(SCHEMA_VERSION):
+        if version == "1" and "validation" in tables:
+            version = _upgrade(path, conn, version)
+        if version not in READABLE:
             raise _refuse(path, "an SQLite file that is not a profile store", _FRESH_HINT)
     except sqlite3.DatabaseError as err:
         conn.close()

@@ -19,6 +19,12 @@ from typing import Optional
 import numpy as np
 
 
+def _plot_label(sel) -> dict:
+    """The chart's ``node`` and ``period`` of a selection (its kind's; the original: none)."""
+    node, period = sel.choice.plot_label(sel) if sel.parts else (None, None)
+    return {"node": node, "period": period}
+
+
 def _num(value) -> Optional[float]:
     """A finite float, or None (JSON has no NaN or infinity)."""
     if value is None:
@@ -51,10 +57,7 @@ def chart_data(prof) -> dict:
             if point[1] < best:
                 front.append(point)
                 best = point[1]
-    selections = [{"label": s.label, "node": "+".join(s.nodes) if s.multi else (s.describe() if s.kind == "amortize"
-                                                                              else s.node),
-                   "period": list(s.periods) if s.multi else (None if s.kind == "amortize" else s.period),
-                   "what": s.describe(),
+    selections = [{"label": s.label, **_plot_label(s), "what": s.describe(),
                    "ms": _num(s.predicted_ms), "error": _num(s.predicted_error)} for s in prof.selections]
     # the amortized estimators' options (estimator, m, λ) on the same axes
     amortized = [[float(o.predicted_ms), float(o.predicted_error), o.describe()] for o in options]

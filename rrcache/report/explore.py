@@ -1,5 +1,5 @@
-"""The notebooks' figures and the interactive profiler widget (``notebooks/explore.ipynb`` and
-``notebooks/interactive.ipynb`` call only this module and :func:`rrcache.profiler.demo_profile`).
+"""The notebooks' figures and HTML pieces, from a profile and its folder only (the interactive
+widget, which renders and measures new choices, is :mod:`rrcache.explorer`).
 
 Figures (matplotlib): :func:`tradeoff_figure` (every node path, the amortized estimators'
 options, the original's time, the Pareto front, the selections), :func:`node_figure` (a node's
@@ -8,32 +8,21 @@ measured errors with the fitted error model, and its predicted frame time over �
 a cached node's or an amortized estimator's). HTML: :func:`source_html` (the shader with a node
 highlighted), :func:`selections_html` (the four selections, predicted against measured).
 
-:class:`Explorer` is the paper's interactive profiler (§4.5): a log-scale slider for the error
-threshold re-selects from the models as it moves (:meth:`Profile.select`, microseconds; the time
-of each re-selection is shown), then shows the chosen node highlighted in the source, its Δn, the
-predicted and measured speed-up and error, a frame with and without the cache side by side, the
-payload and the hit/miss map; a button writes the chosen shader files. A choice that amortizes an
-estimator (m of its N terms per frame, blend λ, history ``blend`` or ``slots``) is shown,
-rendered and measured the same way, its loop highlighted in the source.
-
 >>> prof = demo_profile("demo.rrprofile")          # doctest: +SKIP
->>> Explorer(prof)                                 # doctest: +SKIP
+>>> tradeoff_figure(prof)                          # doctest: +SKIP
 """
 from __future__ import annotations
 
-import asyncio
 import html
 import math
-import threading
 import time
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
 
-from rrcache.errors import RRCacheError
 from rrcache.report.data import read_source, selection_timing  # noqa: F401 (selection_timing re-exported)
-from rrcache.report.images import CAPTIONS, FrameShots  # noqa: F401 (FrameShots re-exported)
+from rrcache.report.images import CAPTIONS, read_frames
 
 
 def _pyplot():
@@ -145,21 +134,29 @@ def images_figure(images):
     return fig
 
 
-def selections_figure(prof, shots: FrameShots):
+def selections_figure(prof, frames: Optional[dict] = None):
     """One row of images per selection (e1..e4; see :func:`images_figure`): the original, a cached
-    node or an amortized estimator (several nodes at once: their description only)."""
+    node or an amortized estimator (several nodes at once: their description only), as the
+    profiler rendered them into the profile folder (``frames``: label → images given instead)."""
+    frames = read_frames(prof.path) if frames is None else frames
     plt = _pyplot()
     names = list(CAPTIONS)
     fig, axes = plt.subplots(len(prof.selections), len(names), figsize=(2.4 * len(names), 2.2 * len(prof.selections)),
                              dpi=100, squeeze=False)
     for row, sel in zip(axes, prof.selections):
-        if sel.multi:  # no frames (the shots render one cached node or one amortized estimator)
+        if sel.parts and not sel.choice.has_frames:  # no frames (several nodes at once)
             for ax in row:
                 ax.axis("off")
             row[0].text(-0.08, 0.5, f"{sel.label}: {sel.describe()}", transform=row[0].transAxes, rotation=90,
                         ha="right", va="center", fontsize=8)
             continue
-        images = shots.selection_images(sel)
+        images = frames.get(sel.label)
+        if images is None:
+            for ax in row:
+                ax.axis("off")
+            row[0].text(-0.08, 0.5, f"{sel.label}: {sel.describe()} (no frames in the folder)",
+                        transform=row[0].transAxes, rotation=90, ha="right", va="center", fontsize=8)
+            continue
         for ax, name in zip(row, names):
             ax.axis("off")
             if name in images.arrays:
@@ -179,7 +176,7 @@ def default_choice(prof) -> tuple:
     Amortized selections are not nodes: :func:`selections_figure` and the :class:`Explorer` show
     them; :func:`default_selection` returns the last selection of any kind."""
     for sel in reversed(prof.selections):
-        if sel.parts and sel.kind == "cache":
+        if sel.parts and sel.choice.one_node:
             return sel.node, int(sel.period)
     node = prof.trained_nodes[0]
     return node.id, int(max(node.periods))
@@ -190,7 +187,7 @@ def default_selection(prof):
     several nodes at once, which have no frames), else the original's selection: what
     :func:`describe_choice` and :meth:`FrameShots.selection_images` show first."""
     for sel in reversed(prof.selections):
-        if sel.parts and not sel.multi:
+        if sel.parts and sel.choice.has_frames:
             return sel
     return prof.selections[0] if prof.selections else None
 
@@ -200,20 +197,7 @@ def describe_choice(prof, choice) -> str:
     frames, or an estimator amortized (m of N terms per frame, blend λ, its history)."""
     if not choice.parts:
         return "<b>the original shader</b>: no variant is predicted faster within this error"
-    if choice.kind == "amortize":
-        part = choice.parts[0]
-        est = next((e for e in prof.estimators if e.id == part.estimator), None)
-        of = f" of {est.samples}" if est is not None else ""
-        loop = f" <code>{html.escape(est.text)}</code>" if est is not None and est.text else ""
-        how = ("its N/m subset sums kept apart (slots history)" if part.history == "slots"
-               else "blended with the reprojected estimate (blend history)")
-        return (f"amortize estimator <b>{html.escape(part.estimator)}</b>{loop}: <b>{part.samples}{of}</b> terms "
-                f"per frame, {how}, <b>λ = {part.blend:g}</b>")
-    if choice.multi:
-        return "cache " + " + ".join(f"<b>{html.escape(n)}</b> every Δn = {p}"
-                                     for n, p in zip(choice.nodes, choice.periods))
-    return (f"cache <b>{html.escape(choice.node)}</b> <code>{html.escape(prof.node(choice.node).text)}</code> "
-            f"every <b>Δn = {choice.period}</b> frames")
+    return choice.choice.sentence_html(choice, prof)
 
 
 # ---------------------------------------------------------------------- HTML pieces
@@ -254,191 +238,9 @@ def selections_html(prof) -> str:
             "pred. speed-up", "meas. speed-up", "PSNR", "hit rate"]
     rows = []
     for s in prof.selections:
-        if s.kind == "amortize":  # an amortized estimator: m of N terms per frame, blend λ
-            node_cell, period_cell = s.describe(), "–"
-        else:
-            node_cell = " + ".join(s.nodes) if s.multi else (s.node or "original")
-            period_cell = " + ".join(str(p) for p in s.periods) if s.multi else (s.period or "–")
+        node_cell, period_cell = s.choice.cells(s) if s.parts else ("original", "–")
         cells = [s.label, _f(s.max_error), node_cell, period_cell, _f(s.predicted_error),
                  _f(s.measured_error), _f(s.predicted_ms), _f(s.measured_ms), _f(s.predicted_speedup, 3),
                  _f(s.measured_speedup, 3), _f(s.measured_psnr, 3), _f(s.hit_rate, 3)]
         rows.append("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>")
     return ("<table><tr>" + "".join(f"<th>{h}</th>" for h in head) + "</tr>" + "".join(rows) + "</table>")
-
-
-# ---------------------------------------------------------------------- measuring a choice
-def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
-                   frames: Optional[int] = None) -> dict:
-    """Render the session with the choice beside the original (:func:`rrcache.harness.cached.compare`,
-    at the session's resolution, the first ``frames`` frames, default the profile's validation
-    frames) and return ``{"error", "psnr", "speedup", "ms", "original_ms", "hit_rate", "frames"}``.
-    The choice is ``node`` cached every ``period`` frames (``node`` None: the original), or
-    ``node`` a :class:`~rrcache.selection.Selection` of any kind with a variant (an amortized
-    estimator included; ``period`` is then not read). A choice the profile validated is not
-    rendered again: its stored figures are returned."""
-    from rrcache.selection import CachedNode, Selection
-
-    if isinstance(node, Selection):
-        choice = node
-        # adaptive refresh is measured as its node at its max age, as before (no adaptive runtime here)
-        node, period = ((choice.node, choice.period) if choice.kind in ("cache", "adaptive", "original")
-                        else (None, None))
-    else:
-        choice = (Selection((CachedNode(node, int(period)),)) if node is not None
-                  else Selection.original(prof.original_ms))
-    for sel in prof.selections:
-        if sel.key == choice.key and sel.measured_error is not None and (sel.parts or sel.frames):
-            return {"error": sel.measured_error, "psnr": sel.measured_psnr, "speedup": sel.measured_speedup,
-                    "ms": sel.measured_ms, "original_ms": sel.measured_original_ms, "hit_rate": sel.hit_rate,
-                    "frames": sel.frames, "stored": True}
-    if not choice.parts:
-        return {"error": 0.0, "psnr": None, "speedup": 1.0, "ms": prof.original_ms, "original_ms": prof.original_ms,
-                "hit_rate": None, "frames": 0, "stored": True}
-    from rrcache.harness.cached import compare
-
-    settings = prof.settings
-    count = min(int(frames or settings.validation_frames or shots.session.frames), int(shots.session.frames))
-    if choice.kind in ("cache", "adaptive"):
-        variant, period = shots.variant(node), int(period)
-    else:  # an amortized estimator (its variant does not use the refresh rule), several nodes
-        variant, period = shots.selection_variant(choice)
-    result = compare(variant, shots.session, shots.work.prepared, range(count), period=period,
-                     **settings.cache_options())
-    return {"error": result.mean_error, "psnr": result.psnr, "speedup": result.speedup, "ms": result.ms_per_frame,
-            "original_ms": result.original_ms_per_frame, "hit_rate": result.hit_rate, "frames": count,
-            "stored": False}
-
-
-# ---------------------------------------------------------------------- the widget
-class Explorer:
-    """The interactive profiler (see the module docstring). ``value`` is the starting threshold
-    (default: the profile's e2 level). Attributes: ``slider``, ``button``, ``choice`` (the last
-    :class:`rrcache.selection.Selection`), ``select_ms`` (the last re-selection's time), ``render_ms``
-    (the last new choice's frames and measurement),
-    ``measured`` (the last choice's measurement), ``written`` (files the button wrote into
-    ``out_dir``, default ``chosen/`` in the profile folder).
-    ``measure=False`` skips rendering the session for choices the profile did not validate."""
-
-    def __init__(self, prof, value: Optional[float] = None, out_dir=None, measure: bool = True,
-                 shots: Optional[FrameShots] = None):
-        import ipywidgets as w
-
-        self.prof = prof
-        self.out_dir = Path(out_dir) if out_dir is not None else Path(prof.path or ".") / "chosen"
-        self.measure = measure
-        self.shots = shots or FrameShots(prof)
-        levels = [s.max_error for s in prof.selections if s.max_error and s.max_error > 0] or [1e-3]
-        lo, hi = math.log10(min(levels) / 10.0), math.log10(max(levels) * 10.0)
-        start = value if value is not None else levels[min(1, len(levels) - 1)]
-        self.slider = w.FloatLogSlider(value=start, base=10, min=lo, max=hi, step=(hi - lo) / 200,
-                                       description="max error", readout_format=".2e", continuous_update=True,
-                                       layout=w.Layout(width="640px"))
-        self.button = w.Button(description="Write shader files", icon="save", button_style="primary",
-                               tooltip=f"write the chosen variant's passes and manifest into {self.out_dir}/",
-                               layout=w.Layout(width="190px"))
-        self.summary = w.HTML()
-        self.source = w.HTML()
-        self.status = w.HTML()
-        self.frames = w.HBox()
-        self.widget = w.VBox([w.HBox([self.slider, self.button]), self.summary, self.frames, self.source,
-                              self.status])
-        self.choice = None
-        self.error: Optional[BaseException] = None
-        self.images = None
-        self.render_ms: Optional[float] = None
-        self.select_ms: Optional[float] = None
-        self.measured: Optional[dict] = None
-        self.written: list = []
-        # GL work must run on the thread that holds the GL context (the one building the widget);
-        # a frontend may deliver widget events on another thread (JupyterLab's kernel subshells)
-        self._thread = threading.current_thread()
-        try:
-            self._loop = asyncio.get_running_loop()  # the kernel's loop, when built in a notebook cell
-        except RuntimeError:
-            self._loop = None
-        self.slider.observe(lambda change: self._on_gl_thread(self.update, change["new"]), names="value")
-        self.button.on_click(lambda _: self._on_gl_thread(self.write_files))
-        self.update(self.slider.value)
-
-    def _on_gl_thread(self, action, *args) -> None:
-        """Run a widget callback on the widget's own thread (handed to its event loop when the event
-        arrives on another thread)."""
-        if threading.current_thread() is self._thread or self._loop is None:
-            self._guarded(action, *args)
-        else:
-            self._loop.call_soon_threadsafe(self._guarded, action, *args)
-
-    def _guarded(self, action, *args):
-        """Run a widget callback; an error shows in the widget (a callback's traceback would
-        otherwise go only to the kernel's log) and the widget keeps working."""
-        try:
-            return action(*args)
-        except Exception as err:  # shown to the user in the widget, not lost in the log
-            import traceback
-
-            self.error = err
-            detail = "" if isinstance(err, RRCacheError) else f"<pre>{html.escape(traceback.format_exc())}</pre>"
-            self.status.value = (f'<span style="color:#b00020">[{html.escape(threading.current_thread().name)}] '
-                                 f'{html.escape(type(err).__name__)}: '
-                                 f"{html.escape(str(err))}</span>{detail}")
-            return None
-
-    def update(self, max_error: float):
-        """Re-select for ``max_error`` and refresh the view (renders only when the choice changes)."""
-        start = time.perf_counter()
-        choice = self.prof.select(max_error)  # a cached node, an amortized estimator or the original
-        self.select_ms = (time.perf_counter() - start) * 1000.0
-        changed = self.choice is None or choice.key != self.choice.key
-        self.choice = choice
-        if changed:  # the predictions show at once; the frames and the measurement follow
-            self.measured = None
-            self._show_summary(max_error, pending=True)
-            start = time.perf_counter()
-            self._show_choice(choice)
-            self.render_ms = (time.perf_counter() - start) * 1000.0
-        self._show_summary(max_error)
-        return choice
-
-    def _show_choice(self, choice) -> None:
-        import ipywidgets as w
-
-        images = self.shots.selection_images(choice)
-        boxes = []
-        for name in CAPTIONS:
-            if name in images.arrays:
-                boxes.append(w.VBox([w.Image(value=images.png(name), format="png",
-                                             width=2 * images.size[0] if images.size[0] <= 200 else images.size[0]),
-                                     w.HTML(f"<small>{html.escape(images.caption(name))}</small>")]))
-        self.frames.children = boxes
-        self.images = images
-        if self.measure or not choice.parts:
-            self.measured = measure_choice(self.prof, choice, None, self.shots)
-        else:
-            self.measured = None
-        shown = choice.parts[0].estimator if choice.kind == "amortize" else (choice.node if choice.parts else None)
-        self.source.value = source_html(self.prof, shown, context=8) if shown else source_html(self.prof)
-
-    def _show_summary(self, max_error: float, pending: bool = False) -> None:
-        c, m = self.choice, self.measured or {}
-        what = describe_choice(self.prof, c)
-        measured = (f"measured over {m.get('frames')} frames{' (stored by the profile)' if m.get('stored') else ''}: "
-                    f"speed-up <b>{_f(m.get('speedup'), 3)}×</b>, error <b>{_f(m.get('error'))}</b>, "
-                    f"PSNR {_f(m.get('psnr'), 3)} dB, hit rate {_f(m.get('hit_rate'), 3)}"
-                    if m else ("rendering and measuring…" if pending else "not measured (measure=False)"))
-        shown = (f"this frame rendered at {self.images.size[0]}×{self.images.size[1]}, frame {self.images.frame}, "
-                 f"with the measurement in {self.render_ms:.0f} ms" if self.images is not None and not pending else "")
-        self.summary.value = (
-            f"<div>max error {max_error:.3g} → {what}<br>"
-            f"predicted: speed-up <b>{_f(c.predicted_speedup, 3)}×</b>, error <b>{_f(c.predicted_error)}</b>, "
-            f"{_f(c.predicted_ms)} ms per frame (original {_f(self.prof.original_ms)} ms)<br>{measured}<br>"
-            f"<small>re-selected in {self.select_ms:.3f} ms from the models; {shown}</small></div>")
-
-    def write_files(self) -> list:
-        """Write the chosen shader files into ``out_dir`` (the button does this)."""
-        self.written = self.prof.write_variant(self.choice, self.out_dir)
-        self.status.value = (f"wrote {len(self.written)} files to <code>{html.escape(str(self.out_dir))}</code>: "
-                             + ", ".join(html.escape(Path(p).name) for p in self.written))
-        return self.written
-
-    def _repr_mimebundle_(self, **kwargs):
-        return self.widget._repr_mimebundle_(**kwargs)

@@ -32,7 +32,7 @@ from rrcache.profiles.document import algorithm_line
 from rrcache.profiles.notices import run_warnings
 from rrcache.report import assets
 from rrcache.report.data import chart_data, node_benefits, node_details, read_source, selection_timing
-from rrcache.report.images import CAPTIONS, FrameShots, data_uri
+from rrcache.report.images import CAPTIONS, data_uri, read_frames
 from rrcache.report.next_steps import next_steps_html
 
 REPORT_NAME = "report.html"
@@ -143,22 +143,11 @@ def _source(prof, lines: list[str]) -> str:
     return legend + '<div class="src">' + "".join(rows) + "</div>"
 
 
-def _amortized_what(prof, sel) -> str:
-    """What an amortized selection does: the estimator, m of N terms per frame, the history and λ."""
-    p = sel.parts[0]
-    est = next((e for e in getattr(prof, "estimators", ()) if e.id == p.estimator), None)
-    of = f" of its {est.samples}" if est is not None else " of its"
-    how = ("each of its N/m subset sums kept apart and blended with its own reprojected value"
-           if p.history == "slots" else "blended with the reprojected estimate")
-    return (f"amortize estimator <b>{_e(p.estimator)}</b>: {p.samples}{of} terms per frame, {how} by "
-            f"λ = {p.blend:g} ({_e(p.history)} history)" + (f" (<code>{_e(p.text)}</code>)" if p.text else ""))
-
-
-def _multi_selection(prof, sel, shots: FrameShots) -> str:
-    """A selection of several nodes: what each caches at which period and its figures (its frames
-    are not rendered here: the report's images show one cached node or one amortized estimator)."""
-    what = "cache " + " + ".join(f"<b>{_e(p.node)}</b> every Δn = {p.period} frames"
-                                 + (f" (<code>{_e(p.text)}</code>)" if p.text else "") for p in sel.parts)
+def _multi_selection(prof, sel, note: str = "several nodes: no frames are shown for this choice") -> str:
+    """A selection shown without frames (a kind without them, several nodes; or a folder without
+    them): what it caches and its figures."""
+    what = (sel.choice.report_html(sel, prof) if sel.parts
+            else "keep the original shader (nothing is predicted faster at this level)")
     rows = [("error (mean RGB L2)", _f(sel.predicted_error), _f(sel.measured_error)),
             ("ms per frame", _f(sel.predicted_ms), _f(sel.measured_ms)),
             ("speed-up", _x(sel.predicted_speedup), _x(sel.measured_speedup)),
@@ -170,8 +159,18 @@ def _multi_selection(prof, sel, shots: FrameShots) -> str:
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e("+".join(sel.nodes))}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
-            '<p class="muted">several nodes: no frames are shown for this choice</p>'
-            f"{next_steps_html(prof, sel, shots.session.resolution)}</div>")
+            f'<p class="muted">{_e(note)}</p>'
+            f"{next_steps_html(prof, sel, _session_size(prof))}</div>")
+
+
+def _session_size(prof) -> tuple:
+    """The session's resolution, read from its file (the training's when it cannot be read)."""
+    from rrcache.profiles.inputs import session_document
+
+    try:
+        return tuple(int(v) for v in session_document(prof)["resolution"])
+    except (RRCacheError, ValueError, KeyError, TypeError):
+        return tuple(prof.settings.resolution or (0, 0))
 
 
 def _level(sel) -> str:
@@ -180,16 +179,15 @@ def _level(sel) -> str:
     return f"error ≤ {_f(sel.max_error)}"
 
 
-def _selection(prof, sel, shots: FrameShots) -> str:
-    if sel.multi:
-        return _multi_selection(prof, sel, shots)
-    images = shots.selection_images(sel)  # the original, one cached node or one amortized estimator
-    amortized = sel.kind == "amortize"
-    if amortized:
-        what = _amortized_what(prof, sel)
-    else:
-        what = (f"cache <b>{_e(sel.node)}</b> every Δn = {sel.period} frames: <code>{_e(sel.text or '')}</code>"
-                if sel.node else "keep the original shader (nothing is predicted faster at this level)")
+def _selection(prof, sel, frames: dict) -> str:
+    kind = sel.choice  # None: the original shader
+    if kind is not None and not kind.has_frames:
+        return _multi_selection(prof, sel)
+    images = frames.get(sel.label)  # rendered by the profiler into the folder (rrcache.profiler.frames)
+    if images is None:
+        return _multi_selection(prof, sel, "no frames in the profile folder: 'rrcache report' renders them")
+    what = (kind.report_html(sel, prof) if kind is not None
+            else "keep the original shader (nothing is predicted faster at this level)")
     what += _level_marks(sel)
     exact = sel.exact or not sel.parts
     predicted_psnr = ("∞ (exact)" if exact else
@@ -222,17 +220,30 @@ def _selection(prof, sel, shots: FrameShots) -> str:
             h = round(h0 * w / w0)
             figures.append(f'<figure><img alt="{_e(name)}" data-image="{_e(name)}" width="{w}" height="{h}" '
                            f'src="{images.uri(name)}"><figcaption>{_e(images.caption(name))}</figcaption></figure>')
-    settled = " (its history settled: the cycle of subsets and the blend's memory)" if amortized else ""
+    settled = kind.settled_note if kind is not None else ""
     frame_note = (f"frame {images.frame} at {images.size[0]}×{images.size[1]}"
                   + (f", after {images.frame + 1} frames with the cache{settled}: this frame's error "
                      f"{_f(images.error)}, hit rate {_f(images.hit_rate, 3)}; the table's measurements are over "
                      f"{sel.frames} frames of the session" if images.cached else ""))
     files = f" · shader files: <code>{_e(sel.files)}</code>" if sel.files else ""
-    node_attr = "" if amortized else (sel.node or "")
+    node_attr = sel.single_node or ""
     return (f'<div class="sel" id="sel-{_e(sel.label)}" data-node="{_e(node_attr)}" data-kind="{_e(sel.kind)}">'
             f"<h3>{_e(sel.label)}: {_e(_level(sel))}</h3><p>{what}{files}</p>{table}"
             f'<p class="muted">{_e(frame_note)}</p>'
-            f'<div class="shots">{"".join(figures)}</div>{next_steps_html(prof, sel, shots.session.resolution)}</div>')
+            f'<div class="shots">{"".join(figures)}</div>{next_steps_html(prof, sel, _session_size(prof))}</div>')
+
+
+def _answer(prof) -> str:
+    """The profile's answer when it stopped before training (``Profile.verdict``: the ceiling
+    below the gain worth having, or no value a cache can hold): the answer, why, and what would
+    change it."""
+    v = prof.verdict
+    ceiling = prof.measured_ceiling
+    measured = f"<p>ceiling: {_e(ceiling.summary())}</p>" if ceiling is not None else ""
+    changes = "".join(f"<li>{_e(c)}</li>" for c in v.get("changes") or [])
+    return (f'<div class="sel" id="answer"><h3>{_e(v["answer"])}</h3>{measured}<p>why: {_e(v["reason"])}</p>'
+            f"<p>what would change it:</p><ul>{changes}</ul>"
+            "<p class=\"muted\">the original shader's manifest is in <code>optimized/original</code></p></div>")
 
 
 def _level_marks(sel) -> str:
@@ -350,9 +361,12 @@ def _estimators(prof) -> str:
             "<th>error model</th><th class=num>ms per 1e6 terms</th></tr>" + "".join(rows) + "</table>")
 
 
-def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
-    """The report page of ``prof`` as a string (renders the selections' frames)."""
-    shots = shots or FrameShots(prof, work)
+def report_html(prof, frames: Optional[dict] = None) -> str:
+    """The report page of ``prof`` as a string, from its folder's files: the selections' frames
+    are those the profiler rendered there (:func:`rrcache.report.images.read_frames`; ``frames``:
+    label → images given instead)."""
+    if frames is None:
+        frames = read_frames(prof.path) if prof.path is not None else {}
     lines = read_source(prof)
     timing = selection_timing(prof) if prof.trained_nodes else {"median_ms": None, "repeats": 0}
     data = {"source": lines, "details": {n.id: node_details(prof, n.id) for n in prof.nodes}}
@@ -363,7 +377,8 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
     payload = script_json(data)
     name = Path(prof.shader).name
     sections = [
-        "<h2>Summary</h2>", _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
+        "<h2>Summary</h2>", _answer(prof) if prof.verdict is not None else "",
+        _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
         "<h2>Error against run time</h2>",
         '<p class="muted">Each path is one node over Δn = 1..50 as the fitted models predict it (larger '
         "dots: the trained periods); the black line is the Pareto front, the dashed line the original's "
@@ -379,7 +394,7 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
         '<p class="muted">The four levels e1..e4; predicted by the models, measured by rendering '
         "the session with the chosen variant beside the original. A level ships only what was measured to "
         "meet it (docs/levels.md).</p>",
-        "".join(_selection(prof, s, shots) for s in prof.selections) or "<p>No selection.</p>",
+        "".join(_selection(prof, s, frames) for s in prof.selections) or "<p>No selection.</p>",
         _prediction_errors(prof),
         _estimators(prof),
         "<h2>Model validation</h2>", _plots(prof),
@@ -396,14 +411,14 @@ def report_html(prof, work=None, shots: Optional[FrameShots] = None) -> str:
             f"<script>{assets.JS}</script></body></html>\n")
 
 
-def write_report(profile, out_dir, work=None, filename: str = REPORT_NAME) -> Path:
+def write_report(profile, out_dir, filename: str = REPORT_NAME, frames: Optional[dict] = None) -> Path:
     """Write the report of ``profile`` into ``out_dir`` (as ``filename``, default ``report.html``)
-    and return its path. ``work`` (the profiled :class:`~rrcache.pipeline.ShaderWork`) saves
-    loading the shader again."""
+    and return its path: it reads the profile folder's files only (its frames rendered there by
+    the profiler, :mod:`rrcache.profiler.frames`; ``frames`` given instead)."""
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise RRCacheError("the report's folder is a file", str(out), hint="give a folder, or --out FILE.html")
     with OutputFolder(out) as folder:
         folder.regular_or_missing(filename)  # a device or a link as --out: refused before rendering
-        folder.write_text(filename, report_html(profile, work))
+        folder.write_text(filename, report_html(profile, frames))
     return out / filename

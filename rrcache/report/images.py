@@ -1,34 +1,27 @@
-"""Frames of a profile's choices: the original, the cached variant, the error map, the payload and
-the hit/miss map of one frame, rendered for real (the harness and the cache runtime) at a modest
-resolution, and encoded as PNG for the report and the notebooks.
+"""Frames of a profile's choices as the report and the notebooks show them: the original, the cached
+variant, the error map, the payload and the hit/miss map of one frame (:class:`ChoiceImages`),
+the image helpers, and :func:`read_frames`, which reads the frames the profiler rendered into the
+profile folder (:mod:`rrcache.profiler.frames` renders them: the report renders nothing).
 
-The cached frame is the last of a run of consecutive frames from frame 0, long enough for the
-cache to be in its steady state (Δn + 2 frames, at most the session's), so its hits and its
-refreshes look as they do while the application runs. The original is rendered at the same frame.
-
-An amortized selection (an estimator's m of N terms per frame, blend λ, history ``blend`` or
-``slots``; :class:`rrcache.selection.AmortizedLoop`) is rendered the same way with its variant
-(:func:`rrcache.pipeline.variant_for_selection`): the run is long enough for its history to settle
-(:func:`settle_frame`: the N/m-frame cycle of subsets plus the frames the blend's memory λ^k needs
-to fall below 5 %), and its payload image is the running estimate (``blend``) or the N/m subset
-sums (``slots``). :meth:`FrameShots.selection_images` renders any selection with frames.
-
->>> shots = FrameShots(load_profile("demo.rrprofile"))                     # doctest: +SKIP
->>> images = shots.images("n932", 16)                                      # doctest: +SKIP
->>> images.png("hit_map")[:4]                                              # doctest: +SKIP
-b'\\x89PNG'
->>> shots.selection_images(prof.select(0.02)).what                         # doctest: +SKIP
-'e1 m=4 λ=0.6'
+>>> frames = read_frames("demo.rrprofile")                                 # doctest: +SKIP
+>>> frames["e1"].png("hit_map")[:4], frames["e1"].what                     # doctest: +SKIP
+(b'\\x89PNG', 'n932 Δn=16')
 """
 from __future__ import annotations
 
 import base64
 import io
-import math
+import json
+import os
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
+
+from rrcache.budgets import budget
+from rrcache.errors import RRCacheError
+from rrcache.files import Refused, read_file
 
 #: the widest image the report and the notebooks render (pixels)
 MAX_WIDTH = 320
@@ -48,20 +41,7 @@ CAPTIONS = {
 }
 
 
-#: how far the blend's memory λ^k must fall before an amortized frame is shown
-SETTLED = 0.05
-
-
-def settle_frame(frames: int, cycle: int, blend: float) -> int:
-    """The frame shown for an amortized selection: after its ``cycle`` (N/m frames, every subset
-    once) and the frames its blend's memory needs (λ^k ≤ 5 %), plus one; at most the session's
-    last frame (``frames`` - 1).
-
-    >>> settle_frame(150, 4, 0.6), settle_frame(150, 4, 0.0), settle_frame(12, 2, 0.9)
-    (11, 5, 11)
-    """
-    memory = math.ceil(math.log(SETTLED) / math.log(blend)) if 0.0 < blend < 1.0 else 0
-    return min(int(frames) - 1, int(cycle) + memory + 1)
+from rrcache.kinds.amortize import SETTLED, settle_frame  # noqa: F401,E402 (re-exported: the amortize kind's frame)
 
 
 def image_size(resolution, max_width: int = MAX_WIDTH) -> tuple[int, int]:
@@ -156,22 +136,61 @@ class ChoiceImages:
     payload_ranges: list = field(default_factory=list)
     part: object = None
     captions: dict = field(default_factory=dict)
+    #: what the images show, in words (from a profile folder, where there is no part to ask)
+    description: Optional[str] = None
+    #: image name -> its PNG file (from a profile folder: :func:`read_frames`)
+    files: dict = field(default_factory=dict)
+    #: image name -> the PNG bytes read from that file (by :mod:`rrcache.files`' rule)
+    blobs: dict = field(default_factory=dict)
 
     @property
     def cached(self) -> bool:
         """Whether these are a variant's images (not the original shader's alone)."""
-        return self.node is not None or self.part is not None
+        return self.node is not None or self.part is not None or getattr(self, "was_cached", False)
 
     @property
     def what(self) -> str:
         """``n12 Δn=16``, ``e1 m=4 λ=0.6`` or ``the original shader``."""
+        if self.description is not None:
+            return self.description
         if self.part is not None:
             return self.part.describe()
         return f"{self.node} Δn={self.period}" if self.node is not None else "the original shader"
 
     def png(self, name: str) -> bytes:
-        """One image as PNG bytes (``KeyError`` for an image this choice does not have)."""
+        """One image as PNG bytes (``KeyError`` for an image this choice does not have): its file
+        as written, or the array encoded."""
+        if name in self.blobs:
+            return self.blobs[name]
         return png_bytes(self.arrays[name])
+
+    def to_json(self, files: dict) -> dict:
+        """The record ``frames.json`` keeps (``files``: image name → path relative to the folder)."""
+        return {"node": self.node, "period": self.period, "frame": int(self.frame), "size": list(self.size),
+                "error": float(self.error), "hit_rate": None if self.hit_rate is None else float(self.hit_rate),
+                "error_scale": None if self.error_scale is None else float(self.error_scale),
+                "payload_ranges": [list(map(float, r)) for r in self.payload_ranges], "captions": dict(self.captions),
+                "cached": self.cached, "what": self.what, "images": dict(files)}
+
+    @classmethod
+    def from_json(cls, record: dict, folder) -> "ChoiceImages":
+        """The images of a ``frames.json`` record, their PNG files in ``folder``, each read by
+        :mod:`rrcache.files`' rule inside the profile folder (``frames.json`` may have been
+        edited: a file it names elsewhere, or through a link out, is refused, never read)."""
+        from PIL import Image
+
+        files = {name: Path(folder) / rel for name, rel in record.get("images", {}).items()}
+        arrays, blobs = {}, {}
+        for name, path in files.items():
+            blobs[name] = _folder_file(folder, path, budget.asset_bytes)
+            with Image.open(io.BytesIO(blobs[name])) as im:
+                arrays[name] = np.asarray(im.convert("RGB"), dtype=np.float32) / 255.0
+        out = cls(record.get("node"), record.get("period"), int(record["frame"]), tuple(record["size"]), arrays,
+                  float(record.get("error") or 0.0), record.get("hit_rate"), record.get("error_scale"),
+                  [tuple(r) for r in record.get("payload_ranges", [])], None, dict(record.get("captions", {})),
+                  record.get("what"), files, blobs)
+        out.was_cached = bool(record.get("cached"))
+        return out
 
     def uri(self, name: str) -> str:
         return data_uri(self.png(name))
@@ -187,137 +206,27 @@ class ChoiceImages:
         return base
 
 
-class FrameShots:
-    """Renders :class:`ChoiceImages` for a profile's choices; the shader is loaded and analysed
-    once (pass ``work``, a :class:`~rrcache.pipeline.ShaderWork`, when you have it), the original
-    frames and the images of each (node, Δn) and each amortized option are kept."""
+def _folder_file(folder, path, limit: int) -> bytes:
+    """The bytes of ``path``, a file of the profile folder ``folder``, read by :mod:`rrcache.files`'
+    rule confined to that folder; a refusal is an :class:`RRCacheError` naming the file."""
+    try:
+        return read_file(path, limit, [os.path.realpath(folder)]).data
+    except Refused as err:
+        said = f"resolves to {err.real}, outside the profile's folder" if err.kind == "outside" else err.reason
+        raise RRCacheError(f"a frame file of the profile {said}; nothing of it was read", str(path),
+                           hint="frames/frames.json was damaged or edited; run 'rrcache profile' again") from None
 
-    def __init__(self, profile, work=None, max_width: int = MAX_WIDTH):
-        from rrcache.session import load_session
 
-        self.profile = profile
-        if work is None:  # a profile read from its folder: what it names is checked first
-            from rrcache.profiles.inputs import load_session_of
+#: where the profiler keeps the report's frames in a profile folder, and their record
+FRAMES_DIR = "frames"
+FRAMES_JSON = "frames.json"
 
-            self.session = load_session_of(profile)
-        else:
-            self.session = load_session(profile.session)
-        if work is None:
-            from rrcache.pipeline import load_for_session
 
-            work = load_for_session(profile.shader, self.session, profile.defines,
-                                    getattr(profile, "include_dirs", ()), vertex=profile.vertex,
-                                    term_scores=getattr(profile, "term_scores", None))
-            work.filter = getattr(profile, "filter", work.filter)
-        self.work = work
-        self.size = image_size(self.session.resolution, max_width)
-        self._originals: dict = {}
-        self._images: dict = {}
-        self._variants: dict = {}
-
-    def variant(self, node: str):
-        """The compiled variant caching ``node`` (one per node: the refresh period is the runtime's)."""
-        if node not in self._variants:
-            from rrcache.pipeline import variant_for
-
-            self._variants[node] = variant_for(self.work, node, self.profile.algorithm)
-        return self._variants[node]
-
-    def selection_variant(self, selection):
-        """``(variant, period)`` of any selection with parts (its ``algorithm``, else the profile's;
-        :func:`rrcache.pipeline.variant_for_selection`), compiled once per kind of choice."""
-        algorithm = selection.algorithm or self.profile.algorithm
-        key = (selection.key, algorithm)
-        if key not in self._variants:
-            if selection.kind == "cache":
-                self._variants[key] = (self.variant(selection.node), int(selection.period))
-            else:
-                from rrcache.pipeline import variant_for_selection
-
-                self._variants[key] = variant_for_selection(self.work, selection.replace(algorithm=algorithm))
-        return self._variants[key]
-
-    def selection_images(self, selection) -> ChoiceImages:
-        """The images of a selection: the original (no part), one cached node (kind ``cache`` or
-        ``adaptive``, as :meth:`images`) or an amortized estimator (kind ``amortize``). Several
-        nodes at once have no images here: RRCacheError."""
-        if not selection.parts:
-            return self.images(None, None)
-        if selection.kind == "amortize":
-            key = (selection.key, selection.algorithm or self.profile.algorithm)
-            if key not in self._images:
-                self._images[key] = self._render_amortized(selection)
-            return self._images[key]
-        if selection.multi:
-            from rrcache.errors import RRCacheError
-
-            raise RRCacheError(f"no frames for a selection of several nodes ({selection.describe()})", "selection",
-                               hint="show one node's frames with FrameShots.images(node, period)")
-        return self.images(selection.node, selection.period)
-
-    def frame_for(self, period: Optional[int]) -> int:
-        """The frame shown for a refresh period: Δn + 2 frames into the session (at most its last)."""
-        return min(int(self.session.frames) - 1, int(period or 0) + 2)
-
-    def original(self, frame: int):
-        """The original shader's :class:`~rrcache.harness.renderer.FrameResult` at ``frame``."""
-        if frame not in self._originals:
-            from rrcache.harness.renderer import Renderer
-
-            with Renderer(self.work.prepared, self.session, self.size) as renderer:
-                self._originals[frame] = renderer.render_frame(frame)
-        return self._originals[frame]
-
-    def images(self, node: Optional[str], period: Optional[int]) -> ChoiceImages:
-        """The images of caching ``node`` every ``period`` frames (node None: the original)."""
-        key = (node, None if node is None else int(period))
-        if key not in self._images:
-            self._images[key] = self._render(*key)
-        return self._images[key]
-
-    def _render(self, node: Optional[str], period: Optional[int]) -> ChoiceImages:
-        frame = self.frame_for(period)
-        ref = self.original(frame)
-        out = ChoiceImages(node, period, frame, self.size)
-        out.arrays["original"] = ref.image[..., :3]
-        if node is None:
-            return out
-        return self._cached_run(out, self.variant(node), period, ref)
-
-    def _render_amortized(self, selection) -> ChoiceImages:
-        part = selection.parts[0]
-        variant, period = self.selection_variant(selection)
-        info = getattr(variant, "amortized", None) or {}
-        frame = settle_frame(self.session.frames, info.get("cycle", 1), part.blend)
-        out = ChoiceImages(None, None, frame, self.size, part=part)
-        n, m = info.get("of"), part.samples
-        out.captions["cached"] = f"amortized: {m} of {n} terms per frame"
-        if part.history == "slots":
-            shown = min(3, variant.components)
-            sums = f"{n // m} subset sums" if n else "subset sums"
-            out.captions["payload"] = f"the {sums} (slots; {shown} channel(s) shown)"
-        else:
-            out.captions["payload"] = "running estimate (blend)"
-        ref = self.original(frame)
-        out.arrays["original"] = ref.image[..., :3]
-        return self._cached_run(out, variant, period, ref)
-
-    def _cached_run(self, out: ChoiceImages, variant, period, ref) -> ChoiceImages:
-        """Render ``variant`` from frame 0 to ``out.frame`` and fill in ``out``'s cached images."""
-        from rrcache.harness.cached import CachedRenderer
-        from rrcache.harness.metrics import mean_l2
-
-        frame = out.frame
-        with CachedRenderer(variant, self.session, self.work.prepared, self.size, period=period,
-                            hit_maps=True, keep_payload=True, **self.profile.settings.cache_options()) as cached:
-            for index in range(frame + 1):
-                got = cached.render_frame(index)
-        mask = ref.mask
-        out.arrays["cached"] = got.image[..., :3]
-        out.arrays["error_map"], out.error_scale = error_map(got.image, ref.image, mask)
-        out.error = float(mean_l2(got.image, ref.image, mask)[0])
-        out.arrays["payload"], out.payload_ranges = payload_image(got.payload, variant.components, got.mask)
-        if got.hit_map is not None:
-            out.arrays["hit_map"] = hit_map_image(got.hit_map, got.mask)
-            out.hit_rate = got.hits / got.covered_pixels if got.covered_pixels else 0.0
-        return out
+def read_frames(folder) -> dict:
+    """Label → :class:`ChoiceImages` of the frames the profiler rendered into the profile folder
+    ``folder`` (:func:`rrcache.profiler.frames.write_frames`); empty when it has none."""
+    path = Path(folder) / FRAMES_DIR / FRAMES_JSON
+    if not path.exists():
+        return {}
+    data = json.loads(_folder_file(folder, path, budget.document_bytes))
+    return {label: ChoiceImages.from_json(record, Path(folder)) for label, record in data.get("selections", {}).items()}

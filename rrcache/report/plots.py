@@ -163,8 +163,9 @@ def plot_validation(prof, out_dir) -> list[str]:
     fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4), dpi=110)
     for ax, pred, meas, name in ((a, "predicted_error", "measured_error", "mean RGB L2 error"),
                                  (b, "predicted_ms", "measured_ms", "ms per frame")):
-        xs = [getattr(s, pred) for s in rows]
-        ys = [getattr(s, meas) for s in rows]
+        pairs = [(getattr(s, pred), getattr(s, meas)) for s in rows
+                 if getattr(s, pred) is not None and getattr(s, meas) is not None]
+        xs, ys = [p[0] for p in pairs], [p[1] for p in pairs]
         top = max(xs + ys + [1e-9]) * 1.15
         ax.plot([0, top], [0, top], "--", color="gray", lw=1)
         ax.plot(xs, ys, "o", color="tab:red")

@@ -88,7 +88,7 @@ def plot_fronts(profiles, path, titles=None) -> list[str]:
         for sel in prof.selections:
             if sel.measured_speedup and sel.parts:
                 x = 1.0 / float(sel.measured_speedup)
-                ax.plot([x], [sel.measured_error], "*" if sel.multi else "s", color="crimson", ms=9, mfc="none")
+                ax.plot([x], [sel.measured_error], sel.choice.marker if sel.parts else "s", color="crimson", ms=9, mfc="none")
                 ax.annotate(sel.label, (x, sel.measured_error), textcoords="offset points", xytext=(-14, 4),
                             fontsize=7, color="crimson")
         ax.plot([], [], "D", color="darkorange", label="set: predicted (hollow) → trained (filled)")

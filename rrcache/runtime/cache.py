@@ -131,9 +131,8 @@ class CacheRuntime:
     (:attr:`rrcache.compiler.variant.Variant.depth_channel`): the payload channel its passes keep
     the inverse depth in (one texture and render target fewer), None for its own texture. ``cull_back_faces``: True/False sets face culling for every pass; None (the default) leaves
     the application's culling state alone (the draw callback may set it per object).
-    ``period`` given as a list or tuple (one Δn per node, with ``payload_components`` one count
-    per node) makes the cache of a multi-node variant, a
-    :class:`rrcache.runtime.multi.MultiCacheRuntime`.
+    A variant of several nodes runs in a :class:`rrcache.runtime.multi.MultiCacheRuntime` (one
+    period and one payload per node); :meth:`from_spec` makes either from a variant's spec.
 
     Example, inside a render loop (``draw`` renders the scene with the given program)::
 
@@ -143,17 +142,20 @@ class CacheRuntime:
             image = rt.read_color()
     """
 
-    #: the class made for several periods (one per node): rrcache.runtime.multi registers
-    #: MultiCacheRuntime here (the package imports it), so this module need not import it
-    multi_class: Optional[type] = None
-
-    def __new__(cls, *args, **kwargs):
-        # several periods (one per node): the cache of a multi-node variant
-        if cls is CacheRuntime and isinstance(kwargs.get("period"), (list, tuple)):
-            if CacheRuntime.multi_class is None:
-                raise ValueError("several periods need rrcache.runtime.multi (import rrcache.runtime)")
-            return super().__new__(CacheRuntime.multi_class)
-        return super().__new__(cls)
+    @classmethod
+    def from_spec(cls, ctx: moderngl.Context, programs: dict, spec, size: tuple[int, int], *,
+                  payload_components, payload_dtype: Optional[str] = None, depth_channel: Optional[int] = None,
+                  payload_decode=None, phase_cycle: int = 1, **target) -> "CacheRuntime":
+        """The runtime of a variant described by ``spec`` (a :class:`rrcache.runtime.spec.VariantSpec`,
+        taken whole: algorithm, periods, refresh, adaptive refresh, blend), with what its
+        compilation fixed (``payload_components``, ``depth_channel``, ``payload_decode``,
+        ``phase_cycle``: a compiled variant's :meth:`~rrcache.compiler.variant.Variant.runtime`
+        passes them) and the application's ``target`` options (``color_format``, ``clear_color``,
+        ``seed``, ``cull_back_faces``). ``payload_dtype`` overrides the spec's (a 16- or 8-bit
+        cache starts in 32 bits until its values are known to fit)."""
+        return cls(ctx, programs, spec.algorithm, size, payload_dtype=payload_dtype or spec.payload,
+                   payload_components=payload_components, depth_channel=depth_channel,
+                   payload_decode=payload_decode, phase_cycle=phase_cycle, **spec.runtime_options(), **target)
 
     def __init__(
         self,
@@ -216,6 +218,8 @@ class CacheRuntime:
         if payload_components not in (1, 2, 3, 4):
             raise ValueError(f"payload_components must be 1 to 4, not {payload_components}")
         self.payload_components = int(payload_components)
+        #: each cached node's payload components (one node here; MultiCacheRuntime sets its own)
+        self.node_components = getattr(self, "node_components", None) or (self.payload_components,)
         if depth_channel is not None and (int(depth_channel) != self.payload_components or payload_dtype != "f4"):
             raise ValueError(f"the inverse depth packs into channel {self.payload_components} of a 32-bit payload "
                              f"(rrcache.runtime.glsl.depth_channel_for), not channel {depth_channel} of {payload_dtype}")
@@ -331,6 +335,7 @@ class CacheRuntime:
             self._color_only_fbo = ctx.framebuffer([self.color])
         self._resources = [self.depth, self.color, *self._payload, *self._invdepth, *self._state, *self._cache_fbos,
                            *self._clear_fbos, self._out_fbo, self._color_only_fbo]
+        self._make_zero_fbos()
         if self.window is not None:
             try:
                 check_window(self.window, self.size)
@@ -366,12 +371,29 @@ class CacheRuntime:
         return 4 + bytes_per_texel(self.color_format) + 2 * payload + (0 if packed else 2 * 4) + state + 41
 
     def reset(self) -> None:
-        """Forget the cache: the next frame misses everywhere (as after a camera cut), and the
-        clock starts again at 0, so a run after a reset refreshes the same pixels on the same
-        frames whatever ran before it (a profile resumed after a kill measures what an
-        uninterrupted one does)."""
+        """Forget the cache: the next frame misses everywhere (as after a camera cut), the clock
+        starts again at 0 and the cache's targets (payloads, inverse depths, volatility) are
+        cleared, so a run after a reset renders exactly what a new runtime does whatever ran
+        before it (a profile resumed after a kill measures what an uninterrupted one does; a
+        renderer serving many runs measures what one per run would: the bilinear lookups of the
+        second frame near silhouettes read texels the first frame did not write). Binds the
+        default framebuffer."""
         self._valid = False
         self.clock = 0
+        for fbo in getattr(self, "_zero_fbos", ()):
+            fbo.scissor = None
+            fbo.use()
+            fbo.clear(0.0, 0.0, 0.0, 0.0)
+        bind_default_framebuffer(self.ctx)
+
+    def _cache_textures(self) -> list:
+        """Every texture the cache keeps from frame to frame (what :meth:`reset` clears)."""
+        return [*self._payload, *self._invdepth, *self._state]
+
+    def _make_zero_fbos(self) -> None:
+        """One framebuffer per cache texture, to clear it whole (:meth:`reset`)."""
+        self._zero_fbos = [self.ctx.framebuffer([tex]) for tex in self._cache_textures()]
+        self._resources += self._zero_fbos
 
     def _release_targets(self) -> None:
         # moderngl re-binds the current framebuffer whenever it creates a new one: if the bound
@@ -381,6 +403,7 @@ class CacheRuntime:
         for res in self._resources:
             res.release()
         self._resources = []
+        self._zero_fbos = []
 
     def release(self) -> None:
         """Release every GL object the runtime made (not the programs, which the caller owns)."""
@@ -541,6 +564,10 @@ class CacheRuntime:
         if self.payload_components < 4:
             payload = np.concatenate([payload, np.zeros(payload.shape[:2] + (4 - self.payload_components,), np.float32)], axis=-1)
         return payload
+
+    def read_payloads(self) -> list:
+        """Every cached node's payload (:meth:`read_payload`), in node order: one here."""
+        return [self.read_payload()]
 
     def read_inverse_depth(self, current: bool = False) -> np.ndarray:
         """1/w of the visible surface per pixel (0 where nothing is cached), row 0 = top.

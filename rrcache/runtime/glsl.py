@@ -46,7 +46,9 @@ import re
 from typing import Optional
 
 from rrcache.runtime.refresh import REFRESH_GLSL
-from rrcache.selection import FILTERS  # the names; a selection record names one
+
+#: the cache's reconstruction filters (their GLSL below), named by selections and variant specs
+FILTERS = ("nearest", "bilinear", "catmull-rom", "catmull-rom-y", "edge", "plane")
 
 # Names the runtime binds. Kept in one place so the compiler and the runtime agree.
 PREV_PAYLOAD = "rr_prevPayload"

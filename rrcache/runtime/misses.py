@@ -114,7 +114,7 @@ class MissClassifier:
     whatever draws the scene (the harness's drawer) and returns nothing useful."""
 
     def __init__(self, ctx: moderngl.Context, runtime, vertex: str, filter: str = "bilinear", add_program=None):
-        if hasattr(runtime, "read_payloads"):
+        if len(runtime.node_components) > 1:
             raise ValueError("the miss breakdown is for one cached node (not several)")
         self.ctx = ctx
         self.runtime = runtime

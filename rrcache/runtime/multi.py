@@ -1,7 +1,8 @@
 """`MultiCacheRuntime`: the cache of a variant that caches k ≥ 2 nodes, each at its own rate.
 
-:class:`rrcache.runtime.CacheRuntime` given a sequence of periods (``period=(50, 4)``, one per
-node, in the variant's node order) makes one of these; everything else is as for one node
+:class:`MultiCacheRuntime` takes a sequence of periods (``period=(50, 4)``, one per node, in the
+variant's node order; a compiled variant of several nodes makes it with
+``variant.runtime(ctx, programs, size)``); everything else is as for one node
 (the passes, their depth tests, the clears, the window, the queries: the frame loop is the
 one-node runtime's). What differs:
 
@@ -68,8 +69,7 @@ def target_budget(ctx: moderngl.Context, algorithm: str, k: int) -> None:
 
 
 class MultiCacheRuntime(CacheRuntime):
-    """The cache of several nodes (made by :class:`CacheRuntime` from a sequence of periods;
-    see the module docstring). ``payload_components`` is one count per node; ``period`` reads
+    """The cache of several nodes (see the module docstring). ``payload_components`` is one count per node; ``period`` reads
     as the tuple of periods and may be set to one int (every node) or a sequence."""
 
     def __init__(self, ctx: moderngl.Context, programs, algorithm: str = "three-pass",
@@ -116,6 +116,9 @@ class MultiCacheRuntime(CacheRuntime):
 
     # ------------------------------------------------------------------ resources
 
+    def _cache_textures(self) -> list:
+        return [t for pair in self._payloads + self._invdepths for t in pair]
+
     def bytes_per_pixel(self) -> int:
         """Depth, colour, each node's two payloads and two inverse depths, and the read-back."""
         size = 4 if self.payload_dtype == "f4" else 2
@@ -156,6 +159,7 @@ class MultiCacheRuntime(CacheRuntime):
         self._resources = [self.depth, self.color, *[t for pair in self._payloads + self._invdepths for t in pair],
                            *self._cache_fbos, *self._clear_fbos, self._out_fbo, self._color_only_fbo,
                            *[f for pair in self._node_fbos for f in pair], *self._depth_only]
+        self._make_zero_fbos()
         if self.window is not None:
             from rrcache.gl.window import check_window
             try:
@@ -266,4 +270,3 @@ class MultiCacheRuntime(CacheRuntime):
         return self._read(self._invdepths[node][index], 1)[..., 0]
 
 
-CacheRuntime.multi_class = MultiCacheRuntime

@@ -63,7 +63,7 @@ def page_data(variant, session, work, period: int, runtime: Optional[dict] = Non
     """The page's data: ``variant`` (algorithm, pass order, GLSL ES sources, period, the cache's
     options, payload precision, node), ``original`` (its GLSL ES sources) and ``scene``
     (:func:`rrcache.webgl.scene.bake` at ``size``, default the session's resolution)."""
-    from rrcache.harness.vertex import vertex_for
+    from rrcache.compiler.vertex import vertex_for
     from rrcache.runtime import DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_REFRESH
 
     if variant.amortized:

@@ -23,7 +23,7 @@ import numpy as np
 
 from rrcache.errors import RRCacheError, SessionError
 from rrcache.harness.drawer import attribute_data, frame_builtins
-from rrcache.harness.vertex import ATTRIBUTES
+from rrcache.compiler.vertex import ATTRIBUTES
 
 #: the largest page the target writes (meshes and textures, before base64), bytes
 MAX_BYTES = 96 * 2 ** 20
@@ -128,7 +128,7 @@ def bake(session, prepared, size: tuple[int, int], frames: Optional[int] = None)
     from rrcache.gl.program import build_program
     from rrcache.gl.uniforms import encode_uniform
     from rrcache.harness.bindings import lookup, plan_bindings
-    from rrcache.harness.vertex import vertex_for
+    from rrcache.compiler.vertex import vertex_for
 
     if getattr(session, "shadow_map", None) is not None:
         raise SessionError("the session's light has a shadow map, which the WebGL2 page does not render",

@@ -3,7 +3,8 @@ reprojection of shaded points, the predecessor of the reverse reprojection cache
 harness as a baseline to compare at equal frame time. It is an alternative to compare, not a
 choice the profiler makes.
 
-- :mod:`~.settings`: the knobs (:class:`RenderCacheSettings`) and their defaults;
+- the knobs and their defaults, :class:`RenderCacheSettings`, are the part of the registered kind
+  ``render-cache`` (:mod:`rrcache.kinds.render_cache`): it is never a profiler choice;
 - :mod:`~.points`: the fixed-size point cache (ring replacement, ageing, eviction);
 - :mod:`~.projection`: projection into a frame, the z-buffer, the predicted occupancy image;
 - :mod:`~.filters`: depth cull, the 3×3 interpolation with the priority image, the 7×7 prefilter;
@@ -15,6 +16,6 @@ choice the profiler makes.
 docs/render_cache.md describes the choices and what was measured.
 """
 from rrcache.alternatives.render_cache.renderer import RenderCacheFrame, RenderCacheRenderer, STAGES
-from rrcache.alternatives.render_cache.settings import RenderCacheSettings
+from rrcache.kinds.render_cache import RenderCacheSettings
 
 __all__ = ["RenderCacheFrame", "RenderCacheRenderer", "RenderCacheSettings", "STAGES"]

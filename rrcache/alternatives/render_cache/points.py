@@ -28,7 +28,10 @@ from typing import Optional
 
 import numpy as np
 
-from rrcache.alternatives.render_cache.settings import MAX_AGE, TARGET_AGE
+#: the largest age; a point reaching it is evicted (the paper's byte)
+MAX_AGE = 255.0
+#: the age a point should reach, on average, when the ring overwrites it (the paper's 128)
+TARGET_AGE = 128.0
 
 #: the ``object`` of a point on a static object (world-space position)
 STATIC = -1

@@ -30,7 +30,7 @@ The frame time is the wall time of all of it, from the shadow map to the upload 
 ``ctx.finish()``; ``stages`` has each stage's share (the paper's Table 1). The image and coverage
 are read afterwards, untimed, as every renderer of the harness does.
 
->>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.compiler.prepared import prepare_file
 >>> from rrcache.session import load_session
 >>> session = load_session("sessions/marble.json")
 >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
@@ -54,11 +54,12 @@ from rrcache.alternatives.render_cache.points import BACKGROUND, STATIC, PointCa
 from rrcache.alternatives.render_cache.projection import Projector, screen_matrix, zbuffer
 from rrcache.alternatives.render_cache.sampling import (block_priority, blocks_to_pixels, dither, grid_size,
                                                         hilbert_order, predicted_requests)
-from rrcache.alternatives.render_cache.settings import RenderCacheSettings
+from rrcache.kinds.render_cache import RenderCacheSettings
 from rrcache.alternatives.render_cache.shading import SampleShader
 from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.gl.resources import GLScope
 from rrcache.harness.renderer import FrameResult, check_frame_index, session_background
+from rrcache.harness.timing import DEFAULT_CLOCK, make_clock
 
 #: a background sample becomes a point this many times the far plane away along its view ray
 BACKGROUND_DISTANCE = 1000.0
@@ -110,6 +111,7 @@ class RenderCacheRenderer:
         try:
             self.shader = SampleShader(prepared, session, self.size, ctx, color_format)
             self.ctx = self.shader.ctx
+            self.frame_clock = make_clock(DEFAULT_CLOCK, self.ctx)  # (rrcache.harness.timing)
             self.notes = self.shader.notes
             self._display = self._scope.own(self.ctx.texture(self.size, 3, dtype="f4"))
         except BaseException:
@@ -251,7 +253,7 @@ class RenderCacheRenderer:
         clock("sampling")
 
         self._display.write(np.ascontiguousarray(np.moveaxis(image, 0, -1)))
-        ctx.finish()
+        self.frame_clock.mark()  # the upload done
         clock("display")
         self._previous = image
         self._last = index
@@ -270,12 +272,10 @@ class RenderCacheRenderer:
             self._warm = True
         stages: dict = {}
         with watchdog.frame(f"frame {index} of the render cache"):
-            self.ctx.finish()
-            cpu = time.process_time()
-            start = time.perf_counter()
+            self.frame_clock.start()
             info = self._frame(index, stages)
-            ms = (time.perf_counter() - start) * 1000.0
-            cpu_ms = (time.process_time() - cpu) * 1000.0
+            ms = self.frame_clock.stop()
+            cpu_ms = self.frame_clock.cpu_ms
         w, h = self.size
         image = np.ones((h, w, 4), np.float32)
         image[..., :3] = np.moveaxis(self._previous, 0, -1)

@@ -1,7 +1,7 @@
 """Choosing where the renderer shades next: the priority image dithered under a sample budget, and
 predictive sampling on the next camera's occupancy image.
 
-The renderer shades aligned ``k×k`` pixel *blocks* (:mod:`~rrcache.alternatives.render_cache.settings`);
+The renderer shades aligned ``k×k`` pixel *blocks* (:class:`~rrcache.kinds.render_cache.RenderCacheSettings`);
 everything here works on the block grid (``ceil(W/k) × ceil(H/k)``, flat row-major, GL
 orientation) and the budget counts ``k²`` pixels per block, partial blocks at the frame's edge
 included, so the pixels shaded never exceed the budget.

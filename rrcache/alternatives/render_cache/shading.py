@@ -15,7 +15,7 @@ draws the moving objects again with a trivial program, depth test ``<=`` against
 depth (nudged toward the camera, depth writes off), writing the object's index + 1: a sample
 whose id is 0 lies on a static object.
 
->>> from rrcache.harness.prepare import prepare_file
+>>> from rrcache.compiler.prepared import prepare_file
 >>> from rrcache.session import load_session
 >>> session = load_session("sessions/marble.json")
 >>> prepared = prepare_file("shaders/glslviewer_basic.glsl", session)
@@ -40,7 +40,7 @@ from rrcache.gl.resources import GLScope
 from rrcache.gl.uniforms import write_uniform
 from rrcache.harness.drawer import SceneDrawer
 from rrcache.harness.renderer import session_background
-from rrcache.harness.vertex import vertex_for
+from rrcache.compiler.vertex import vertex_for
 
 _MASK_FRAGMENT = """#version 330 core
 uniform usampler2D rr_mask;

@@ -19,7 +19,7 @@ from typing import Mapping, Optional, Sequence
 
 from rrcache.deep import deep
 from rrcache.errors import SourceLoc
-from rrcache.harness.vertex import VARYINGS, mesh_defines, session_attributes, shadow_defines
+from rrcache.compiler.vertex import VARYINGS, mesh_defines, session_attributes, shadow_defines
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class PreparedShader:
     uniforms: dict[str, Decl] = field(default_factory=dict)
     inputs: dict[str, Decl] = field(default_factory=dict)
     defines: dict[str, str] = field(default_factory=dict)
-    #: the user's vertex shader (``rrcache.harness.user_vertex.UserVertex``); None: generated
+    #: the user's vertex shader (``rrcache.compiler.user_vertex.UserVertex``); None: generated
     vertex: Optional[object] = None
 
     def declaration(self, name: str) -> Optional[Decl]:
@@ -190,7 +190,7 @@ def load_user_vertex(vertex, session=None, defines=None, include_dirs=()):
     path = vertex if vertex is not None else getattr(session, "vertex", None)
     if path is None:
         return None
-    from rrcache.harness.user_vertex import load_vertex, user_vertex_from_text
+    from rrcache.compiler.user_vertex import load_vertex, user_vertex_from_text
 
     if vertex is None and getattr(session, "vertex_text", None) is not None:
         return user_vertex_from_text(session.vertex_text, path, defines, include_dirs)  # read, confined, at load

@@ -1,10 +1,16 @@
-"""The render cache's knobs and their defaults, checked once.
+"""Kind ``render-cache``: the render cache of Walter, Drettakis and Greenberg 2002 (forward
+reprojection of shaded points; :mod:`rrcache.alternatives.render_cache`, docs/render_cache.md).
 
-:class:`RenderCacheSettings` is frozen; :meth:`RenderCacheSettings.checked` raises an
-:class:`~rrcache.errors.RRCacheError` naming the knob for a value out of range. The defaults are
-the paper's where it gives one (the 7×7 and 3×3 filters, up to half the budget on predicted
-samples, ages in [0, 255] reaching 128 when the ring overwrites them) and a measured choice
-where it does not (see docs/render_cache.md: the sample block, the cache size, the z-buffer).
+It is an alternative to compare at equal time, **not a choice the profiler makes**: it has no
+compiled variant (:meth:`RenderCacheKind.spec` and :meth:`RenderCacheKind.compile` refuse), no
+training and no store tables, and nothing selects it. Its part is :class:`RenderCacheSettings`,
+the frozen record of every knob (the share of the pixels shaded per frame first), with its JSON
+and checks, so a measured render cache can stand in a :class:`~rrcache.selection.Selection`
+beside the cached choices (the bench's equal-time table) and be described by the registry.
+
+The defaults are the paper's where it gives one (the 7×7 and 3×3 filters, up to half the budget
+on predicted samples, ages in [0, 255] reaching 128 when the ring overwrites them) and a measured
+choice where it does not (docs/render_cache.md: the sample block, the cache size, the z-buffer).
 
 >>> RenderCacheSettings(samples=0.05).checked().pixel_budget(640 * 480)
 15360
@@ -12,20 +18,24 @@ where it does not (see docs/render_cache.md: the sample block, the cache size, t
 Traceback (most recent call last):
 ...
 rrcache.errors.RRCacheError: render cache: samples=1.5 is not a share of the pixels (hint: give 0 < F <= 1, e.g. 0.03 for 3% of the pixels per frame)
+>>> from rrcache import kinds
+>>> part = RenderCacheSettings(samples=0.03)
+>>> kinds.kind_of((part,)).name, kinds.parts_from_json(kinds.parts_to_json((part,)), "parts") == (part,)
+('render-cache', True)
+>>> part.describe()
+'render cache: 3% of the pixels per frame in 2×2 blocks'
 """
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
+from typing import ClassVar
 
 from rrcache.errors import RRCacheError
+from rrcache.kinds.base import Kind, only
 
 #: sample blocks the renderer shades as one request (k×k pixels, aligned)
 BLOCKS = (1, 2, 4)
-#: the largest age; a point reaching it is evicted (the paper's byte)
-MAX_AGE = 255.0
-#: the age a point should reach, on average, when the ring overwrites it (the paper's 128)
-TARGET_AGE = 128.0
 
 
 @dataclass(frozen=True)
@@ -45,7 +55,11 @@ class RenderCacheSettings:
       pixel by more than the threshold (RGB L2) adds the penalty to the ages of the points around it;
     - ``tiled``: bucket-sort the projected points into ``tile``×``tile`` tiles before the z-buffer;
     - ``seed``: the dither's phase per frame.
+
+    It is the part of a render-cache choice (JSON tag ``render-cache``).
     """
+
+    KIND: ClassVar[str] = "render-cache"
 
     samples: float = 0.03
     points_per_pixel: float = 1.0
@@ -101,3 +115,62 @@ class RenderCacheSettings:
 
     def to_json(self) -> dict:
         return asdict(self)
+
+    # ---------------------------------------------------------------- as a part
+    def key(self) -> tuple:
+        return (self.KIND,) + tuple(asdict(self).values())
+
+    def describe(self) -> str:
+        return f"render cache: {self.samples * 100:.3g}% of the pixels per frame in {self.block}×{self.block} blocks"
+
+    @classmethod
+    def from_json(cls, data: dict, where: str) -> "RenderCacheSettings":
+        names = tuple(f.name for f in fields(cls))
+        only(data, ("kind",) + names, where)
+        values = {k: v for k, v in data.items() if k != "kind"}
+        for name, value in values.items():
+            default = getattr(cls(), name)
+            if isinstance(default, bool) != isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise RRCacheError(f"must be {'true or false' if isinstance(default, bool) else 'a number'}",
+                                   f"{where}.{name}")
+        try:
+            return cls(**values).checked()
+        except RRCacheError as err:
+            raise RRCacheError(err.message, where, hint=err.hint) from None
+
+
+class RenderCacheKind(Kind):
+    """The render cache as a kind of choice that is never chosen (see the module docstring)."""
+
+    name = "render-cache"
+    part = RenderCacheSettings
+    title = "the render cache (Walter et al. 2002), an alternative to compare"
+    one_node = False
+    has_frames = True
+    marker = "P"
+
+    def _refuse(self):
+        return RRCacheError("the render cache is an alternative to compare, not a compiled cache", "selection",
+                            hint="render it with rrcache.alternatives.render_cache.RenderCacheRenderer, or "
+                                 "'rrcache render SHADER SESSION --method render-cache --samples F'")
+
+    def spec(self, parts, algorithm, filter=None, **runtime):
+        raise self._refuse()
+
+    def compile(self, work, spec):
+        raise self._refuse()
+
+    def training(self, subject, settings, algorithm=None, filter=None) -> list:
+        return []
+
+    def cells(self, selection, profile=None, texts: bool = False) -> tuple[str, str]:
+        return self.describe(selection.parts), "–"
+
+    def summary(self, selection, profile=None) -> dict:
+        return {"kind": self.name, "describe": self.describe(selection.parts), **selection.parts[0].to_json()}
+
+    def shown_frame(self, selection, variant, frames: int) -> int:
+        return min(int(frames) - 1, 30)  # after a second of a 30 fps session: the cache has filled
+
+
+KIND = RenderCacheKind()

@@ -1,5 +1,6 @@
 """A profile's choice at one level, exactly as the profile made it: the one place that turns a
-level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with.
+level (``e1`` … ``e4``) into its compiled variant and every option the cache runs with. (It sits
+above the pipeline and the profile's data: the document, :mod:`rrcache.profiles`, compiles nothing.)
 
 The profile's ``optimized/eN`` folders, ``rrcache instance PROFILE --level eN``,
 ``rrcache render PROFILE --level eN``, ``rrcache select --out`` and the report's "what to do
@@ -20,8 +21,9 @@ import json
 from pathlib import Path
 from typing import Optional
 
+from rrcache import kinds
 from rrcache.errors import RRCacheError
-from rrcache.selection import AdaptiveNode, Selection
+from rrcache.selection import Selection
 
 
 def level(prof, label: str) -> Selection:
@@ -43,11 +45,14 @@ def algorithm_of(prof, sel: Selection) -> str:
 
 
 def adaptive_kwargs(sel: Selection) -> dict:
-    """The runtime's adaptive-refresh arguments of ``sel`` (empty unless its part is adaptive)."""
-    if len(sel.parts) == 1 and isinstance(sel.parts[0], AdaptiveNode):
-        p = sel.parts[0]
-        return {"threshold": float(p.threshold), "fast_period": int(p.fast_period), "spread": float(p.spread)}
-    return {}
+    """The runtime's adaptive-refresh arguments of ``sel`` (empty unless its variant spec has a
+    threshold: :func:`rrcache.kinds.spec_for`)."""
+    if not sel.parts:
+        return {}
+    spec = kinds.spec_for(sel)
+    if spec.threshold is None:
+        return {}
+    return {"threshold": float(spec.threshold), "fast_period": int(spec.fast_period), "spread": float(spec.spread)}
 
 
 def runtime_options(prof, sel: Selection) -> dict:
@@ -98,7 +103,7 @@ def variant_of(prof, sel: Selection, work):
     (:func:`rrcache.pipeline.variant_for_selection`); the original shader has none (an error)."""
     from rrcache.pipeline import variant_for_selection
 
-    return variant_for_selection(work, sel.replace(algorithm=algorithm_of(prof, sel)))
+    return variant_for_selection(work, sel.replace(algorithm=algorithm_of(prof, sel)), **prof.settings.cache_options())
 
 
 def original_note(prof, sel: Selection) -> str:

@@ -129,7 +129,7 @@ def _convert(expr: str, size: int, pad: str, declared: int) -> str:
 def vertex_for(inputs: Mapping[str, str], locs: Optional[Mapping[str, Optional[SourceLoc]]] = None,
                user=None, prev_clip: bool = False, invariant: Optional[bool] = None) -> str:
     """The vertex shader of a program whose fragment shader reads ``inputs``: the user's own
-    (a :class:`rrcache.harness.user_vertex.UserVertex`, checked against ``inputs``) when given,
+    (a :class:`rrcache.compiler.user_vertex.UserVertex`, checked against ``inputs``) when given,
     else the generated one; ``prev_clip`` adds ``rr_prevClip`` and ``invariant gl_Position`` (the
     cached variants' passes); ``invariant`` adds ``invariant gl_Position`` whatever ``prev_clip``
     (every pass of a variant needs it: the depth tests between passes compare exact depths).
