@@ -26,6 +26,7 @@ from rrcache import kinds
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
+from rrcache.harness.segments import restart, run_order, warmup_of
 from rrcache.runs import PSNR_CAP, FrameRow, RunResult, RunSpec
 
 #: ``on_frame(spec, units)``: progress, ``units`` frames of ``spec.cost`` done
@@ -130,18 +131,13 @@ def _execute(spec: RunSpec, bench: Bench, on_frame: Optional[FrameCallback]) -> 
     refs = bench.references(spec) if spec.measure == "error" else None
     cached, setup_s = bench.cached(spec)
     original = bench.original(spec) if spec.measure == "timing" else None
-    rows = []
-    complete = True
+    rows: list = []
     cached.reset()
-    for i, index in enumerate(spec.frames):
-        if spec.measure == "error":
-            ref = refs[i]
-            got = cached.render_frame(index)
-            err, left_out = mean_l2(got.image, ref.image, ref.mask)
-            rows.append(FrameRow(index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP), got.hits,
-                                 got.misses, int(got.covered_pixels), int(left_out), float(got.ms)))
-            step()
-        else:  # timing (beside the original) or overhead (alone): frame index after a warm-up frame
+    if spec.measure == "error":
+        complete = _error_rows(spec, cached, refs, rows, step)
+    else:  # timing (beside the original) or overhead (alone): each frame after a warm-up frame
+        complete = True
+        for index in spec.frames:
             ref = original.render_frame(index) if original is not None else None
             cached.reset()
             cached.render_frame(index - 1)
@@ -149,24 +145,58 @@ def _execute(spec: RunSpec, bench: Bench, on_frame: Optional[FrameCallback]) -> 
             rows.append(FrameRow(index, hits=got.hits, misses=got.misses, covered=int(got.covered_pixels),
                                  ms=float(got.ms), original_ms=float(ref.ms) if ref is not None else math.nan))
             step(3 if original is not None else 1)
-        if spec.strict_payload and cached.payload_dtype != spec.variant.payload:
-            complete = False
-            break
+            if spec.strict_payload and cached.payload_dtype != spec.variant.payload:
+                complete = False
+                break
     return RunResult(spec, tuple(rows), time.perf_counter() - start, setup_s, cached.payload_dtype,
                      tuple(cached.notes) + ((cached.payload_note,) if cached.payload_note else ()), complete)
 
 
+def _error_rows(spec: RunSpec, cached: CachedRenderer, refs: list, rows: list, step) -> bool:
+    """An error run's rows into ``rows``: its frames against the original's ``refs``, segment by
+    segment, each later one after its warm-up (:mod:`rrcache.harness.segments`; frames 0..N−1 are
+    one segment from an empty cache, as validation renders them). False when ``strict_payload``
+    stopped it."""
+    by_index = dict(zip(spec.frames, refs))
+    for segment in run_order(spec.frames, warmup_of(spec.variant)):
+        restart(cached, segment[0][0])
+        for index, compared in segment:
+            got = cached.render_frame(index)
+            if not compared:
+                continue
+            ref = by_index[index]
+            err, left_out = mean_l2(got.image, ref.image, ref.mask)
+            rows.append(FrameRow(index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP), got.hits,
+                                 got.misses, int(got.covered_pixels), int(left_out), float(got.ms)))
+            step()
+            if spec.strict_payload and cached.payload_dtype != spec.variant.payload:
+                return False
+    return True
+
+
 def _compare(spec: RunSpec, bench: Bench, step, start: float) -> RunResult:
     from rrcache.harness.cached import compare
+    from rrcache.harness.perceptual import FrameQuality
 
     variant = kinds.compile(bench.work, spec.variant)
     setup = time.perf_counter() - start
+    quality = FrameQuality(spec.flip_frames) if spec.flip_frames or spec.temporal else None
+
+    def on_frame(row, got, ref):
+        if quality is not None:
+            quality.add(row.index, got.image, ref.image)
+        step(2)
+
+    # the session's own size is asked as such (a target too large then names the session's file)
+    size = None if spec.resolution == tuple(bench.session.resolution) else spec.resolution
     result = compare(variant, bench.session, bench.work.prepared, spec.frames, spec.variant,
-                     resolution=spec.resolution, window=spec.window, color_format=spec.color_format,
-                     clock=spec.clock, on_frame=lambda *a: step(2))
+                     resolution=size, window=spec.window, color_format=spec.color_format,
+                     clock=spec.clock, on_frame=on_frame)
     rows = tuple(FrameRow(f.index, float(f.mean_error), min(float(f.psnr), PSNR_CAP), f.hits, f.misses, int(f.covered),
                           int(f.left_out), float(f.ms), float(f.original_ms)) for f in result.frames)
-    return RunResult(spec, rows, time.perf_counter() - start, setup, result.payload_dtype, tuple(result.notes))
+    return RunResult(spec, rows, time.perf_counter() - start, setup, result.payload_dtype, tuple(result.notes),
+                     flips=tuple(quality.flips) if quality is not None else (),
+                     temporal_psnr=quality.temporal_psnr if quality is not None and spec.temporal else None)
 
 
 class LocalExecutor:
@@ -176,7 +206,9 @@ class LocalExecutor:
     an ``on_frame`` for this call's progress, else the executor's) and yields one
     :class:`~rrcache.runs.RunResult` per spec (here in order, as each finishes; a caller that
     stops iterating stops the runs not begun); a ``KeyboardInterrupt`` stops it between frames
-    (the results already yielded stand); :meth:`close` releases what it holds."""
+    (the results already yielded stand); :meth:`close` releases what it holds. Optional:
+    :meth:`release` drops what the runs so far kept (reference frames, renderers) and leaves the
+    executor usable; the profile calls it when training is over, before validation."""
 
     def __init__(self, bench: Bench, on_frame: Optional[FrameCallback] = None):
         self.bench = bench
@@ -185,6 +217,9 @@ class LocalExecutor:
     def run(self, specs: Iterable[RunSpec], on_frame: Optional[FrameCallback] = None) -> Iterator[RunResult]:
         for spec in specs:
             yield execute(spec, self.bench, on_frame or self.on_frame)
+
+    def release(self) -> None:
+        self.bench.close()  # a bench closed stays usable: what it keeps is made again when asked
 
     def close(self) -> None:
         self.bench.close()
