@@ -47,7 +47,7 @@ def measure_choice(prof, node, period: Optional[int], shots: FrameShots,
     else:
         choice = (Selection((CachedNode(node, int(period)),)) if node is not None
                   else Selection.original(prof.original_ms))
-    for sel in prof.selections:
+    for sel in list(prof.selections) + list(getattr(prof, "measured", None) or []):
         if sel.key == choice.key and sel.measured_error is not None and (sel.parts or sel.frames):
             return {"error": sel.measured_error, "psnr": sel.measured_psnr, "speedup": sel.measured_speedup,
                     "ms": sel.measured_ms, "original_ms": sel.measured_original_ms, "hit_rate": sel.hit_rate,
@@ -105,6 +105,7 @@ class Explorer:
         self.render_ms: Optional[float] = None
         self.select_ms: Optional[float] = None
         self.measured: Optional[dict] = None
+        self.answer = None  # the last rrcache.profiles.measured.Choice: measured or predicted, warnings
         self.written: list = []
         # GL work must run on the thread that holds the GL context (the one building the widget);
         # a frontend may deliver widget events on another thread (JupyterLab's kernel subshells)
@@ -141,9 +142,15 @@ class Explorer:
             return None
 
     def update(self, max_error: float):
-        """Re-select for ``max_error`` and refresh the view (renders only when the choice changes)."""
+        """Re-select for ``max_error`` and refresh the view (renders only when the choice changes).
+        Where the profile's validation measured a choice, its measurement answers
+        (:func:`rrcache.profiles.measured.choose`); :attr:`answer` says which figures were measured."""
+        from rrcache.profiles.measured import choose
+
         start = time.perf_counter()
-        choice = self.prof.select(max_error)  # a cached node, an amortized estimator or the original
+        self.prof.select(max_error)  # the threshold's own checks
+        self.answer = choose(self.prof, max_error=max_error)  # a cached node, an amortized estimator or the original
+        choice = self.answer.selection
         self.select_ms = (time.perf_counter() - start) * 1000.0
         changed = self.choice is None or choice.key != self.choice.key
         self.choice = choice
@@ -184,11 +191,17 @@ class Explorer:
                     if m else ("rendering and measuring…" if pending else "not measured (measure=False)"))
         shown = (f"this frame rendered at {self.images.size[0]}×{self.images.size[1]}, frame {self.images.frame}, "
                  f"with the measurement in {self.render_ms:.0f} ms" if self.images is not None and not pending else "")
+        answer = self.answer
+        source = (f"<b>{answer.source}</b>" + (f": {html.escape(answer.note)}" if answer.note else "")
+                  if answer is not None else "")
+        warnings = "".join(f'<br><span style="color:#b00020">warning: {html.escape(w)}</span>'
+                           for w in (answer.warnings if answer is not None else []))
         self.summary.value = (
-            f"<div>max error {max_error:.3g} → {what}<br>"
+            f"<div>max error {max_error:.3g} → {what} ({source}){warnings}<br>"
             f"predicted: speed-up <b>{_f(c.predicted_speedup, 3)}×</b>, error <b>{_f(c.predicted_error)}</b>, "
             f"{_f(c.predicted_ms)} ms per frame (original {_f(self.prof.original_ms)} ms)<br>{measured}<br>"
-            f"<small>re-selected in {self.select_ms:.3f} ms from the models; {shown}</small></div>")
+            f"<small>re-selected in {self.select_ms:.3f} ms from the models and the profile's measurements; "
+            f"{shown}</small></div>")
 
     def write_files(self) -> list:
         """Write the chosen shader files into ``out_dir`` (the button does this)."""

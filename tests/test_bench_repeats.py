@@ -68,3 +68,23 @@ def test_summary_has_one_line_per_level_over_the_runs(runs, capsys):
     assert len(body) == 4 and all("| 2 |" in line for line in body)
     main(["bench-repeats", "--summary", str(runs[0])])
     assert capsys.readouterr().out.count("\n| marbled_sphere") == 4
+
+
+def test_levels_met_tries_and_the_predictions_error(runs, capsys):
+    """Issue 29's columns: whether each shipped level was met as measured and how many candidates
+    it took; --predictions: |predicted − measured| PSNR over every validated choice."""
+    from rrcache.bench.repeats import predictions, predictions_markdown
+
+    table = rows(runs)
+    assert all(r["met"] in ("met", "below", "–") and r["tries"] >= 0 for r in table)
+    assert all(r["met"] == "met" for r in table if r["kind"] == "original")
+    assert "levels needed a second candidate" in markdown(table)
+    found = predictions(runs)
+    assert [r["run"] for r in found] == ["demo-r1.rrprofile", "demo-r2.rrprofile"]
+    for r in found:
+        assert r["raw"]["n"] == len(r["pairs"]) and (r["raw"]["n"] == 0 or r["raw"]["worst"] >= r["raw"]["mean"])
+        for _, raw, calibrated, measured in r["pairs"]:
+            assert all(isinstance(v, float) for v in (raw, calibrated, measured))
+    assert predictions_markdown(found).splitlines()[-1].startswith("| all | 2 profiles |")
+    main(["bench-repeats", "--predictions", str(runs[0])])
+    assert "models alone" in capsys.readouterr().out

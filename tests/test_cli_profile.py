@@ -115,7 +115,10 @@ def test_select_json_and_out(full, tmp_path):
     choice = json.loads(proc.stdout)
     assert set(choice) == {"node", "period", "predicted_error", "predicted_ms", "predicted_speedup",
                            "predicted_speedup_range", "predicted_psnr", "predicted_psnr_uncertainty", "exact",
-                           "visible_artifacts"}
+                           "visible_artifacts", "source", "note", "warnings", "measured_error", "measured_psnr",
+                           "measured_psnr_uncertainty", "measured_speedup", "speedups", "measured_flip",
+                           "measured_temporal_psnr"}
+    assert choice["source"] in ("measured", "predicted")  # docs/levels.md: each figure says which
     data = json.loads((out / "profile.json").read_text())
     if choice["node"] is not None:
         assert choice["node"] in {n["id"] for n in data["nodes"]} and 1 <= choice["period"] <= 50
@@ -123,7 +126,7 @@ def test_select_json_and_out(full, tmp_path):
     assert by_psnr["node"] is None or by_psnr["predicted_psnr"] >= 40 - 1e-9
     assert by_psnr["exact"] == (by_psnr["node"] is None or by_psnr["predicted_error"] == 0)
     both = rrcache("select", out, "--min-psnr", "40", "--max-error", "0.1", check=False)
-    assert both.returncode == 2 and "one of --max-error and --min-psnr" in both.stderr
+    assert both.returncode == 2 and "one of --max-error, --min-psnr and --max-flip" in both.stderr
     strict = json.loads(rrcache("select", out / "profile.json", "--max-error", "0", "--json").stdout)
     assert strict["predicted_error"] <= 1e-12 and strict["predicted_ms"] >= choice["predicted_ms"]
     written = rrcache("select", out, "--max-error", "1e9", "--out", tmp_path / "opt")

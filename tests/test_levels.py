@@ -83,7 +83,7 @@ def _table_text(prof, rows) -> str:
     shown = copy.copy(prof)
     shown.selections = rows
     console = Console(record=True, width=220)
-    console.print(_table(shown))
+    _table(shown).print(console)
     return console.export_text()
 
 
@@ -107,7 +107,7 @@ def test_a_validation_5_db_under_the_level_tries_the_next_candidate(trained, tmp
         # the next candidate was measured and stands; what was refused, and why, is kept
         assert row.key == second.key and row.level_met and row.tries == 2
         assert row.measured_psnr == pytest.approx(LEVEL + 3.0)
-        assert f"{first.describe()}: measured {LEVEL - 5.0:.1f}" in row.fallback
+        assert f"{node.id} ({node.text[:20]}" in row.fallback and f"Δn=8: measured {LEVEL - 5.0:.1f}" in row.fallback
         assert f"below the level {LEVEL:g} dB" in row.fallback and "candidate 2" in row.fallback
         labels = sorted(r.label for r in store.validations())
         assert labels == ["e1", "e1~1"]
@@ -130,7 +130,7 @@ def test_when_every_candidate_misses_the_original_stands(trained, tmp_path, monk
     with store:
         [row] = Validator(work, session, settings, store, candidates=lambda c: [second]).run([first])
         assert not row.parts and row.exact and row.level_met and row.tries == 2
-        assert first.describe() in row.fallback and second.describe() in row.fallback
+        assert "Δn=8: measured" in row.fallback and "Δn=2: measured" in row.fallback
         assert row.fallback.endswith("so the original shader stands")
         assert "original (2 tried)" in _table_text(prof, [row])
         # told not to fall back, validation ships the miss and marks it
@@ -167,3 +167,90 @@ def test_flip_and_the_temporal_error_on_real_frames(trained, tmp_path, gl_ctx):
     assert lagging.measured_temporal_psnr is not None and lagging.measured_temporal_psnr < 100.0
     assert lagging.measured_psnr_uncertainty is not None and lagging.measured_psnr_uncertainty >= 0.0
     assert exact.exact and exact.measured_flip == 0.0 and exact.measured_temporal_psnr is None
+
+
+def test_a_screen_space_shader_is_answered_with_its_files(tmp_path):
+    """Every input gets an answer (issue 29 item 7): a shader whose every value is a function of
+    gl_FragCoord (The Book of Shaders' clouds) exits 0 with "keep the original" and why, and
+    writes profile.json, report.html and the original's manifest; select answers the original."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from test_cli_profile import _env as _cli_env
+
+    def _env():  # this checkout's rrcache in the child
+        return dict(_cli_env(), PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+
+    shader = Path(__file__).parent / "data" / "shaders" / "clouds_fragcoord.frag"
+    _, session = write_scene(tmp_path)
+    out = tmp_path / "clouds.rrprofile"
+    run = subprocess.run([sys.executable, "-m", "rrcache", "profile", str(shader), str(session), "--out", str(out),
+                          "--quiet"], capture_output=True, text=True, env=_env(), timeout=300)
+    assert run.returncode == 0, run.stderr
+    answer = "keep the original shader: every value it computes per pixel depends on the screen position"
+    assert answer in run.stdout and "why:" in run.stdout and "gl_FragCoord" in run.stdout
+    data = json.loads((out / "profile.json").read_text())
+    assert data["verdict"]["choice"] == "original" and data["verdict"]["answer"].startswith(answer)
+    assert "screen" in data["verdict"]["reason"] and data["selections"] == []
+    report = (out / "report.html").read_text()
+    assert answer in report and "what would change it" in report
+    assert json.loads((out / "optimized" / "original" / "manifest.json").read_text())["node"] is None
+    chosen = subprocess.run([sys.executable, "-m", "rrcache", "select", str(out), "--min-psnr", "40", "--json"],
+                            capture_output=True, text=True, env=_env(), timeout=120)
+    assert chosen.returncode == 0, chosen.stderr
+    assert json.loads(chosen.stdout)["node"] is None
+
+
+def _measured(node, period, psnr, speedups=(2.0, 2.1, 1.9), flip=0.02):
+    return _option(node, period, psnr + 1.0).with_measurement(0.01, psnr, 1.0, 2.0, sorted(speedups)[1], 0.8, 12,
+                                                             speedups).replace(
+        measured_psnr_uncertainty=0.2, measured_flip=flip, measured_flip_uncertainty=0.001, label="e2")
+
+
+def test_select_prefers_what_was_measured(trained, tmp_path, monkeypatch):
+    """rrcache select answers from validation's measurements where the profile has them, says
+    which figures were measured, and warns when the models' choice was measured below the level."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from rrcache.profiles import load_profile
+    from rrcache.profiles.measured import choose
+
+    prof, folder = trained
+    prof = load_profile(folder / "out")
+    a, b = prof.trained_nodes[:2]
+    good, bad = _measured(a, 4, LEVEL + 2.0), _measured(b, 8, LEVEL - 5.0, speedups=(3.0, 3.1, 2.9))
+    prof.measured = [good, bad]
+    # the models choose b at Δn = 8 (predicted above the level), which validation measured 5 dB under
+    model = _option(b, 8, LEVEL + 1.0).replace(predicted_speedup=3.0)
+    monkeypatch.setattr(prof, "select_psnr", lambda level: model)
+    answer = choose(prof, min_psnr=LEVEL)
+    assert answer.source == "measured" and answer.selection.key == good.key
+    assert answer.selection.measured_psnr == LEVEL + 2.0 and answer.selection.measured_speedup == 2.0
+    assert len(answer.warnings) == 1 and "measured and misses the level" in answer.warnings[0]
+    assert f"{LEVEL - 5.0:.1f}" in answer.warnings[0] and good.describe() in answer.warnings[0]
+    # a level the measured choices cannot tell about: the models' prediction, said to be one
+    monkeypatch.setattr(prof, "select_psnr", lambda level: _option(a, 2, LEVEL + 9.0).replace(predicted_speedup=5.0))
+    answer = choose(prof, min_psnr=LEVEL + 8.0)
+    assert answer.source == "predicted" and answer.selection.measured_error is None and not answer.warnings
+    # FLIP: a measured level only; the measured choice that meets it
+    assert choose(prof, max_flip=0.03).selection.key in (good.key, bad.key)
+    # through the command: profile.json keeps the measured choices; each figure says which it is
+    monkeypatch.undo()
+    prof.measured = [good]
+    out = tmp_path / "measured.rrprofile"
+    prof.write(out)
+    env = dict(__import__("os").environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    run = subprocess.run([sys.executable, "-m", "rrcache", "select", str(out), "--min-psnr", str(LEVEL), "--json"],
+                         capture_output=True, text=True, env=env, timeout=120)
+    assert run.returncode == 0, run.stderr
+    data = json.loads(run.stdout)
+    assert data["source"] == "measured" and data["node"] == a.id and data["period"] == 4
+    assert data["measured_psnr"] == LEVEL + 2.0 and data["measured_flip"] == 0.02
+    text = subprocess.run([sys.executable, "-m", "rrcache", "select", str(out), "--min-psnr", str(LEVEL)],
+                          capture_output=True, text=True, env=env, timeout=120).stdout
+    assert f"measured PSNR {LEVEL + 2.0:.1f} ± 0.2 dB" in text and "measured 2.00×" in text

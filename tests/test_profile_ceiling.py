@@ -86,6 +86,9 @@ def test_cheap_shader_stops_with_the_original_and_the_reason(stopped):
     assert data["verdict"]["choice"] == "original" and data["ceiling"]["reaches"] is False
     manifest = json.loads((folder / "out" / "optimized" / "original" / "manifest.json").read_text())
     assert manifest["node"] is None and "ceiling" in manifest["note"]
+    # the answer is reported like any other (issue 29: a report for every answer)
+    report = (folder / "out" / "report.html").read_text()
+    assert v["answer"] in report and "what would change it" in report
 
 
 def test_select_on_a_stopped_profile_is_the_original(stopped):

@@ -184,8 +184,8 @@ def test_key_ignores_budget_and_validate_and_resolves_defaults():
     b = TrainingSettings(periods=(2, 4, 8), resolution=(64, 48), frames=12, budget_s=5, validate=False,
                          min_saving=0.3).resolved(session)
     assert a.resolution == (64, 48) and a.frames == 12
-    long = TrainingSettings(periods=(2, 4, 8)).resolved(SimpleNamespace(resolution=(64, 48), frames=150, path="s.json"))
-    assert long.frames == 64  # the default: 64 consecutive frames
+    long = TrainingSettings(periods=(2, 4, 8)).resolved(SimpleNamespace(resolution=(64, 48), frames=600, path="s.json"))
+    assert long.frames == 150  # the default: 150 frames (all of a session up to that long)
     assert a.key_hash() == b.key_hash()
     assert a.key_hash() != TrainingSettings(periods=(2, 4, 9)).resolved(session).key_hash()
     assert TrainingSettings.from_json(b.to_json()) == b

@@ -13,6 +13,11 @@ several times (:mod:`rrcache.profiler.validate`); here each is classed by those 
 
 :func:`rows` reads the folders; :func:`markdown` writes one line per shipped selection and
 :func:`summary_markdown` one line per scene and level over all the runs (the README's table).
+Issue 29's checks are here too (docs/levels.md): each row says whether the shipped selection met
+its level as measured (``met``: its measured PSNR at least the level minus its uncertainty, or
+the original), how many candidates its level measured (``tries``), its mean FLIP; and
+:func:`predictions` gives the PSNR predictions' error over every choice each profile validated,
+from the models alone and as calibrated when each was measured (``--predictions``).
 
 >>> classify(())
 'original'
@@ -60,6 +65,7 @@ def rows(folders: Iterable) -> list[dict]:
             continue
         for sel in profile.selections:
             speedups = tuple(sel.speedups) or ((sel.measured_speedup,) if sel.measured_speedup else ())
+            met = _met(sel)
             out.append(dict(
                 scene=scene, run=Path(folder).name, level=sel.label, min_psnr=sel.min_psnr,
                 cached=sel.describe(), kind=sel.kind, predicted_speedup=sel.predicted_speedup,
@@ -68,8 +74,65 @@ def rows(folders: Iterable) -> list[dict]:
                 psnr=None if sel.exact else sel.measured_psnr, exact=sel.exact,
                 predicted_psnr=sel.predicted_psnr, fallback=sel.fallback,
                 cls="original" if not sel.parts else classify(speedups, exact_original=False),
-                ceiling=(profile.ceiling or {}).get("speedup")))
+                ceiling=(profile.ceiling or {}).get("speedup"), tries=int(sel.tries or (1 if sel.parts else 0)),
+                met=met, psnr_uncertainty=sel.measured_psnr_uncertainty, flip=sel.measured_flip,
+                visible=bool(sel.visible_artifacts), temporal_psnr=sel.measured_temporal_psnr))
     return out
+
+
+def _met(sel) -> str:
+    """``met`` (measured within its level's uncertainty, or exact), ``below`` (measured below it:
+    a miss shipped, with the reason in the fallback), or ``–`` (not measured)."""
+    if not sel.parts:
+        return "met"
+    if sel.measured_error is None:
+        return "–"
+    if sel.level_met is not None:
+        return "met" if sel.level_met else "below"
+    if sel.min_psnr is None or sel.exact:
+        return "met"
+    psnr = sel.measured_psnr if sel.measured_psnr is not None else float("inf")
+    return "met" if psnr + float(sel.measured_psnr_uncertainty or 0.0) >= sel.min_psnr else "below"
+
+
+def predictions(folders: Iterable) -> list[dict]:
+    """Per profile folder, |predicted − measured| PSNR (dB) over the distinct choices its
+    validation measured (``Profile.measured``; a profile from before it: its shipped selections):
+    ``raw`` from the models alone, ``calibrated`` as predicted when each was measured
+    (:mod:`rrcache.model.calibration`), each ``{"n", "mean", "worst"}``, and the pairs."""
+    from rrcache.model.calibration import prediction_errors
+
+    out = []
+    for folder in folders:
+        profile = load_profile(folder)
+        seen, pairs = set(), []
+        for sel in list(getattr(profile, "measured", None) or []) + list(profile.selections):
+            if not sel.parts or sel.exact or sel.key in seen or sel.predicted_psnr is None or sel.measured_psnr is None:
+                continue
+            seen.add(sel.key)
+            raw = sel.predicted_psnr - float(sel.calibration_db or 0.0)
+            pairs.append((sel.describe(), raw, sel.predicted_psnr, sel.measured_psnr))
+        out.append(dict(scene=f"{Path(profile.shader).stem} / {Path(profile.session).stem}", run=Path(folder).name,
+                        raw=prediction_errors([(r, m) for _, r, _, m in pairs]),
+                        calibrated=prediction_errors([(c, m) for _, _, c, m in pairs]), pairs=pairs))
+    return out
+
+
+def predictions_markdown(table: list[dict]) -> str:
+    """:func:`predictions` as a Markdown table, with every profile's choices pooled last."""
+    from rrcache.model.calibration import prediction_errors
+
+    def cell(e):
+        return "–" if not e["n"] else f"{e['mean']:.2f} / {e['worst']:.2f}"
+
+    lines = ["| scene | run | validated choices | |pred − meas| dB, models alone (mean / worst) | "
+             "calibrated when measured (mean / worst) |", "|---|---|---|---|---|"]
+    for r in table:
+        lines.append(f"| {r['scene']} | {r['run']} | {r['raw']['n']} | {cell(r['raw'])} | {cell(r['calibrated'])} |")
+    raw = prediction_errors([(p[1], p[3]) for r in table for p in r["pairs"]])
+    cal = prediction_errors([(p[2], p[3]) for r in table for p in r["pairs"]])
+    lines.append(f"| all | {len(table)} profiles | {raw['n']} | {cell(raw)} | {cell(cal)} |")
+    return "\n".join(lines)
 
 
 def slowdowns(table: list[dict]) -> list[dict]:
@@ -84,22 +147,27 @@ def _x(value: Optional[float]) -> str:
 def markdown(table: list[dict]) -> str:
     """The rows as a Markdown table (one line per shipped selection) and a closing count."""
     lines = ["| scene | run | level | cached | predicted | measured (range of repeats) | PSNR dB "
-             "(predicted) | class |", "|---|---|---|---|---|---|---|---|"]
+             "(predicted) | mean FLIP | level met | tries | class |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in table:
         rng = r["speedup_range"]
         measured = _x(r["speedup"]) + (f" ({rng[0]:.2f}–{rng[1]:.2f})" if rng and rng[0] != rng[1] else "")
         psnr = "∞ (exact)" if r.get("exact") or r["kind"] == "original" else (
-            "–" if r["psnr"] is None else f"{r['psnr']:.1f}")
+            "–" if r["psnr"] is None else f"{r['psnr']:.1f}" + (
+                f" ± {r['psnr_uncertainty']:.1f}" if r.get("psnr_uncertainty") else ""))
         if r.get("predicted_psnr") is not None:
             psnr += f" ({r['predicted_psnr']:.1f})"
         cached = r["cached"] + (f" ↩ {r['fallback']}" if r.get("fallback") else "")
         level = r["level"] + (f" ≥{r['min_psnr']:.0f} dB" if r.get("min_psnr") else "")
+        flip = "0" if r["kind"] == "original" or r.get("exact") else (
+            "–" if r.get("flip") is None else f"{r['flip']:.3f}" + (" (visible)" if r.get("visible") else ""))
         lines.append(f"| {r['scene']} | {r['run']} | {level} | {cached} | {_x(r['predicted_speedup'])} | "
-                     f"{measured} | {psnr} | {r['cls']} |")
+                     f"{measured} | {psnr} | {flip} | {r.get('met', '–')} | {r.get('tries', '–')} | {r['cls']} |")
     bad = slowdowns(table)
     lines.append("")
     lines.append(f"{len(table)} shipped selections in {len({(r['scene'], r['run']) for r in table})} profiles; "
-                 f"{len(bad)} measured slower than the original in every repeat.")
+                 f"{len(bad)} measured slower than the original in every repeat; "
+                 f"{sum(1 for r in table if r.get('met') == 'below')} shipped below their level; "
+                 f"{sum(1 for r in table if (r.get('tries') or 0) > 1)} levels needed a second candidate.")
     return "\n".join(lines)
 
 
@@ -111,7 +179,7 @@ def summary_markdown(table: list[dict]) -> str:
     for r in table:
         groups.setdefault((r["scene"], r["level"], r.get("min_psnr")), []).append(r)
     lines = ["| scene | level | runs | shipped | measured speed-up (run medians) | lowest repeat | "
-             "PSNR dB (range) | fell back |", "|---|---|---|---|---|---|---|---|"]
+             "PSNR dB (range) | met | fell back | second candidate |", "|---|---|---|---|---|---|---|---|---|---|"]
     for (scene, level, min_psnr), rs in groups.items():
         cached = [r for r in rs if r["kind"] != "original"]
         shipped = ", ".join(f"{k}× {n}" for n, k in _counts(r["cached"] if r["kind"] != "original"
@@ -125,7 +193,8 @@ def summary_markdown(table: list[dict]) -> str:
         label = level + (f" ≥{min_psnr:.0f} dB" if min_psnr else "")
         lines.append(f"| {scene} | {label} | {len(rs)} | {shipped} | {speed} | "
                      f"{'–' if not lows else f'{min(lows):.2f}×'} | {psnr} | "
-                     f"{sum(1 for r in rs if r.get('fallback'))} |")
+                     f"{sum(1 for r in rs if r.get('met') == 'met')}/{len(rs)} | "
+                     f"{sum(1 for r in rs if r.get('fallback'))} | {sum(1 for r in rs if (r.get('tries') or 0) > 1)} |")
     return "\n".join(lines)
 
 

@@ -3,6 +3,7 @@
     rrcache profile shaders/marble.glsl sessions/marble.json --out runs/marble-r1.rrprofile
     rrcache profile shaders/marble.glsl sessions/marble.json --out runs/marble-r2.rrprofile
     rrcache bench-repeats runs/*.rrprofile
+    rrcache bench-repeats --predictions runs/*.rrprofile     # the PSNR predictions against validation
 
 One line per shipped selection (:mod:`rrcache.bench.repeats`); exits 1 when a profile shipped a
 selection measured slower than the original in every repeat.
@@ -18,7 +19,9 @@ import click
 @click.argument("profiles", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
 @click.option("--summary", is_flag=True, help="One line per scene and level over all the runs.")
-def command(profiles, as_json, summary):
+@click.option("--predictions", is_flag=True,
+              help="The PSNR predictions' error on every validated choice, per profile and pooled (docs/levels.md).")
+def command(profiles, as_json, summary, predictions):
     """Tabulate the shipped selections of PROFILES (folders of repeated 'rrcache profile' runs):
     speed-ups measured beside the original (median and range of the repeats), PSNR, fallbacks,
     and whether any shipped a measured slowdown."""
@@ -31,6 +34,12 @@ def command(profiles, as_json, summary):
         click.echo(f"note: {p}: skipped, no profile.json yet (still running, or interrupted)", err=True)
     if not done:
         raise click.UsageError("none of the folders holds a profile.json")
+    if predictions:
+        from rrcache.bench.repeats import predictions as prediction_rows, predictions_markdown
+
+        found = prediction_rows(done)
+        click.echo(json.dumps(found) if as_json else predictions_markdown(found))
+        return
     table = rows(done)
     if as_json:
         click.echo(json.dumps(table))

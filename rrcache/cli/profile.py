@@ -86,7 +86,8 @@ def _fmt(value, spec=".3g", none="–"):
               help="Share of the frame the error runs render at full resolution (default: chosen from the "
                    "original's cost, at most 0.25; 1: the whole frame).")
 @click.option("--frames", type=click.IntRange(min=2), default=None,
-              help="Train the error on the first N frames (default: 64, or all of a shorter session).")
+              help="Train the error on N frames, spread over the session in segments (default: 150, all of a "
+                   "shorter session).")
 @click.option("--periods", callback=_periods, default=None, metavar="LIST",
               help=f"Training refresh periods (default: {','.join(map(str, DEFAULT_PERIODS))}).")
 @click.option("--timing-frames", type=click.IntRange(min=1), default=None,
@@ -130,6 +131,9 @@ def _fmt(value, spec=".3g", none="–"):
               help="After validation, measure each selection's node with adaptive refresh at these "
                    "thresholds (e.g. 0.005,0.01,0.02) and keep it where faster at the same level "
                    "(docs/adaptive.md).")
+@click.option("--max-flip", type=click.FloatRange(min=0, min_open=True), default=None, metavar="F",
+              help="Add a level 'flip': the fastest choice measured at mean FLIP <= F against the original "
+                   "(docs/levels.md).")
 @click.option("--clock", type=click.Choice(sorted(CLOCKS)), default=DEFAULT_CLOCK, show_default=True,
               help="The frame clock of every timed run: wall = wall time around glFinish (the only one that "
                    "means anything on a software rasterizer); gl-timer = GL timer queries (real GPUs). "
@@ -140,7 +144,7 @@ def _fmt(value, spec=".3g", none="–"):
 @include_dirs_option
 def command(shader, session, out_dir, resolution, error_window, frames, periods, timing_frames, timing_periods,
             algorithm, filter_, measure_terms, budget, min_saving, validation_frames, no_validate, fresh, min_gain,
-            timing_format, levels, wait, max_sets, defines, adaptive, clock, workers, scheduler, quiet, vert,
+            timing_format, levels, wait, max_sets, defines, adaptive, clock, workers, scheduler, max_flip, quiet, vert,
             include_dirs):
     """Train error and performance models of the cacheable nodes of SHADER over SESSION, select
     what to cache at four error levels, and write the profile folder."""
@@ -167,7 +171,7 @@ def command(shader, session, out_dir, resolution, error_window, frames, periods,
                 with maybe_cluster(workers, scheduler, announce=reporter.line) as cluster:
                     prof = profile(shader, session, out, settings, parse_defines(defines), reporter.event, fresh=fresh,
                                    vertex=vert, include_dirs=include_dirs, wait=wait, adaptive=adaptive,
-                                   executor=cluster)
+                                   executor=cluster, max_flip=max_flip)
             finally:
                 for w in caught:
                     err_console.print(f"warning: {w.message}", highlight=False, markup=False)
@@ -234,6 +238,11 @@ def _summary(prof, console: Console) -> None:
                   f"training {_fmt(prof.training_wall_s, '.1f')} s", highlight=False)
     console.print(f"algorithm: {algorithm_line(prof)}", highlight=False)
     console.print(f"filter: {filter_line(prof)}", highlight=False)
+    if prof.plan:
+        from rrcache.profiler.plan import Plan
+
+        console.print(Plan.from_json(prof.plan).describe(prof.settings.resolution, prof.settings.frames),
+                      highlight=False)
     for line in _estimator_lines(prof):
         console.print(line, highlight=False)
     ceiling = prof.measured_ceiling

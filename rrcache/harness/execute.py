@@ -26,6 +26,7 @@ from rrcache import kinds
 from rrcache.harness.cached import CachedRenderer
 from rrcache.harness.metrics import mean_l2, psnr
 from rrcache.harness.renderer import Renderer
+from rrcache.harness.segments import restart, run_order, warmup_of
 from rrcache.runs import PSNR_CAP, FrameRow, RunResult, RunSpec
 
 #: ``on_frame(spec, units)``: progress, ``units`` frames of ``spec.cost`` done
@@ -130,18 +131,13 @@ def _execute(spec: RunSpec, bench: Bench, on_frame: Optional[FrameCallback]) -> 
     refs = bench.references(spec) if spec.measure == "error" else None
     cached, setup_s = bench.cached(spec)
     original = bench.original(spec) if spec.measure == "timing" else None
-    rows = []
-    complete = True
+    rows: list = []
     cached.reset()
-    for i, index in enumerate(spec.frames):
-        if spec.measure == "error":
-            ref = refs[i]
-            got = cached.render_frame(index)
-            err, left_out = mean_l2(got.image, ref.image, ref.mask)
-            rows.append(FrameRow(index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP), got.hits,
-                                 got.misses, int(got.covered_pixels), int(left_out), float(got.ms)))
-            step()
-        else:  # timing (beside the original) or overhead (alone): frame index after a warm-up frame
+    if spec.measure == "error":
+        complete = _error_rows(spec, cached, refs, rows, step)
+    else:  # timing (beside the original) or overhead (alone): each frame after a warm-up frame
+        complete = True
+        for index in spec.frames:
             ref = original.render_frame(index) if original is not None else None
             cached.reset()
             cached.render_frame(index - 1)
@@ -149,11 +145,33 @@ def _execute(spec: RunSpec, bench: Bench, on_frame: Optional[FrameCallback]) -> 
             rows.append(FrameRow(index, hits=got.hits, misses=got.misses, covered=int(got.covered_pixels),
                                  ms=float(got.ms), original_ms=float(ref.ms) if ref is not None else math.nan))
             step(3 if original is not None else 1)
-        if spec.strict_payload and cached.payload_dtype != spec.variant.payload:
-            complete = False
-            break
+            if spec.strict_payload and cached.payload_dtype != spec.variant.payload:
+                complete = False
+                break
     return RunResult(spec, tuple(rows), time.perf_counter() - start, setup_s, cached.payload_dtype,
                      tuple(cached.notes) + ((cached.payload_note,) if cached.payload_note else ()), complete)
+
+
+def _error_rows(spec: RunSpec, cached: CachedRenderer, refs: list, rows: list, step) -> bool:
+    """An error run's rows into ``rows``: its frames against the original's ``refs``, segment by
+    segment, each later one after its warm-up (:mod:`rrcache.harness.segments`; frames 0..N−1 are
+    one segment from an empty cache, as validation renders them). False when ``strict_payload``
+    stopped it."""
+    by_index = dict(zip(spec.frames, refs))
+    for segment in run_order(spec.frames, warmup_of(spec.variant)):
+        restart(cached, segment[0][0])
+        for index, compared in segment:
+            got = cached.render_frame(index)
+            if not compared:
+                continue
+            ref = by_index[index]
+            err, left_out = mean_l2(got.image, ref.image, ref.mask)
+            rows.append(FrameRow(index, float(err), min(float(psnr(got.image, ref.image)), PSNR_CAP), got.hits,
+                                 got.misses, int(got.covered_pixels), int(left_out), float(got.ms)))
+            step()
+            if spec.strict_payload and cached.payload_dtype != spec.variant.payload:
+                return False
+    return True
 
 
 def _compare(spec: RunSpec, bench: Bench, step, start: float) -> RunResult:

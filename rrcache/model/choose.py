@@ -159,7 +159,9 @@ def _psnr_terms(prof, i: int, period, fit) -> tuple[float, float]:
     spread = 0.0
     if node.frame_spreads and len(node.frame_spreads) == len(node.periods) and period is not None:
         j = min(range(len(node.periods)), key=lambda k: abs(node.periods[k] - period))
-        spread = float(node.frame_spreads[j])
+        # the error's drift over the session moves the prediction only through the frames the
+        # error runs did not cover (docs/levels.md)
+        spread = float(node.frame_spreads[j]) * prof.uncovered_share()
     return prof._loo[node.id], spread
 
 

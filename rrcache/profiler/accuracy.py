@@ -148,7 +148,7 @@ def held_out(profile, periods: Sequence[int] = DEFAULT_PERIODS, nodes: Optional[
                            hint="give trained node ids (profile.json lists them)")
     work, session = load_work(profile)
     plan = Plan.from_json(profile.plan or {})
-    train_frames = list(range(settings.frames))
+    train_frames = plan.error_frames(settings.frames)  # the profile's error frames (rrcache.profiler.plan)
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     meter = Meter(progress, len(train_frames) * (1 + len(nodes) * len(periods)) + 3 * len(timing) * len(nodes) * len(periods))
     report = AccuracyReport(periods, nodes, chosen_by=chosen_by)

@@ -55,7 +55,9 @@ class RunShapes:
 
     @classmethod
     def of(cls, settings, session, plan, timing_frames) -> "RunShapes":
-        return cls(tuple(range(settings.frames)), tuple(settings.resolution),
+        # the error frames the plan chose (rrcache.profiler.plan: the session, or segments of it)
+        frames = plan.error_frames(settings.frames) if plan is not None else range(settings.frames)
+        return cls(tuple(frames), tuple(settings.resolution),
                    plan.error_window if plan is not None else None, tuple(timing_frames),
                    tuple(int(v) for v in session.resolution), plan.timing_window if plan is not None else None,
                    settings.timing_format, settings.clock)

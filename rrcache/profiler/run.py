@@ -52,7 +52,7 @@ def default_out_dir(shader_path, session_path) -> Path:
 def profile(shader_path, session_path, out_dir=None, settings: Optional[TrainingSettings] = None,
             defines: Optional[Mapping[str, str]] = None, progress: Optional[ProgressFn] = None,
             fresh: bool = False, plots: bool = True, include_dirs=(), wait: bool = False,
-            vertex=None, adaptive=None, executor=None) -> Profile:
+            vertex=None, adaptive=None, executor=None, max_flip: Optional[float] = None) -> Profile:
     """Profile ``shader_path`` over the session file ``session_path`` into ``out_dir`` (see the
     module docstring) and return the :class:`~rrcache.profiles.document.Profile`. Resumes from a
     store in ``out_dir`` trained with the same shader, session and settings; ``fresh=True``
@@ -69,7 +69,8 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
     factory with a ``capacity`` (runs made at once: a Dask cluster's workers,
     :class:`rrcache.cluster.client.Cluster`) buys a larger default plan
     (:mod:`rrcache.profiler.capacity`); an executor with a ``record(capacity)`` has it kept in
-    ``Profile.cluster``.
+    ``Profile.cluster``. ``max_flip``: a fifth level, ``flip``, of mean FLIP at most this
+    (:func:`rrcache.profiler.validate.flip_level`; docs/levels.md).
 
     >>> p = profile("noise.frag", "orbit.json", "out/", TrainingSettings(periods=(2, 4, 8)))  # doctest: +SKIP
     """
@@ -82,7 +83,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
             try:
                 prof = _profile(shader_path, session_path, out_dir, settings, caught, defines=defines,
                                 progress=progress, fresh=fresh, plots=plots, include_dirs=include_dirs, wait=wait,
-                                vertex=vertex, adaptive=adaptive, executor=executor)
+                                vertex=vertex, adaptive=adaptive, executor=executor, max_flip=max_flip)
             finally:
                 raised = list(caught)
     finally:
@@ -92,7 +93,7 @@ def profile(shader_path, session_path, out_dir=None, settings: Optional[Training
 
 
 def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defines, progress, fresh, plots,
-             include_dirs, wait, vertex, adaptive, executor) -> Profile:
+             include_dirs, wait, vertex, adaptive, executor, max_flip: Optional[float] = None) -> Profile:
     import rrcache
     from rrcache.pipeline import load_for_session
     from rrcache.session import load_session
@@ -124,25 +125,31 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
         make_executor, runner = executor, None
         try:
             store.begin_run()
-            if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
-                from rrcache.profiler.terms import scores_for
+            verdict = None
+            if not work.table.nodes:  # nothing a cache can hold: the answer is the original, why, its frame time
+                result, verdict = _original_only(work, session, resolved), no_node_verdict(work)
+                runner = None
+            else:
+                if resolved.measure_terms:  # the order of sums whose weights do not fold, measured once
+                    from rrcache.profiler.terms import scores_for
 
-                scores = scores_for(work, session, store, progress)
-                if scores:
-                    work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
-                                            term_scores=scores)
-            # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
-            # the original's reference frames rendered once
-            runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
-            result = train(work, session, resolved, store, progress, executor=runner)
-            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out)
+                    scores = scores_for(work, session, store, progress)
+                    if scores:
+                        work = load_for_session(shader_path, session, defines, include_dirs, vertex=vertex,
+                                                term_scores=scores)
+                # one executor for every stage: the shader's variants compiled once (rrcache.kinds.compile),
+                # the original's reference frames rendered once
+                runner = make_executor(work, session) if make_executor is not None else LocalExecutor(Bench(work, session))
+                result = train(work, session, resolved, store, progress, executor=runner)
+            prof = _assemble(work, session, shader_path, session_path, resolved, result, store, out, verdict)
             prof.term_scores = dict(work.term_scores)
-            prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
-            # amortized sampling: the estimators' models, on the same front as the nodes
-            from rrcache.profiler.amortize import train_estimators
-            prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
-            runner.close()  # validation renders side by side with its own renderers
-            prof.selections = _selections(prof, work, session, resolved, result, store, progress)
+            if runner is not None:
+                prof.sets = _sets(prof, work, session, resolved, store, progress, runner)
+                # amortized sampling: the estimators' models, on the same front as the nodes
+                from rrcache.profiler.amortize import train_estimators
+                prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
+                runner.close()  # validation renders side by side with its own renderers
+            prof.selections = _selections(prof, work, session, resolved, result, store, progress, max_flip)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
@@ -195,9 +202,10 @@ def _add_times(prof: Profile, store, run_wall_s: float) -> None:
 
 
 def _assemble(work, session, shader_path, session_path, settings, result: TrainingResult, store,
-              out: Path) -> Profile:
+              out: Path, verdict: Optional[dict] = None) -> Profile:
     """The profile of a training result, before its selections (read back from its own
-    document, so that what the run goes on with is what a reader gets)."""
+    document, so that what the run goes on with is what a reader gets); ``verdict``: the answer
+    when nothing was trained for a reason other than the ceiling's."""
     by_id = {n.id: n for n in work.table.nodes}
     nodes = []
     for nid in result.order:
@@ -237,7 +245,7 @@ def _assemble(work, session, shader_path, session_path, settings, result: Traini
         hit_fit=_fit_json(hit), overhead_ms=result.overhead_ms, original_ms=result.original_ms,
         pixels=result.pixels, training_wall_s=result.spent_s, counts=dict(result.counts),
         ceiling=result.ceiling.to_json() if result.ceiling is not None else None,
-        verdict=_verdict(result.ceiling) if result.stopped else None,
+        verdict=verdict if verdict is not None else (_verdict(result.ceiling) if result.stopped else None),
         timing_noise=result.noise, timing_reliable=result.noise <= UNRELIABLE_NOISE,
         psnr_offset_db=_psnr_offset(store, settings, result))
     prof = Profile.from_json(draft.to_json(), str(out / JSON_NAME))
@@ -279,7 +287,8 @@ def _psnr_offset(store, settings, result: TrainingResult) -> float:
     return coverage_offset_db(train_covered, train_area, check_covered, check_area)
 
 
-def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress) -> list:
+def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress,
+                max_flip: Optional[float] = None) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
     (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
     if not result.trained:
@@ -293,12 +302,19 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
                           window=result.plan.timing_window if result.plan is not None else None,
                           candidates=prof.front_candidates)
     measured = validator.run(choices)
+    if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first
+        from rrcache.profiler.validate import flip_level
+
+        flip = flip_level(prof, validator, float(max_flip))
+        store.add_validation(flip)
+        measured.append(flip)
     if any(s.multi for s in measured):  # a set stands only where it beats the single choice it displaced
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
                                result.plan.timing_window if result.plan is not None else None)
     prof.calibration = calibration_record(validator)
+    prof.measured = [s.replace(files=None) for s in validator.measured.values()]
     # the counts were taken before validation: count the validations now
     prof.counts = dict(prof.counts, validations=store.counts()["validations"])
     return measured
@@ -327,6 +343,60 @@ def _verdict(ceiling) -> dict:
             "reason": ceiling.reason(), "changes": ceiling.changes()}
 
 
+def _original_only(work, session, settings) -> TrainingResult:
+    """The training result of a shader with nothing to train: the original's frame time (the
+    median over the timing frames at full resolution) and covered pixels, nothing else."""
+    import statistics
+
+    from rrcache.harness.renderer import Renderer
+    from rrcache.profiler.train import timing_frame_indices
+
+    full = tuple(int(v) for v in session.resolution)
+    with Renderer(work.prepared, session, full, color_format=settings.timing_format) as renderer:
+        frames = [renderer.render_frame(i) for i in timing_frame_indices(session.frames, settings.timing_frames)]
+    result = TrainingResult(order=[], trained=[], untrained=[], stopped=True)
+    if frames:
+        result.original_ms = float(statistics.median(f.ms for f in frames))
+        result.pixels = float(statistics.mean(f.covered_pixels for f in frames))
+    return result
+
+
+def no_node_verdict(work) -> dict:
+    """The answer for a shader with no value a cache can hold (``work.table.nodes`` empty): keep
+    the original, why (the analysis's reasons, counted) and what would change it. A shader whose
+    every per-pixel value depends on the screen position (a Book of Shaders sketch of
+    ``gl_FragCoord``) is said to be one.
+
+    >>> from types import SimpleNamespace as NS
+    >>> table = NS(nodes=[], excluded=[NS(reason="screen")] * 3 + [NS(reason="uniform")], shader=None)
+    >>> no_node_verdict(NS(table=table))["answer"]
+    'keep the original shader: every value it computes per pixel depends on the screen position (gl_FragCoord), which a surface cache cannot hold'
+    """
+    from collections import Counter
+
+    counts = Counter(x.reason for x in work.table.excluded)
+    per_pixel = {r: n for r, n in counts.items() if r not in ("uniform", "type", "duplicate")}
+    listed = ", ".join(f"{n} {r}" for r, n in counts.most_common())
+    if per_pixel and set(per_pixel) <= {"screen", "derivative"} and counts.get("screen"):
+        answer = ("keep the original shader: every value it computes per pixel depends on the screen position "
+                  "(gl_FragCoord), which a surface cache cannot hold")
+        reason = (f"a reverse reprojection cache keeps values of surface points and fetches them where the surface "
+                  f"was last frame; every value this shader computes per pixel is a function of the pixel's "
+                  f"position on the screen, so none of them belongs to a surface (the analysis left out {listed})")
+    elif counts:
+        answer = "keep the original shader: none of the values it computes can be cached"
+        reason = f"the analysis left every value out ({listed}; 'rrcache nodes SHADER --all' says why for each)"
+    else:
+        answer = "keep the original shader: it computes no value a cache could hold"
+        reason = "its colour comes from inputs and constants alone"
+    return {"choice": "original", "ceiling": None, "min_gain": None, "answer": answer, "reason": reason,
+            "changes": ["compute the costly values from surface inputs (v_position, v_objectPosition, v_texcoord, "
+                        "v_normal) rather than gl_FragCoord: a reprojection cache follows surfaces as they move",
+                        "a screen-space effect is better served by rendering it at a lower resolution or caching it "
+                        "in a screen-space texture of your own",
+                        "'rrcache nodes SHADER --all' lists every value left out and the reason"]}
+
+
 def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
     """The shader files of each selection, then (with ``plots``) the plots, the report's frames
     (rendered here, once: :mod:`rrcache.profiler.frames`) and the report, which reads them."""
@@ -339,10 +409,10 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
                 folder.remove_files()
                 choice_write(prof, sel, folder, work=work)
             kept.append(sel.replace(files=f"optimized/{sel.label}"))
-        if prof.verdict is not None:  # stopped before training: nothing to plot or report
+        answered = prof.verdict is not None  # stopped before training: nothing to plot, the answer to report
+        if answered:
             with optimized.folder("original") as folder:
                 choice_write(prof, Selection.original(float(prof.original_ms or 0.0)), folder)
-            plots = False
     prof.selections = kept
     prof.path = out
     if plots:
@@ -350,6 +420,7 @@ def _write_outputs(prof: Profile, out: Path, work, plots: bool) -> None:
         from rrcache.report import write_report
         from rrcache.report.plots import write_plots
 
-        prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
-        write_frames(prof, out, work)
+        if not answered:
+            prof.plots = [str(Path(p).relative_to(out)) for p in write_plots(prof, out)]
+            write_frames(prof, out, work)
         write_report(prof, out)

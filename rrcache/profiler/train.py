@@ -5,10 +5,12 @@ holds, and fits the models from what is stored:
 
 0. **Order and plan.** The nodes worth training, in the order of :mod:`rrcache.profiler.order`
    (too-cheap nodes skipped, the rest diversity first). The original is timed at full resolution
-   on the timing frames, and from that time the windows of :mod:`rrcache.profiler.plan` are
-   chosen (once; kept in the store). With ``algorithm="auto"`` the three-pass and two-pass
-   variants of the first node are timed beside the original (:func:`choose_algorithm`) and the
-   faster serves the whole profile (kept in the plan too).
+   on the timing frames, and the windows and error frames of :mod:`rrcache.profiler.plan` are
+   chosen (once; kept in the store). With ``algorithm="auto"`` the ceiling's per-algorithm
+   limits decide which algorithm serves the whole profile when they differ beyond their noise;
+   else the three-pass and two-pass variants of the first node are timed beside the original
+   (:func:`choose_algorithm`) and the faster serves when the difference exceeds its noise, else
+   the higher ceiling (kept in the plan too, with the reason).
 1. **Reference frames.** The original shader over the training frames inside the error window
    (full pixel density), rendered once and kept in memory for the run.
 2. **Error runs.** Per node one :class:`~rrcache.harness.cached.CachedRenderer` inside the same
@@ -60,9 +62,7 @@ from rrcache.profiler.filters import choose_filter
 from rrcache.runtime.cache import DEFAULT_FILTER
 from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
                                     shader_inputs, signature)
-from rrcache.profiler.plan import (ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION, TIMING_TARGET_MS, Plan,
-                                   coverage_map,
-                                   fraction_for, place_window)
+from rrcache.profiler.plan import Plan, algorithm_by_ceiling, algorithm_by_timing, make_plan as _make_plan
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiler.collect import Collector
 from rrcache.profiler.jobs import Group, Meter, RunPlan, RunShapes
@@ -137,19 +137,11 @@ def training_order(work: ShaderWork, session, settings: TrainingSettings) -> Tra
     return TrainingOrder(diversity_order(keep, signatures), skipped, signatures)
 
 
-def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames: list[int]) -> Plan:
-    """Choose the error and timing windows (:mod:`rrcache.profiler.plan`) for a shader whose
-    full frame costs ``original_ms``, placed over the coverage of ``frames``."""
-    full = tuple(int(v) for v in session.resolution)
-    at_full = tuple(settings.resolution) == full
-    error_fraction = settings.error_window if settings.error_window is not None else \
-        fraction_for(original_ms, ERROR_TARGET_MS, MAX_ERROR_FRACTION, MIN_ERROR_FRACTION)
-    timing_fraction = 1.0 if original_ms <= TIMING_TARGET_MS else fraction_for(original_ms, TIMING_TARGET_MS, 1.0)
-    need = (at_full and error_fraction < 1.0) or timing_fraction < 1.0
-    coverage = coverage_map(work.prepared, session, frames[::max(1, len(frames) // 16)], Renderer) if need else None
-    error_window = place_window(coverage, full, error_fraction) if at_full and error_fraction < 1.0 else None
-    timing_window = place_window(coverage, full, timing_fraction) if timing_fraction < 1.0 else None
-    return Plan(error_window, timing_window, float(original_ms))
+def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames=None) -> Plan:
+    """Choose the error and timing windows and the error frames (:func:`rrcache.profiler.plan.make_plan`:
+    sized from the original's CPU time, which load moves little) for a shader whose full frame
+    measured ``original_ms``. ``frames`` is ignored (the plan chooses the error frames)."""
+    return _make_plan(work, session, settings, original_ms, Renderer)
 
 
 def timing_frame_indices(session_frames: int, count: int) -> list[int]:
@@ -173,10 +165,13 @@ AUTO_CANDIDATES = ("three-pass", "two-pass")
 
 
 def choose_algorithm(settings: TrainingSettings, node_id: str, shapes: RunShapes, executor,
-                     meter: Optional[Meter] = None) -> tuple[str, dict]:
+                     meter: Optional[Meter] = None) -> tuple[str, dict, dict]:
     """Time the :data:`AUTO_CANDIDATES` variants of ``node_id`` on the timing frames at the
     middle timing period, each frame beside the original as the timing runs are, and return the
-    faster and each one's median time as a fraction of the original's. The three-pass
+    faster median, each one's median time as a fraction of the original's and each one's
+    per-frame fractions (whether their difference exceeds its noise is
+    :func:`rrcache.profiler.plan.algorithm_by_timing`'s to say; profiles decide from the
+    ceiling's limits first, :func:`rrcache.profiler.plan.algorithm_by_ceiling`). The three-pass
     algorithm is the paper's choice for GPUs, where a pass over the geometry is cheap and
     multiple render targets are not; on llvmpipe the geometry is set up on one thread, and the
     two-pass variant, one pass over the geometry fewer, measured 8-10% faster on Marble."""
@@ -184,11 +179,11 @@ def choose_algorithm(settings: TrainingSettings, node_id: str, shapes: RunShapes
     runs = [shapes.run("timing", VariantSpec("cache", (node_id,), algorithm, periods=(period,),
                                              **settings.cache_options()),
                        ("auto", algorithm), f"{node_id} {algorithm} Δn={period}") for algorithm in AUTO_CANDIDATES]
-    fractions = {}
+    fractions, ratios = {}, {}
     for result in executor.run(runs, on_frame=meter.on_frame() if meter is not None else None):  # kept in the plan
-        fractions[result.spec.key[1]] = float(statistics.median(r.ms / r.original_ms for r in result.frames
-                                                                 if r.original_ms > 0))
-    return min(fractions, key=fractions.get), fractions
+        ratios[result.spec.key[1]] = [r.ms / r.original_ms for r in result.frames if r.original_ms > 0]
+        fractions[result.spec.key[1]] = float(statistics.median(ratios[result.spec.key[1]]))
+    return min(fractions, key=fractions.get), fractions, ratios
 
 
 def _node_complete(store: ProfileStore, node_id: str, settings: TrainingSettings) -> bool:
@@ -216,7 +211,7 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                            hint="'rrcache nodes SHADER' says why in its algorithms column; profile with "
                                 "--algorithm auto, three-pass or two-pass")
     ids = [n.id for n in order.nodes]
-    train_frames = list(range(settings.frames))
+    train_frames: list[int] = []  # the plan's error frames, once the plan is known
     timing = timing_frame_indices(session.frames, settings.timing_frames)
     full = tuple(int(v) for v in session.resolution)
 
@@ -256,11 +251,11 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
                 collector.add(result)
         stored_plan = store.plan()
         if stored_plan is None:
-            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()),
-                             train_frames)
+            plan = make_plan(work, session, settings, min(ms for _, ms, _ in store.reference_timing()))
             store.set_plan(plan.to_json())
         else:
             plan = Plan.from_json(stored_plan)
+        train_frames[:] = plan.error_frames(settings.frames)
         shapes = RunShapes.of(settings, session, plan, timing)
         if order.nodes and len(timing) > 0:
             ceiling = _ceiling_of_a_compiling_node(work, session, settings, store, plan, order, timing, meter,
@@ -297,9 +292,17 @@ def train(work: ShaderWork, session, settings: TrainingSettings, store: ProfileS
         meter.grow(training_total())
         if plan.algorithm is None:
             if settings.algorithm == "auto" and order.nodes and len(timing) > 0:
-                meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
-                plan.algorithm, plan.algorithm_times = choose_algorithm(settings, order.nodes[0].id, shapes, executor,
-                                                                        meter)
+                # the ceiling's per-algorithm limits decide when they differ beyond their noise;
+                # else a timing of the first node, when its difference exceeds its noise
+                chosen, why = algorithm_by_ceiling(ceiling.algorithms if ceiling is not None else {},
+                                                   ceiling.noise if ceiling is not None else 0.0)
+                if chosen is None:
+                    meter.grow(len(AUTO_CANDIDATES) * 3 * len(timing))
+                    _, plan.algorithm_times, ratios = choose_algorithm(settings, order.nodes[0].id, shapes, executor,
+                                                                       meter)
+                    chosen, why = algorithm_by_timing(ratios, ceiling.algorithm if ceiling is not None
+                                                      else settings.fixed_algorithm)
+                plan.algorithm, plan.algorithm_reason = chosen, why
             else:
                 plan.algorithm = settings.fixed_algorithm
             store.set_plan(plan.to_json())

@@ -293,7 +293,7 @@ class Validator:
             if why is None:
                 sel = sel.replace(tries=len(refused) + 1, level_met=True)
                 if refused:
-                    sel = sel.replace(fallback=f"{_refusals(refused)}; so {sel.describe()} stands "
+                    sel = sel.replace(fallback=f"{_refusals(refused)}; so {described(sel)} stands "
                                                f"(candidate {len(refused) + 1})")
                 return sel
             refused.append((sel, why))
@@ -304,7 +304,7 @@ class Validator:
             return original.replace(fallback=f"{_refusals(refused)}; so the original shader stands")
         shift = self.calibration.shift(calibration_group(choice))
         return original.replace(
-            fallback=f"{choice.describe()} and every other candidate are predicted below the level once calibrated "
+            fallback=f"{described(choice)} and every other candidate are predicted below the level once calibrated "
                      f"by the choices measured before ({shift:+.1f} dB); so the original shader stands")
 
     def run(self, choices: list[Selection]) -> list[Selection]:
@@ -319,12 +319,63 @@ class Validator:
         return out
 
 
+def flip_level(prof, validator: "Validator", max_flip: float, label: str = "flip") -> Selection:
+    """The selection that stands at a mean-FLIP level ``max_flip`` (``rrcache profile
+    --max-flip``), after the PSNR levels were validated: FLIP is measured, not modelled, so the
+    measured choices that meet it (and the gain) are the first answer; else the models' choice at
+    the PSNR the measured choices relate to that FLIP (:func:`rrcache.profiles.measured.flip_psnr`),
+    validated at the FLIP level like any level (up to :data:`MAX_TRIES` candidates of the front
+    at that PSNR, fastest first), and failing those the original."""
+    from rrcache.profiles.measured import flip_psnr
+
+    gain = validator.settings.min_gain
+    measured = [m for m in validator.measured.values() if m.parts]
+    meeting = [m for m in measured if quality_miss(measured_flip=m.measured_flip, max_flip=max_flip,
+                                                   flip_uncertainty=float(m.measured_flip_uncertainty or 0.0),
+                                                   exact=m.exact) is None
+               and speed_miss(m.speedups or (m.measured_speedup,), gain) is None]
+    needed = flip_psnr([(m.measured_psnr, m.measured_flip) for m in measured if not m.exact], max_flip)
+    model = prof.select_psnr(needed) if needed is not None else None
+    best = max(meeting, key=lambda m: float(m.measured_speedup or 0.0), default=None)
+    if best is not None and (model is None or not model.parts
+                             or float(best.measured_speedup) >= float(model.predicted_speedup)):
+        return best.replace(label=label, max_flip=max_flip, min_psnr=None, tries=0, level_met=True, fallback=None,
+                            level_note=None)
+    if model is None:  # nothing to relate FLIP to: the original stands, saying so
+        base = prof.select_psnr(45.0)
+        return _original(base.replace(label=label, min_psnr=None, max_flip=max_flip)).replace(
+            level_met=True, fallback=f"no measured choice has mean FLIP ≤ {max_flip:g}, and too few were measured to "
+                                     "relate FLIP to PSNR; so the original shader stands")
+    choice = model.replace(label=label, min_psnr=None, max_flip=max_flip)
+
+    def candidates(c: Selection) -> list[Selection]:
+        return [x.replace(min_psnr=None, max_flip=max_flip)
+                for x in prof.front_candidates(c.replace(min_psnr=needed)) if x.key != c.key]
+
+    validator.candidates = candidates
+    return validator.level(choice)
+
+
 def _no_nan(value):
     raise TypeError(f"not JSON: {value!r}")
 
 
 def _refusals(refused) -> str:
-    return "; ".join(f"{s.describe()}: {why}" for s, why in refused)
+    return "; ".join(f"{described(s)}: {why}" for s, why in refused)
+
+
+def described(sel: Selection, width: int = 40) -> str:
+    """``sel`` for people: a cached node with its expression (cut to ``width`` characters),
+    ``n2442 (mix(stone, u_veinColor, vein)) Δn=7``; other kinds as :meth:`Selection.describe`.
+
+    >>> from rrcache.selection import CachedNode
+    >>> described(Selection((CachedNode("n7", 4, "mix(a, b, t)"),), 0.01, 1.0, 2.0))
+    'n7 (mix(a, b, t)) Δn=4'
+    """
+    if sel.kind == "cache" and sel.text:
+        text = sel.text if len(sel.text) <= width else sel.text[:width - 1] + "…"
+        return f"{sel.node} ({text}) Δn={sel.period}"
+    return sel.describe()
 
 
 def validate(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore, choices: list[Selection],

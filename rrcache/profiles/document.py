@@ -185,6 +185,10 @@ class Profile:
     #: predictions' error on them, ``raw`` and ``calibrated`` (as each was predicted when it was
     #: measured): ``{"n", "mean", "worst"}`` of |predicted − measured| dB. Empty before validation.
     calibration: dict = field(default_factory=dict)
+    #: every choice validation measured, shipped or refused at a level, with its measured figures
+    #: (``rrcache select`` and the explorer answer from these where they can:
+    #: :mod:`rrcache.profiles.measured`)
+    measured: list[Selection] = field(default_factory=list)
     #: the sets of cached nodes predicted to improve the single-node front, the trained ones with
     #: their measurements (:mod:`rrcache.profiler.sets`); selection returns a trained one where it
     #: was measured faster at the level
@@ -309,6 +313,24 @@ class Profile:
     def front_candidates(self, choice: Selection) -> list[Selection]:
         """:func:`rrcache.model.choose.front_candidates` of this profile."""
         return _choose.front_candidates(self, choice)
+
+    def uncovered_share(self) -> float:
+        """The share of the validation frames the error runs did not cover (``plan``'s
+        ``error_segments``; a plan without them trained on the first ``settings.frames``).
+
+        >>> p = Profile("s", "t", "", "", TrainingSettings(frames=64, validation_frames=150), "two-pass", [])
+        >>> round(p.uncovered_share(), 3)
+        0.573
+        """
+        total = self.settings.validation_frames
+        if not total:
+            return 0.0
+        segments = (self.plan or {}).get("error_segments")
+        if segments:
+            covered = {i for start, n in segments for i in range(int(start), int(start) + int(n))}
+        else:
+            covered = set(range(int(self.settings.frames or 0)))
+        return 1.0 - len(covered & set(range(int(total)))) / float(total)
 
     # ------------------------------------------------------------------ amortized sampling
     def estimator(self, estimator_id: str) -> EstimatorProfile:
@@ -582,8 +604,12 @@ def filter_line(prof: Profile) -> str:
 
 
 def algorithm_line(prof: Profile) -> str:
-    """The profile's algorithm, and with ``auto`` what was measured: 'two-pass (auto: two-pass
-    0.377, three-pass 0.41 of the original's time)'."""
+    """The profile's algorithm, and with ``auto`` how it was decided: 'two-pass (auto, from the
+    ceiling: two-pass 1.47× against three-pass 0.85× ...)', or what a timing measured
+    ('two-pass (auto: two-pass 0.377, three-pass 0.41 of the original's time)')."""
+    reason = (prof.plan or {}).get("algorithm_reason")
+    if prof.settings.algorithm == "auto" and reason:
+        return f"{prof.algorithm} (auto, from {reason})"
     times = prof.algorithm_times or {}
     if prof.settings.algorithm != "auto" or not times:
         return prof.algorithm

@@ -7,9 +7,10 @@ refresh pattern, depth epsilon, validation frames) are hashed into the key of th
 ``budget_s`` and ``validate`` only decide how much is done, so they are left out of the key and
 may change between a run and its resumption.
 
-The error is measured over the first ``frames`` consecutive frames (default 64: the steady state
-of the largest paper period, 50, plus 14 frames) at the session's full resolution, inside a
-window of the frame chosen from the original's cost (:mod:`rrcache.profiler.plan`), or at an
+The error is measured over ``frames`` frames of the session (default 150: all of a session of
+up to 150 frames, as validation measures it; a longer one in segments spread over it,
+:func:`rrcache.profiler.plan.error_segments`) at the session's full resolution, inside a window
+of the frame chosen from the original's CPU time (:mod:`rrcache.profiler.plan`), or at an
 explicit reduced ``resolution`` (errors are then larger: the resampling blur grows with the
 pixel size). The times are measured on ``timing_frames`` frames at the session's full
 resolution.
@@ -48,8 +49,9 @@ DEFAULT_ALGORITHM = "three-pass"
 DEFAULT_PERIODS = (2, 10, 18, 26, 34, 42, 50)
 #: the refresh periods at which times are measured: varying Δn varies the hit/miss mix
 DEFAULT_TIMING_PERIODS = (2, 8, 50)
-#: consecutive frames of the error runs when the session has that many
-DEFAULT_TRAINING_FRAMES = 64
+#: frames of the error runs when the session has that many (all of a session up to this long,
+#: as validation measures; rrcache.profiler.plan)
+DEFAULT_TRAINING_FRAMES = 150
 #: the fields that do not change a measurement (left out of the store key)
 UNKEYED = ("budget_s", "validate", "min_saving", "min_gain", "levels", "max_sets")
 #: how the four selection levels are chosen
@@ -86,8 +88,8 @@ class TrainingSettings:
     - ``error_window``: the share of the frame's area the error runs render (1: all of it);
       None: chosen from the original's cost (:mod:`rrcache.profiler.plan`). Only at the
       session's resolution.
-    - ``frames``: the first N consecutive session frames of the error runs; None: 64 (or all,
-      when the session is shorter).
+    - ``frames``: N frames of the error runs, spread over the session in segments
+      (:func:`rrcache.profiler.plan.error_segments`); None: 150 (all of a shorter session).
     - ``timing_frames``: L, the frames timed per node and timing period (spread evenly).
     - ``timing_periods``: the periods at which each node is timed.
     - ``algorithm``, ``block``, ``refresh``, ``depth_epsilon``: the cache's own settings.

@@ -233,6 +233,19 @@ def _selection(prof, sel, frames: dict) -> str:
             f'<div class="shots">{"".join(figures)}</div>{next_steps_html(prof, sel, _session_size(prof))}</div>')
 
 
+def _answer(prof) -> str:
+    """The profile's answer when it stopped before training (``Profile.verdict``: the ceiling
+    below the gain worth having, or no value a cache can hold): the answer, why, and what would
+    change it."""
+    v = prof.verdict
+    ceiling = prof.measured_ceiling
+    measured = f"<p>ceiling: {_e(ceiling.summary())}</p>" if ceiling is not None else ""
+    changes = "".join(f"<li>{_e(c)}</li>" for c in v.get("changes") or [])
+    return (f'<div class="sel" id="answer"><h3>{_e(v["answer"])}</h3>{measured}<p>why: {_e(v["reason"])}</p>'
+            f"<p>what would change it:</p><ul>{changes}</ul>"
+            "<p class=\"muted\">the original shader's manifest is in <code>optimized/original</code></p></div>")
+
+
 def _level_marks(sel) -> str:
     """What became of the selection's level (docs/levels.md): the choices refused and why, a
     miss shipped as measured, visible artifacts."""
@@ -364,7 +377,8 @@ def report_html(prof, frames: Optional[dict] = None) -> str:
     payload = script_json(data)
     name = Path(prof.shader).name
     sections = [
-        "<h2>Summary</h2>", _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
+        "<h2>Summary</h2>", _answer(prof) if prof.verdict is not None else "",
+        _summary(prof, timing) if prof.trained_nodes else "<p>No node was trained.</p>",
         "<h2>Error against run time</h2>",
         '<p class="muted">Each path is one node over Δn = 1..50 as the fitted models predict it (larger '
         "dots: the trained periods); the black line is the Pareto front, the dashed line the original's "
