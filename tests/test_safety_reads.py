@@ -411,15 +411,20 @@ def test_a_tampered_profile_reads_nothing_it_names(made_profile, tmp_path, stabi
         assert str(outside / "shadow") not in opened
 
 
-def test_a_plot_linked_outside_is_not_embedded(made_profile, tmp_path, stability_case):
+def _copy_and_a_secret_image(made_profile, tmp_path):
+    """(the copied profile folder, an outside folder with ``secret.png``, that image's base64 as
+    a report would embed it)."""
     import base64
     import shutil
     shutil.copytree(made_profile, tmp_path / "case")
-    folder = tmp_path / "case" / "p"
     outside = tmp_path / "outside"
     outside.mkdir()
     _png(outside / "secret.png", 1.0, size=9)
-    secret = base64.b64encode((outside / "secret.png").read_bytes()).decode()
+    return tmp_path / "case" / "p", outside, base64.b64encode((outside / "secret.png").read_bytes()).decode()
+
+
+def test_a_plot_linked_outside_is_not_embedded(made_profile, tmp_path, stability_case):
+    folder, outside, secret = _copy_and_a_secret_image(made_profile, tmp_path)
     (folder / "tradeoff.png").unlink()
     os.symlink(outside / "secret.png", folder / "tradeoff.png")
     code, _, lines, _, _ = rrcache_traced(tmp_path / "case", "report", "p", "--out", "r.html", timeout=300)
@@ -433,14 +438,7 @@ def test_frames_json_cannot_name_a_file_outside(made_profile, tmp_path, stabilit
     """``frames/frames.json`` names the report's images: edited to name a file outside the profile
     (by its path, or through a link placed in the folder), the report refuses it and embeds
     nothing of it."""
-    import base64
-    import shutil
-    shutil.copytree(made_profile, tmp_path / "case")
-    folder = tmp_path / "case" / "p"
-    outside = tmp_path / "outside"
-    outside.mkdir()
-    _png(outside / "secret.png", 1.0, size=7)
-    secret = base64.b64encode((outside / "secret.png").read_bytes()).decode()
+    folder, outside, secret = _copy_and_a_secret_image(made_profile, tmp_path)
     path = folder / "frames" / "frames.json"
     doc = json.loads(path.read_text())
     label = sorted(doc["selections"])[0]

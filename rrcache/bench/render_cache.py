@@ -286,8 +286,10 @@ def _write(out: Path, result: SceneComparison, shots: dict) -> list:
     from rrcache.bench.paper import MethodRow
     from rrcache.jsonable import finite_json
 
+    from rrcache.files import read_bytes
+
     path = out / "equal_time.json"
-    scenes = json.loads(path.read_text(encoding="utf-8"))["scenes"] if path.is_file() else []
+    scenes = json.loads(read_bytes(path, None))["scenes"] if path.is_file() else []
     record = dict(name=result.name, resolution=list(result.resolution), frames=result.frames, choice=result.choice,
                   texts=result.texts, target_speedup=result.target_speedup, sheet_frame=result.sheet_frame,
                   sheet=result.sheet, load=result.load, wall_s=result.wall_s, rows=[vars(row) for row in result.rows])
@@ -306,7 +308,7 @@ def _write(out: Path, result: SceneComparison, shots: dict) -> list:
                                        {k: tuple(v) for k, v in s["sheet"].items()}, s["load"], s["wall_s"]))
         stored = out / "sheet" / f"{s['name']}.npz"
         if stored.is_file():
-            with np.load(stored) as data:
+            with np.load(io.BytesIO(read_bytes(stored, None)), allow_pickle=False) as data:
                 images[s["name"]] = {k.replace("_", " "): data[k] for k in data.files}
     write_text(out / "equal_time.md", _markdown(results))
     contact_sheet(results, images, out / "contact_sheet.png")
