@@ -253,7 +253,7 @@ def test_a_measured_slowdown_falls_back(trained, tmp_path, monkeypatch):
     cores, measured while writing this test), so each variant
     frame's measured time is multiplied by 50 after the real render: the outcome must not depend
     on the load."""
-    import rrcache.profiler.validate as validate_module
+    import rrcache.harness.cached as cached_module  # what validation's compare runs call
     from rrcache.pipeline import load_for_session
     from rrcache.profiles.store import ProfileStore, StoreKey
     from rrcache.profiler.validate import MAX_FALLBACKS, slower_beyond_noise, validate
@@ -270,7 +270,7 @@ def test_a_measured_slowdown_falls_back(trained, tmp_path, monkeypatch):
         return Selection((CachedNode(node.id, 1, node.text),), 0.0, 1.0, 2.0, label="e1", max_error=0.01,
                          algorithm="three-pass")
 
-    real = validate_module.compare
+    real = cached_module.compare
 
     def slower(*args, **kwargs):
         result = real(*args, **kwargs)
@@ -278,7 +278,7 @@ def test_a_measured_slowdown_falls_back(trained, tmp_path, monkeypatch):
             f.ms *= 50.0
         return result
 
-    monkeypatch.setattr(validate_module, "compare", slower)
+    monkeypatch.setattr(cached_module, "compare", slower)
     asked = []
 
     def candidates(choice):
