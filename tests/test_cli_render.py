@@ -242,3 +242,19 @@ def test_bench_cache_breakdown(files, capsys):
         assert set(row["original"]["full_ms"]) == {"clear", "draw", "queries", "read-back"}
         assert all(v >= 0 for v in row["cached"]["per_pixel_ns"].values())
         assert row["cached"]["pixels"] > 0 and row["cached"]["plain_ms"] > 0 and row["original"]["plain_ms"] > 0
+
+
+def test_bench_cache_leaves_out_the_groups_given_empty_but_not_all(files, capsys):
+    """``--periods ''`` (and the other lists) leaves that group of rows out; with every group out
+    there is nothing to compare: one line, exit 2."""
+    shader, session = files
+    node = _final_node(shader, session, capsys)
+    base = ["bench-cache", str(shader), str(session), "--node", node, "--frames", "3", "--repeats", "1",
+            "--resolution", "32x24", "--compare-period", "2", "--periods", "", "--algorithms", "", "--blocks", ""]
+    main(base + ["--filters", "plane", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["periods"] == doc["algorithms"] == doc["blocks"] == [] and doc["no_refresh"] is None
+    assert [r["filter"] for r in doc["filters"]] == ["plane"] and [m["filter"] for m in doc["misses"]] == ["plane"]
+    with pytest.raises(SystemExit) as info:
+        main(base + ["--filters", ""])
+    assert info.value.code == 2 and "nothing to compare" in capsys.readouterr().err

@@ -71,8 +71,6 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
         period_list = [int(p) for p in periods.split(",") if p.strip()]
     except ValueError:
         raise click.BadParameter(f"{periods!r} is not a comma-separated list of integers", param_hint="--periods")
-    if not period_list:
-        raise click.BadParameter("give at least one refresh period", param_hint="--periods")
     period_list = [check_period(p, "--periods") for p in period_list]
     format_list = [f.strip() for f in formats.split(",") if f.strip()]
     bad = [f for f in format_list if f not in COLOR_FORMATS]
@@ -101,6 +99,10 @@ def command(shader, session, node, periods, compare_period, frames, repeats, res
     filter_list = [f.strip() for f in filters.split(",") if f.strip()]
     if any(f not in FILTERS for f in filter_list):
         raise click.BadParameter(f"{filters!r}: give some of {', '.join(FILTERS)}", param_hint="--filters")
+    if not breakdown and not (period_list or algorithm_list or block_list or filter_list):
+        # '' leaves a group of rows out; with every group out there is nothing to measure but the limit
+        raise click.BadParameter("nothing to compare: give --periods, --algorithms, --blocks or --filters",
+                                 param_hint="--periods")
     with Reporter(err, quiet=quiet) as reporter:
         if breakdown:
             bench = run_breakdown(shader, session, node, algorithms=tuple(algorithm_list), formats=tuple(format_list),
