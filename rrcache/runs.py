@@ -13,7 +13,9 @@ over some frames of the session and measures it, as one of :data:`MEASURES`:
   variant, the original alone, timed;
 - ``overhead``: per frame f the variant renders f − 1 from an empty cache and f timed, alone;
 - ``compare``: the variant and the original alternating frame by frame
-  (:func:`rrcache.harness.cached.compare`): each frame's error and both times.
+  (:func:`rrcache.harness.cached.compare`): each frame's error and both times; with
+  ``flip_frames`` the FLIP of those frames and with ``temporal`` the temporal error
+  (:mod:`rrcache.harness.perceptual`), as validation measures them.
 
 Runs are plain records (strings, numbers, tuples: they pickle, hash and compare), so a trainer
 plans a list of them, an executor runs them anywhere the shader and session are loaded
@@ -53,7 +55,8 @@ class RunSpec:
     ``frames`` at ``resolution``, inside ``window`` (x, y, w, h) when given, drawn into
     ``color_format`` and timed with ``clock`` (:mod:`rrcache.harness.timing`). ``strict_payload``:
     stop after the first frame when the cache cannot keep the payload the variant asks for (a 16-
-    or 8-bit payload whose values do not fit), rather than measuring it in 32 bits."""
+    or 8-bit payload whose values do not fit), rather than measuring it in 32 bits. A ``compare``
+    run also measures FLIP on ``flip_frames`` and, with ``temporal``, the temporal error."""
 
     measure: str
     variant: Optional[VariantSpec]
@@ -65,13 +68,18 @@ class RunSpec:
     key: tuple = ()
     label: str = ""
     strict_payload: bool = False
+    flip_frames: tuple = ()
+    temporal: bool = False
 
     def __post_init__(self):
         if self.measure not in MEASURES:
             raise ValueError(f"measure must be one of {MEASURES}, not {self.measure!r}")
         if self.variant is None and self.measure not in ("reference", "timing"):
             raise ValueError(f"a {self.measure} run needs a variant")
+        if (self.flip_frames or self.temporal) and self.measure != "compare":
+            raise ValueError(f"FLIP and the temporal error are measured in compare runs, not {self.measure} runs")
         object.__setattr__(self, "frames", tuple(int(f) for f in self.frames))
+        object.__setattr__(self, "flip_frames", tuple(int(f) for f in self.flip_frames))
         object.__setattr__(self, "resolution", tuple(int(v) for v in self.resolution))
         if self.window is not None:
             object.__setattr__(self, "window", tuple(int(v) for v in self.window))
@@ -114,7 +122,9 @@ class RunResult:
     (seconds it took, ``setup_s`` of them compiling, linking and allocating), the ``payload`` the
     cache kept (``f4`` when a narrower one did not fit), ``notes`` (what the renderers said),
     ``complete`` (False when ``strict_payload`` stopped it), and where and when it ran: ``host``
-    (the machine's name; None in this process), ``started``/``finished`` (Unix seconds)."""
+    (the machine's name; None in this process), ``started``/``finished`` (Unix seconds). A
+    ``compare`` run asked for them has ``flips`` (the FLIP of each of ``spec.flip_frames`` rendered,
+    in order) and ``temporal_psnr`` (dB; inf when the changes match exactly, None without a pair)."""
 
     spec: RunSpec
     frames: tuple = ()
@@ -126,6 +136,8 @@ class RunResult:
     host: Optional[str] = None
     started: Optional[float] = None
     finished: Optional[float] = None
+    flips: tuple = ()
+    temporal_psnr: Optional[float] = None
 
     @property
     def steady(self) -> tuple:

@@ -181,7 +181,9 @@ def test_resume_after_sigkill(full, tmp_path, stability_case):
     # machine the two runs could choose differently (three-pass and two-pass images differ in
     # the last bits, and so would the fitted α, λ)
     algorithm = json.loads((folder / "out" / "profile.json").read_text())["algorithm"]
-    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS, "--algorithm", algorithm)
+    # and the same cache filter ('auto' chooses it by timing too)
+    filter_ = json.loads((folder / "out" / "profile.json").read_text())["filter"]
+    proc = _spawn("profile", shader, session, "--out", out, *CLI_SETTINGS, "--algorithm", algorithm, "--filter", filter_)
     _wait_for_runs(proc, store_path, 3)
     proc.send_signal(signal.SIGKILL)
     proc.wait(timeout=30)
@@ -191,7 +193,7 @@ def test_resume_after_sigkill(full, tmp_path, stability_case):
     assert 3 <= killed_at < total
     assert not (out / "profile.json").exists()  # nothing is written before training finishes
 
-    again = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--algorithm", algorithm)
+    again = rrcache("profile", shader, session, "--out", out, *CLI_SETTINGS, "--algorithm", algorithm, "--filter", filter_)
     assert f"computed; {killed_at} error and" in again.stdout  # the summary: stored runs skipped
     with read_store(store_path) as store:
         log = store.run_log()

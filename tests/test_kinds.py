@@ -75,14 +75,34 @@ def test_the_compile_cache_compiles_a_variant_once(loaded):
 
 def test_each_chosen_variant_is_compiled_once_per_profile(tmp_path):
     """A profile (training, validation, the selections' files and the report's frames) compiles
-    each variant once, and says how many it compiled."""
+    each variant once, and says how many it compiled. Every render of training and validation is
+    a run of the profile's one executor."""
     from test_profile import SETTINGS, write_scene
+    from rrcache.harness.execute import Bench, LocalExecutor
     from rrcache.profiler import profile
+
+    made = []
+
+    class Recording(LocalExecutor):
+        def run(self, specs, on_frame=None):
+            specs = list(specs)
+            made.extend(specs)
+            return super().run(specs, on_frame)
+
+    def factory(work, session):
+        return Recording(Bench(work, session))
 
     shader, session = write_scene(tmp_path)
     kinds.clear_compile_cache()
     prof = profile(shader, session, tmp_path / "out", TrainingSettings(**SETTINGS, budget_s=2.0,
-                                                                       validation_frames=4))
+                                                                       validation_frames=4), executor=factory)
+    validations = [s for s in made if s.key[:1] == ("validate",)]
+    assert {s.measure for s in made} >= {"reference", "error", "timing"}
+    # each choice validation measured (which ones depends on this machine's timings): one error
+    # run with FLIP and the temporal error, three timed (tests/test_runs.py checks the figures)
+    rendered = {s.key[1] for s in validations}
+    assert all(s.measure == "compare" for s in validations) and len(validations) == 4 * len(rendered)
+    assert sum(1 for s in validations if s.temporal and s.flip_frames) == len(rendered)
     counts = kinds.compile_counts()
     assert counts and max(counts.values()) == 1, counts
     assert prof.counts["compiles"] == sum(counts.values())

@@ -54,17 +54,18 @@ def _option(node, period, predicted_psnr, ms=1.0):
 def _fake(monkeypatch, psnr_by_period, speedup=2.0, speedups=None):
     """Every validation render is real; then each frame's PSNR is set to ``psnr_by_period[Δn]``
     and the variant's frame time to the original's / ``speedup`` (per repeat from ``speedups``),
-    so that the outcome does not depend on this machine or its load."""
-    import rrcache.profiler.validate as validate_module
+    so that the outcome does not depend on this machine or its load. (Validation's renders are
+    compare runs: :func:`rrcache.harness.cached.compare` is what the executor calls.)"""
+    import rrcache.harness.cached as cached_module
 
-    real = validate_module.compare
+    real = cached_module.compare
     calls = {"timing": 0}
 
-    def fake(variant, session, prepared, frames, period=1, color_format="rgba32f", **kwargs):
-        result = real(variant, session, prepared, frames, period=period, color_format=color_format, **kwargs)
+    def fake(variant, session, prepared, frames, spec, color_format="rgba32f", **kwargs):
+        result = real(variant, session, prepared, frames, spec, color_format=color_format, **kwargs)
         if color_format == "rgba32f":
             for f in result.frames:
-                f.psnr = psnr_by_period[period]
+                f.psnr = psnr_by_period[spec.period]
         else:
             gain = speedups[calls["timing"] % len(speedups)] if speedups else speedup
             calls["timing"] += 1
@@ -72,7 +73,7 @@ def _fake(monkeypatch, psnr_by_period, speedup=2.0, speedups=None):
                 f.ms = f.original_ms / gain
         return result
 
-    monkeypatch.setattr(validate_module, "compare", fake)
+    monkeypatch.setattr(cached_module, "compare", fake)
 
 
 def _table_text(prof, rows) -> str:
@@ -83,7 +84,7 @@ def _table_text(prof, rows) -> str:
     shown = copy.copy(prof)
     shown.selections = rows
     console = Console(record=True, width=220)
-    _table(shown).print(console)
+    _table(shown).print(console)  # a TextTable (rrcache.cli.tables), printed as the CLI does
     return console.export_text()
 
 

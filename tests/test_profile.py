@@ -253,7 +253,7 @@ def test_a_measured_slowdown_falls_back(trained, tmp_path, monkeypatch):
     cores, measured while writing this test), so each variant
     frame's measured time is multiplied by 50 after the real render: the outcome must not depend
     on the load."""
-    import rrcache.profiler.validate as validate_module
+    import rrcache.harness.cached as cached_module  # what validation's compare runs call
     from rrcache.pipeline import load_for_session
     from rrcache.profiles.store import ProfileStore, StoreKey
     from rrcache.profiler.validate import MAX_FALLBACKS, slower_beyond_noise, validate
@@ -270,7 +270,7 @@ def test_a_measured_slowdown_falls_back(trained, tmp_path, monkeypatch):
         return Selection((CachedNode(node.id, 1, node.text),), 0.0, 1.0, 2.0, label="e1", max_error=0.01,
                          algorithm="three-pass")
 
-    real = validate_module.compare
+    real = cached_module.compare
 
     def slower(*args, **kwargs):
         result = real(*args, **kwargs)
@@ -278,7 +278,7 @@ def test_a_measured_slowdown_falls_back(trained, tmp_path, monkeypatch):
             f.ms *= 50.0
         return result
 
-    monkeypatch.setattr(validate_module, "compare", slower)
+    monkeypatch.setattr(cached_module, "compare", slower)
     asked = []
 
     def candidates(choice):
@@ -364,16 +364,20 @@ def test_store_matches_profile_json(trained):
 
 
 def test_the_cache_filter_is_measured_and_kept(trained):
-    """``filter="auto"`` (the default): bilinear and plane measured on the first node, side by
-    side with the original (time) and in the error window (PSNR); the choice follows the rule
-    of rrcache.profiler.filters.pick and is the profile's, recorded in its plan."""
+    """``filter="auto"`` (the default): bilinear and plane measured on the first node at the
+    shortest, middle and longest training periods, side by side with the original (time) and in
+    the error window (error); the choice follows the equal-time rule of
+    rrcache.profiler.filters.pick and is the profile's, recorded in its plan."""
     from rrcache.profiler.filters import pick
 
     prof, events, _ = trained
     times = prof.plan["filter_times"]
     assert set(times) == {"bilinear", "plane"}
-    for measured in times.values():
-        assert 0 < measured["time"] < 100 and 0 < measured["psnr"] <= 100 and measured["period"] in (2, 4, 8)
+    for points in times.values():
+        assert [q["period"] for q in points] == [2, 4, 8]
+        for q in points:
+            assert 0 < q["time"] < 100 and 0 < q["psnr"] <= 100 and q["error"] >= 0
+        assert points[0]["error"] <= points[-1]["error"]   # longer periods: staler values
     assert prof.filter == prof.plan["filter"] == pick(times)
     assert any(e.stage == "filter" for e in events)
     # a resumed profile keeps the choice without measuring again

@@ -80,3 +80,11 @@ def test_the_results_table_cites_its_figures():
         assert ours and all(f in record for f in ours), (row, cited)
         if cells[2] != "—":
             assert cells[2] in paper, row
+
+
+def test_the_library_table_is_the_run_recorded_in_docs():
+    section = README.split("## A shader library", 1)[1].split("\n## ", 1)[0]
+    cited = re.search(r"\((docs/[\w.]+\.md), with the command\)", section).group(1)
+    record = (ROOT / cited).read_text(encoding="utf-8")
+    rows = [r for r in section.splitlines() if r.startswith("| ") and "---" not in r]
+    assert len(rows) >= 7 and all(row in record for row in rows)

@@ -95,6 +95,29 @@ def test_timing_runs_time_each_frame_beside_the_original(gl_ctx, bench):
     assert len(compared.frames) == 3 and compared.ms > 0 and compared.original_ms > 0
 
 
+def test_a_compare_run_measures_flip_and_the_temporal_error_as_validation_does(gl_ctx, bench):
+    """A compare run asked for FLIP on some frames and the temporal error gives what
+    rrcache.harness.perceptual computes on the same renders by hand (validation's figures); the
+    errors and hits are the harness's compare's; other runs cannot ask for them."""
+    from rrcache.harness.cached import compare
+    from rrcache.harness.perceptual import FrameQuality
+
+    spec = VariantSpec("cache", (_node(bench),), "two-pass", periods=(3,))
+    frames = (0, 1, 2, 3, 4)
+    run = execute(RunSpec("compare", spec, frames, SIZE, flip_frames=(1, 4), temporal=True), bench)
+    quality = FrameQuality((1, 4))
+    by_hand = compare(compile_spec(bench.work, spec), bench.session, bench.work.prepared, frames, spec,
+                      resolution=SIZE, on_frame=lambda row, got, ref: quality.add(row.index, got.image, ref.image))
+    assert [r.error for r in run.frames] == [float(f.mean_error) for f in by_hand.frames]
+    assert [(r.hits, r.misses) for r in run.frames] == [(f.hits, f.misses) for f in by_hand.frames]
+    assert len(run.flips) == 2 and list(run.flips) == pytest.approx(quality.flips)
+    assert run.temporal_psnr == pytest.approx(quality.temporal_psnr)
+    plain = execute(RunSpec("compare", spec, frames, SIZE), bench)
+    assert plain.flips == () and plain.temporal_psnr is None
+    with pytest.raises(ValueError, match="compare runs"):
+        RunSpec("error", spec, frames, SIZE, flip_frames=(1,))
+
+
 def test_specs_and_results_are_plain_records(gl_ctx, bench):
     """Pickled and back they are equal (what a distributed executor ships), and a timing run says
     it is one (a distributed executor keeps those alone on a host)."""
@@ -129,3 +152,38 @@ def test_a_worker_loads_its_bench_from_a_work_source(tmp_path):
         here = execute(spec, bench)
     assert [r.error for r in there.frames] == [r.error for r in here.frames]
     assert [(r.hits, r.misses) for r in there.frames] == [(r.hits, r.misses) for r in here.frames]
+
+
+def test_validation_measures_through_the_executor_it_is_given(gl_ctx, bench, tmp_path):
+    """Validation's renders are compare runs of the executor given (the profile's): one error run
+    with FLIP and the temporal error over the validation frames, three timed repeats; the
+    measured selection holds what they measured."""
+    from rrcache.profiler.validate import REPEATS, validate
+    from rrcache.profiles import TrainingSettings
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.selection import CachedNode, Selection
+
+    made = []
+
+    class Recording(LocalExecutor):
+        def run(self, specs, on_frame=None):
+            specs = list(specs)
+            made.extend(specs)
+            return super().run(specs, on_frame)
+
+    node = _node(bench)
+    settings = TrainingSettings(periods=(2, 4), resolution=SIZE, validation_frames=5).resolved(bench.session)
+    choice = Selection((CachedNode(node, 4),), 0.01, 1.0, 2.0, label="e1", max_error=0.02, algorithm="two-pass")
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    executor = Recording(bench)
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        [row] = validate(bench.work, bench.session, settings, store, [choice], fallback=False, executor=executor)
+    assert [s.measure for s in made] == ["compare"] * (1 + REPEATS)
+    error = made[0]
+    assert error.temporal and error.flip_frames and error.frames == tuple(range(5))
+    assert error.resolution == tuple(bench.session.resolution) and error.variant.periods == (4,)
+    assert all(s.color_format == settings.timing_format and not s.flip_frames for s in made[1:])
+    assert row.parts == choice.parts and row.frames == 5 and row.measured_flip is not None
+    assert len(row.speedups) == REPEATS and row.measured_temporal_psnr is not None
+    # the executor given stays open (it is the profile's): it still runs
+    assert next(executor.run([RunSpec("compare", error.variant, (0, 1), SIZE)])).frames

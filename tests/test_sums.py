@@ -184,7 +184,7 @@ def test_a_profile_measures_the_order_when_asked_and_keeps_it(tmp_path):
     those of the ordered program: loading the shader with its scores finds the same texts."""
     from rrcache.profiler import profile
     from rrcache.profiles import TrainingSettings, load_profile
-    from rrcache.profiles.choice import load_work
+    from rrcache.choice import load_work
 
     settings = TrainingSettings(periods=(2,), timing_periods=(2,), timing_frames=2, frames=3,
                                 resolution=(32, 32), validate=False, budget_s=1e-6, min_gain=0, max_sets=0,

@@ -49,16 +49,11 @@ def _what(r) -> tuple[str, str]:
 
 
 def _filter_text(s) -> str:
-    """`` Cache filter: plane (auto: ...)`` from what the profile measured, or nothing."""
+    """``. Cache filter: plane (auto: ...)`` from what the profile measured, or nothing."""
+    from rrcache.profiles.document import filter_text
+
     chosen = getattr(s, "filter", None)
-    if not chosen:
-        return ""
-    times = getattr(s, "filter_times", None) or {}
-    if not times:
-        return f". Cache filter: {chosen}"
-    measured = ", ".join(f"{name} {t['time'] * 100:.0f}% of the original's time at {t['psnr']:.1f} dB"
-                         for name, t in times.items())
-    return f". Cache filter: {chosen} (auto, on the first node: {measured})"
+    return f". Cache filter: {filter_text(chosen, getattr(s, 'filter_times', None))}" if chosen else ""
 
 
 def scene_markdown(s) -> str:

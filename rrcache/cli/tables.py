@@ -63,6 +63,10 @@ class TextTable:
             table.add_row(*row)
         return table
 
+    def __rich__(self) -> Table:
+        """``console.print(table)`` draws it with rich (:meth:`print` chooses by the console)."""
+        return self.rich()
+
     def print(self, console: Console) -> None:
         """Draw it on ``console``: rich on a terminal, plain text elsewhere."""
         if console.is_terminal:

@@ -176,15 +176,27 @@ def _error_rows(spec: RunSpec, cached: CachedRenderer, refs: list, rows: list, s
 
 def _compare(spec: RunSpec, bench: Bench, step, start: float) -> RunResult:
     from rrcache.harness.cached import compare
+    from rrcache.harness.perceptual import FrameQuality
 
     variant = kinds.compile(bench.work, spec.variant)
     setup = time.perf_counter() - start
+    quality = FrameQuality(spec.flip_frames) if spec.flip_frames or spec.temporal else None
+
+    def on_frame(row, got, ref):
+        if quality is not None:
+            quality.add(row.index, got.image, ref.image)
+        step(2)
+
+    # the session's own size is asked as such (a target too large then names the session's file)
+    size = None if spec.resolution == tuple(bench.session.resolution) else spec.resolution
     result = compare(variant, bench.session, bench.work.prepared, spec.frames, spec.variant,
-                     resolution=spec.resolution, window=spec.window, color_format=spec.color_format,
-                     clock=spec.clock, on_frame=lambda *a: step(2))
+                     resolution=size, window=spec.window, color_format=spec.color_format,
+                     clock=spec.clock, on_frame=on_frame)
     rows = tuple(FrameRow(f.index, float(f.mean_error), min(float(f.psnr), PSNR_CAP), f.hits, f.misses, int(f.covered),
                           int(f.left_out), float(f.ms), float(f.original_ms)) for f in result.frames)
-    return RunResult(spec, rows, time.perf_counter() - start, setup, result.payload_dtype, tuple(result.notes))
+    return RunResult(spec, rows, time.perf_counter() - start, setup, result.payload_dtype, tuple(result.notes),
+                     flips=tuple(quality.flips) if quality is not None else (),
+                     temporal_psnr=quality.temporal_psnr if quality is not None and spec.temporal else None)
 
 
 class LocalExecutor:
@@ -194,7 +206,9 @@ class LocalExecutor:
     an ``on_frame`` for this call's progress, else the executor's) and yields one
     :class:`~rrcache.runs.RunResult` per spec (here in order, as each finishes; a caller that
     stops iterating stops the runs not begun); a ``KeyboardInterrupt`` stops it between frames
-    (the results already yielded stand); :meth:`close` releases what it holds."""
+    (the results already yielded stand); :meth:`close` releases what it holds. Optional:
+    :meth:`release` drops what the runs so far kept (reference frames, renderers) and leaves the
+    executor usable; the profile calls it when training is over, before validation."""
 
     def __init__(self, bench: Bench, on_frame: Optional[FrameCallback] = None):
         self.bench = bench
@@ -203,6 +217,9 @@ class LocalExecutor:
     def run(self, specs: Iterable[RunSpec], on_frame: Optional[FrameCallback] = None) -> Iterator[RunResult]:
         for spec in specs:
             yield execute(spec, self.bench, on_frame or self.on_frame)
+
+    def release(self) -> None:
+        self.bench.close()  # a bench closed stays usable: what it keeps is made again when asked
 
     def close(self) -> None:
         self.bench.close()

@@ -148,8 +148,9 @@ def _profile(shader_path, session_path, out_dir, settings, caught: list, *, defi
                 # amortized sampling: the estimators' models, on the same front as the nodes
                 from rrcache.profiler.amortize import train_estimators
                 prof.estimators = train_estimators(work, session, resolved, store, result, progress, executor=runner)
-                runner.close()  # validation renders side by side with its own renderers
-            prof.selections = _selections(prof, work, session, resolved, result, store, progress, max_flip)
+                if hasattr(runner, "release"):  # the training's reference frames are not needed again
+                    runner.release()
+            prof.selections = _selections(prof, work, session, resolved, result, store, progress, max_flip, runner)
             if adaptive and prof.selections and resolved.validate:
                 from rrcache.profiler.adaptive import extend
 
@@ -288,9 +289,10 @@ def _psnr_offset(store, settings, result: TrainingResult) -> float:
 
 
 def _selections(prof: Profile, work, session, settings, result: TrainingResult, store, progress,
-                max_flip: Optional[float] = None) -> list:
+                max_flip: Optional[float] = None, executor=None) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
-    (:mod:`rrcache.profiler.validate`), else predicted only; none without a trained node."""
+    (:mod:`rrcache.profiler.validate`, its renders run by ``executor``), else predicted only;
+    none without a trained node."""
     if not result.trained:
         return []
     choices = prof.threshold_selections()
@@ -300,7 +302,7 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
 
     validator = Validator(work, session, settings, store, progress,
                           window=result.plan.timing_window if result.plan is not None else None,
-                          candidates=prof.front_candidates)
+                          candidates=prof.front_candidates, executor=executor)
     measured = validator.run(choices)
     if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first
         from rrcache.profiler.validate import flip_level
@@ -312,7 +314,7 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
         from rrcache.profiler.sets import keep_faster
 
         measured = keep_faster(prof, work, session, settings, store, measured, progress,
-                               result.plan.timing_window if result.plan is not None else None)
+                               result.plan.timing_window if result.plan is not None else None, executor)
     prof.calibration = calibration_record(validator)
     prof.measured = [s.replace(files=None) for s in validator.measured.values()]
     # the counts were taken before validation: count the validations now

@@ -232,7 +232,8 @@ def single_choices(prof) -> dict:
         prof.sets = saved
 
 
-def keep_faster(prof, work, session, settings, store, measured: list, progress=None, window=None) -> list:
+def keep_faster(prof, work, session, settings, store, measured: list, progress=None, window=None,
+                executor=None) -> list:
     """After validation: each level whose selection is a set is measured again with the choice
     it displaced (the single-node choice at the level, validated the same way, as
     ``<label>~single``), and the set stands only when its measured speed-up (the repeats'
@@ -240,11 +241,13 @@ def keep_faster(prof, work, session, settings, store, measured: list, progress=N
     ``fallback`` saying what the set measured. A set is chosen on its training measurement
     (one sample per timing frame) against the single node's model, and on Marble one that
     training put at 2.23× measured 1.70–1.94× beside a single choice measured at 2.34–2.92×:
-    a set must beat what it displaced where it counts, in the validation."""
+    a set must beat what it displaced where it counts, in the validation (its renders run by
+    ``executor``, None: one in this process)."""
     from rrcache.profiler.validate import validate
 
     def measure(sel):
-        return validate(work, session, settings, store, [sel], progress, window, candidates=prof.front_candidates)[0]
+        return validate(work, session, settings, store, [sel], progress, window, candidates=prof.front_candidates,
+                        executor=executor)[0]
 
     def decided(row, stood) -> None:
         if stood is not row:

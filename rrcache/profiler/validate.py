@@ -3,8 +3,9 @@ says (docs/levels.md).
 
 After training, :class:`Validator` (``validate``) takes the labelled selections of the profile
 (:meth:`rrcache.profiles.Profile.threshold_selections`: by default predicted PSNR ≥ 45, 40, 35,
-30 dB) and measures each with :func:`rrcache.harness.cached.compare`, side by side with the
-original at the session's full resolution, alternating frame by frame (main paper §4.4, Fig. 6).
+30 dB) and measures each in ``compare`` runs (:class:`rrcache.runs.RunSpec`, run by the profile's
+executor or an in-process one), side by side with the original at the session's full
+resolution, alternating frame by frame (main paper §4.4, Fig. 6).
 Shaders timed in a window (:mod:`rrcache.profiler.plan`) are validated in the same window.
 
 **What is measured.** Over ``validation_frames`` consecutive frames drawn exactly (``rgba32f``,
@@ -48,9 +49,12 @@ import math
 import statistics
 from typing import Callable, Optional
 
+import numpy as np
+
 from rrcache.gl.formats import ERROR_FORMAT
-from rrcache.harness.cached import compare
-from rrcache.harness.perceptual import FrameQuality, flip_frame_indices
+from rrcache.harness.cached import runtime_spec
+from rrcache.harness.execute import Bench, LocalExecutor
+from rrcache.harness.perceptual import flip_frame_indices
 from rrcache.harness.timing import frame_noise
 from rrcache.model.calibration import Calibration
 from rrcache.model.levels import VISIBLE_FLIP, batch_uncertainty, quality_miss, speed_miss
@@ -58,6 +62,7 @@ from rrcache.pipeline import ShaderWork, variant_for_selection
 from rrcache.profiler.train import PSNR_CAP, ProgressEvent, ProgressFn
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiles.store import ProfileStore
+from rrcache.runs import RunResult, RunSpec
 from rrcache.selection import Selection
 
 #: side-by-side measurements of each selection, and the frames of each after the first
@@ -107,13 +112,15 @@ def _key_text(sel: Selection) -> str:
 class Validator:
     """One profile's validation (see the module docstring): ``run(choices)`` returns the
     selections that stand; :attr:`calibration` is the calibration after every measured point,
-    :attr:`measured` every measurement by what it caches."""
+    :attr:`measured` every measurement by what it caches. ``executor`` runs the renders (the
+    profile's; None: one in this process, closed at the end of :meth:`run`)."""
 
     def __init__(self, work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore,
                  progress: Optional[ProgressFn] = None, window=None,
                  candidates: Optional[Callable[[Selection], list[Selection]]] = None, fallback: bool = True,
-                 calibration: Optional[Calibration] = None):
+                 calibration: Optional[Calibration] = None, executor=None):
         self.work, self.session, self.settings, self.store = work, session, settings, store
+        self.executor, self._own_executor = executor, executor is None
         self.progress, self.window, self.candidates, self.fallback = progress, window, candidates, fallback
         self.calibration = calibration or Calibration()
         self.frames = list(range(settings.validation_frames))
@@ -155,8 +162,8 @@ class Validator:
         flip = sel.measured_flip
         return sel.replace(visible_artifacts=bool(flip is not None and flip >= VISIBLE_FLIP and not sel.exact))
 
-    def _step(self, detail: str) -> None:
-        self.state["done"] += 2
+    def _step(self, detail: str, units: int = 2) -> None:
+        self.state["done"] += units
         if self.progress is not None:
             self.progress(ProgressEvent("validate", self.state["done"], max(self.state["total"], self.state["done"]),
                                         detail))
@@ -175,47 +182,55 @@ class Validator:
             return sel
         self.state["total"] += 2 * self.per
         variant, period = variant_for_selection(self.work, choice)
-        common = dict(period=period, window=self.window, **self.settings.cache_options())
-        quality = FrameQuality(flip_frame_indices(self.frames))
+        spec = runtime_spec(variant, None, period=period, **self.settings.cache_options())
+        size = tuple(self.session.resolution)
         what = f"{choice.label}: {choice.describe()}"
-
-        def on_exact(row, got, ref):
-            quality.add(row.index, got.image, ref.image)
-            self._step(f"{what} error")
-
-        # the error over every validation frame, drawn exactly (rgba32f) as the error runs are
-        exact_run = compare(variant, self.session, self.work.prepared, self.frames, color_format=ERROR_FORMAT,
-                            on_frame=on_exact, **common)
+        key = ("validate", _key_text(choice))
+        # the error over every validation frame, drawn exactly (rgba32f) as the error runs are, with
+        # FLIP on frames spread over them and the temporal error
+        runs = [RunSpec("compare", spec, self.frames, size, self.window, ERROR_FORMAT, key=key + ("error",),
+                        label=f"{what} error", flip_frames=tuple(flip_frame_indices(self.frames)), temporal=True)]
         # the speed-up in the timing format, REPEATS times over stretches spread over the frames
-        runs = []
         for repeat in range(REPEATS):
             start = (len(self.frames) - len(self.short)) * repeat // max(1, REPEATS - 1)
-            stretch = self.frames[start:start + len(self.short)]
-            runs.append(compare(variant, self.session, self.work.prepared, stretch,
-                                color_format=self.settings.timing_format, clock=self.settings.clock,
-                                on_frame=lambda *a, r=repeat: self._step(f"{what} timing [{r + 1}/{REPEATS}]"),
-                                **common))
-        speedups = tuple(r.speedup for r in runs)
+            runs.append(RunSpec("compare", spec, self.frames[start:start + len(self.short)], size, self.window,
+                                self.settings.timing_format, self.settings.clock, key=key + ("timing", repeat),
+                                label=f"{what} timing [{repeat + 1}/{REPEATS}]"))
+        results = {r.spec.key: r for r in self._executor().run(runs, on_frame=lambda run, n: self._step(run.label, n))}
+        exact_run = _Figures(results[key + ("error",)])
+        timed = [_Figures(results[key + ("timing", repeat)]) for repeat in range(REPEATS)]
+        speedups = tuple(r.speedup for r in timed)
         exact = exact_run.mean_error == 0.0
-        steady = exact_run.frames[1:] or exact_run.frames
+        steady = exact_run.steady
         psnr = None if exact else min(exact_run.psnr, PSNR_CAP)  # exact: PSNR ∞, kept as null
         sel = choice.with_measurement(exact_run.mean_error, psnr,
-                                      statistics.median(r.ms_per_frame for r in runs),
-                                      statistics.median(r.original_ms_per_frame for r in runs),
-                                      float(statistics.median(speedups)), exact_run.hit_rate,
-                                      len(exact_run.frames), speedups)
-        temporal = quality.temporal_psnr
+                                      statistics.median(r.ms_per_frame for r in timed),
+                                      statistics.median(r.original_ms_per_frame for r in timed),
+                                      float(statistics.median(speedups)), exact_run.result.hit_rate,
+                                      len(exact_run.result.frames), speedups)
+        flips, temporal = exact_run.result.flips, exact_run.result.temporal_psnr
         sel = sel.replace(
-            measured_noise=max(frame_noise([f.original_ms for f in r.frames[1:]]) for r in runs), exact=exact,
+            measured_noise=max(frame_noise([f.original_ms for f in r.result.frames[1:]]) for r in timed), exact=exact,
             measured_psnr_uncertainty=None if exact else batch_uncertainty([min(f.psnr, PSNR_CAP) for f in steady]),
-            measured_error_uncertainty=batch_uncertainty([f.mean_error for f in steady]),
-            measured_flip=quality.flip,
-            measured_flip_uncertainty=batch_uncertainty(quality.flips) if quality.flips else None,
+            measured_error_uncertainty=batch_uncertainty([f.error for f in steady]),
+            measured_flip=float(np.mean(flips)) if flips else None,
+            measured_flip_uncertainty=batch_uncertainty(list(flips)) if flips else None,
             measured_temporal_psnr=None if temporal is None or not math.isfinite(temporal) else min(temporal, PSNR_CAP))
         sel = self._flagged(sel)
         self.measured[choice.key] = sel
         self._keep_extras(sel)
         return sel
+
+    def _executor(self):
+        if self.executor is None:
+            self.executor = LocalExecutor(Bench(self.work, self.session))
+        return self.executor
+
+    def close(self) -> None:
+        """Close the executor made here (the caller's stays open)."""
+        if self._own_executor and self.executor is not None:
+            self.executor.close()
+            self.executor = None
 
     # ------------------------------------------------------------------ the levels
     def _learn(self, sel: Selection) -> None:
@@ -312,11 +327,28 @@ class Validator:
         return the selections that stand, in order."""
         self.state["total"] = 2 * self.per * len({c.key for c in choices if c.parts} - set(self._stored))
         out = []
-        for choice in choices:
-            sel = self.level(choice)
-            self.store.add_validation(sel)
-            out.append(sel)
+        try:
+            for choice in choices:
+                sel = self.level(choice)
+                self.store.add_validation(sel)
+                out.append(sel)
+        finally:
+            self.close()
         return out
+
+
+class _Figures:
+    """A compare run's summary as :class:`rrcache.harness.cached.Comparison` gives it (the mean
+    error and PSNR of the steady frames, the median times and their ratio)."""
+
+    def __init__(self, result: RunResult):
+        self.result = result
+        self.steady = result.steady
+        self.mean_error = float(np.mean([f.error for f in self.steady]))
+        self.psnr = float(np.mean([min(f.psnr, PSNR_CAP) for f in self.steady]))
+        self.ms_per_frame = statistics.median(f.ms for f in self.steady)
+        self.original_ms_per_frame = statistics.median(f.original_ms for f in self.steady)
+        self.speedup = self.original_ms_per_frame / self.ms_per_frame if self.ms_per_frame > 0 else float("nan")
 
 
 def flip_level(prof, validator: "Validator", max_flip: float, label: str = "flip") -> Selection:
@@ -353,7 +385,10 @@ def flip_level(prof, validator: "Validator", max_flip: float, label: str = "flip
                 for x in prof.front_candidates(c.replace(min_psnr=needed)) if x.key != c.key]
 
     validator.candidates = candidates
-    return validator.level(choice)
+    try:
+        return validator.level(choice)
+    finally:
+        validator.close()  # an executor it made for these renders (the profile's stays open)
 
 
 def _no_nan(value):
@@ -381,11 +416,13 @@ def described(sel: Selection, width: int = 40) -> str:
 def validate(work: ShaderWork, session, settings: TrainingSettings, store: ProfileStore, choices: list[Selection],
              progress: Optional[ProgressFn] = None, window=None,
              candidates: Optional[Callable[[Selection], list[Selection]]] = None,
-             fallback: bool = True, calibration: Optional[Calibration] = None) -> list[Selection]:
+             fallback: bool = True, calibration: Optional[Calibration] = None, executor=None) -> list[Selection]:
     """Measure each of ``choices`` (labelled selections with their algorithm) beside the original
     inside ``window`` when given and return the selections that stand at their levels (see the
-    module docstring; ``fallback=False`` keeps every choice as measured, marked)."""
-    return Validator(work, session, settings, store, progress, window, candidates, fallback, calibration).run(choices)
+    module docstring; ``fallback=False`` keeps every choice as measured, marked; ``executor``:
+    what runs the renders, None for one in this process)."""
+    return Validator(work, session, settings, store, progress, window, candidates, fallback, calibration,
+                     executor).run(choices)
 
 
 def _original(choice: Selection) -> Selection:

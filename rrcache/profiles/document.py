@@ -593,14 +593,23 @@ def _read_dataclass(cls, value, path: str, file: str, skip=()):
 
 # ---------------------------------------------------------------------- reading
 def filter_line(prof: Profile) -> str:
-    """The profile's cache filter, and with ``auto`` what was measured: 'plane (auto: bilinear
-    31% of the original's time at 42.5 dB, plane 14% at 42.2 dB)'."""
-    times = (prof.plan or {}).get("filter_times") or {}
-    if prof.settings.filter != "auto" or not times:
-        return prof.filter
-    measured = ", ".join(f"{name} {t['time']:.0%} of the original's time at {t['psnr']:.1f} dB"
-                         for name, t in times.items())
-    return f"{prof.filter} (auto: {measured})"
+    """The profile's cache filter, and with ``auto`` what was measured on the first node: 'plane
+    (auto, node n12: bilinear Δn=2 58% of the original's time at 44.1 dB, Δn=26 …; plane …)'."""
+    return filter_text(prof.filter, (prof.plan or {}).get("filter_times") if prof.settings.filter == "auto" else None)
+
+
+def filter_text(chosen: str, times) -> str:
+    """``chosen``, with what ``auto`` measured (``plan.filter_times``) when given."""
+    if not times:
+        return chosen
+    parts = []
+    for name, points in times.items():
+        if isinstance(points, dict):  # one point (profiles of 2026-12-06 morning)
+            points = [points]
+        parts.append(f"{name} " + ", ".join(f"Δn={q.get('period', '?')} {q['time']:.0%} of the original's time at "
+                                            f"{q['psnr']:.1f} dB" for q in points))
+        # the same equal-time rule decided it: rrcache.profiler.filters.pick
+    return f"{chosen} (auto: {'; '.join(parts)})"
 
 
 def algorithm_line(prof: Profile) -> str:
