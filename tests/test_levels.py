@@ -255,3 +255,23 @@ def test_select_prefers_what_was_measured(trained, tmp_path, monkeypatch):
     text = subprocess.run([sys.executable, "-m", "rrcache", "select", str(out), "--min-psnr", str(LEVEL)],
                           capture_output=True, text=True, env=env, timeout=120).stdout
     assert f"measured PSNR {LEVEL + 2.0:.1f} ± 0.2 dB" in text and "measured 2.00×" in text
+
+
+def test_a_flip_level_is_answered_from_the_measured_choices(trained, tmp_path):
+    """rrcache profile --max-flip: the measured choices that meet the FLIP level (and the gain)
+    answer it first; a level none meets is asked of the models at the PSNR the measured choices
+    relate to it (here: the original)."""
+    from rrcache.profiler.validate import Validator, flip_level
+
+    prof, work, session, settings, store = _setup(trained, tmp_path)
+    a, b = prof.trained_nodes[:2]
+    soft = _measured(a, 4, 44.0, flip=0.012, speedups=(2.0, 2.1, 1.9))
+    rough = _measured(b, 8, 35.0, flip=0.045, speedups=(3.0, 3.1, 2.9))
+    with store:
+        validator = Validator(work, session, settings, store)
+        validator.measured = {soft.key: soft, rough.key: rough}
+        met = flip_level(prof, validator, 0.03)
+        assert met.key == soft.key and met.label == "flip" and met.max_flip == 0.03 and met.level_met
+        assert met.min_psnr is None and met.measured_flip == 0.012
+        strict = flip_level(prof, validator, 0.001)
+        assert not strict.parts and strict.label == "flip" and strict.max_flip == 0.001
