@@ -216,6 +216,35 @@ def summary_markdown(table: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def scenes_markdown(table: list[dict]) -> str:
+    """One line per scene, one column per level (the README's table): each run's shipped
+    selection as measured (PSNR ± its uncertainty, speed-up, mean FLIP) and how its level stood
+    (``met``, ``met, try 2``, ``original (N tried)``, ``below: …``); runs of a scene separated by
+    ``;``."""
+    levels: dict = {}
+    scenes: dict = {}
+    for r in table:
+        levels.setdefault(r["level"], r.get("min_psnr"))
+        scenes.setdefault(r["scene"], {}).setdefault(r["level"], []).append(r)
+
+    def cell(r) -> str:
+        status = r.get("status") or r.get("met", "–")
+        if r["kind"] == "original" or r.get("exact"):
+            return status if status.startswith("original") else "original"
+        psnr = "–" if r["psnr"] is None else f"{r['psnr']:.1f}" + (
+            f" ± {r['psnr_uncertainty']:.1f}" if r.get("psnr_uncertainty") else "")
+        flip = "" if r.get("flip") is None else f", FLIP {r['flip']:.3f}"
+        return f"{psnr} dB, {_x(r['speedup'])}{flip}: " + ("BELOW the level" if status.startswith("below") else status)
+
+    names = list(levels)
+    lines = ["| scene | " + " | ".join(n + (f" ≥ {levels[n]:g} dB" if levels[n] else "") for n in names) + " |",
+             "|---|" + "---|" * len(names)]
+    for scene, by_level in scenes.items():
+        lines.append(f"| {scene} | " + " | ".join("; ".join(cell(r) for r in by_level.get(n, [])) or "–"
+                                               for n in names) + " |")
+    return "\n".join(lines)
+
+
 def _counts(items) -> list[tuple[str, int]]:
     out: dict = {}
     for item in items:
