@@ -79,6 +79,10 @@ def test_levels_met_tries_and_the_predictions_error(runs, capsys):
     assert all(r["met"] in ("met", "below", "–") and r["tries"] >= 0 for r in table)
     assert all(r["met"] == "met" for r in table if r["kind"] == "original")
     assert "levels needed a second candidate" in markdown(table)
+    later = sum(1 for r in table if r["kind"] != "original" and r["tries"] > 1)
+    kept = sum(1 for r in table if r["kind"] == "original" and r["tries"] > 0)
+    assert f"{later + kept} levels needed a second candidate ({later} stood with a later candidate, {kept} kept the " \
+           "original after its candidates were refused)" in markdown(table)
     found = predictions(runs)
     assert [r["run"] for r in found] == ["demo-r1.rrprofile", "demo-r2.rrprofile"]
     for r in found:
