@@ -33,6 +33,13 @@ SESSION = {
     "objects": [{"procedural": {"type": "icosphere", "subdivisions": 1}}],
 }
 
+#: the most memory (MiB) a command that refuses its input may take (measured: 44-118 MiB: the
+#: interpreter, numpy and, for textures, OpenImageIO); reading a hostile input would take gigabytes
+REFUSAL_PEAK_MIB = 300
+#: the most memory (MiB) a command that renders or profiles this module's 32×24 scene may take
+#: (GL through llvmpipe, the profile's plots and report)
+RUN_PEAK_MIB = 1024
+
 #: the smallest profile run: a few seconds on llvmpipe
 QUICK_PROFILE = ["--budget", "3", "--periods", "2,4", "--timing-periods", "2", "--timing-frames", "2",
                  "--no-validate", "--algorithm", "three-pass", "--min-gain", "0"]
@@ -104,16 +111,29 @@ main(sys.argv[1:])
 #: memory count from its parent's resident size at the fork, so the command is forked from this
 #: fresh interpreter (tens of MiB), not from the test process, and its own peak is what is measured
 _LAUNCH = """
-import os, sys
+import os, signal, sys
 usage_file, argv = sys.argv[1], sys.argv[2:]
 pid = os.fork()
 if pid == 0:
     os.execv(sys.executable, [sys.executable, *argv])
+for sig in (signal.SIGTERM, signal.SIGINT):  # a signal to the launcher is the command's
+    signal.signal(sig, lambda number, _frame: os.kill(pid, number))
 _, status, usage = os.wait4(pid, 0)
 with open(usage_file, "w") as f:
     f.write(str(usage.ru_maxrss))
 sys.exit(os.waitstatus_to_exitcode(status) % 256)
 """
+
+
+def launched(usage_file, *args) -> list:
+    """The command line running ``python -m rrcache ARGS`` under the launcher, which writes the
+    command's peak resident memory (KiB) to ``usage_file`` when it ends and passes SIGTERM and
+    SIGINT on to it (for a test that starts it with ``Popen``; :func:`peak_mib` reads it)."""
+    return [sys.executable, "-c", _LAUNCH, str(usage_file), "-m", "rrcache", *map(str, args)]
+
+
+def peak_mib(usage_file) -> float:
+    return int(open(usage_file).read()) / 1024
 
 
 def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
@@ -132,7 +152,7 @@ def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
                                   stdout=out, stderr=err, timeout=timeout)
         read = lambda k: open(names[k], encoding="utf-8", errors="replace").read()  # noqa: E731
         lines = [line for line in read("err").splitlines() if line.strip()]
-        return proc.returncode, read("out"), lines, int(read("usage")) / 1024, read("opens").splitlines()
+        return proc.returncode, read("out"), lines, peak_mib(names["usage"]), read("opens").splitlines()
 
 
 @pytest.fixture(scope="module")
