@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from child import python_argv
+
 ROOT = Path(__file__).resolve().parent.parent
 
 SHADER = """#version 330
@@ -64,10 +66,11 @@ def env() -> dict:
     return {**os.environ, "LP_NUM_THREADS": "1", "PYTHONPATH": str(ROOT)}
 
 
-def rrcache(cwd, *args, stdout=subprocess.PIPE, timeout=300, **popen):
-    """``python -m rrcache ARGS`` in ``cwd``: (exit code, stdout, the non-empty stderr lines)."""
-    proc = subprocess.run([sys.executable, "-m", "rrcache", *map(str, args)], cwd=cwd, env=env(),
-                          stdout=stdout, stderr=subprocess.PIPE, text=True, timeout=timeout, **popen)
+def rrcache(cwd, *args, stdout=subprocess.PIPE, timeout=300, file_size=None):
+    """``python -m rrcache ARGS`` in ``cwd``: (exit code, stdout, the non-empty stderr lines);
+    ``file_size``: a limit in bytes on the files it writes (tests/child.py)."""
+    proc = subprocess.run(python_argv(["-m", "rrcache", *args], file_size=file_size), cwd=cwd, env=env(),
+                          stdout=stdout, stderr=subprocess.PIPE, text=True, timeout=timeout)
     return proc.returncode, proc.stdout, [line for line in proc.stderr.splitlines() if line.strip()]
 
 

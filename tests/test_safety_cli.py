@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
-import signal
 import stat
 import struct
 import subprocess
@@ -47,13 +45,6 @@ def mounts():
     yield mount
     for target in reversed(made):
         subprocess.run(["umount", "-l", str(target)], capture_output=True)
-
-
-def _limit_file_size(limit):
-    def apply():
-        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
-    return apply
 
 
 @pytest.fixture
@@ -101,7 +92,7 @@ def test_full_disk_instance_leaves_no_empty_file(case_dir, mounts, stability_cas
         how = "a 16 KiB tmpfs, 12 KiB already used"
     else:
         full.mkdir()
-        popen = {"preexec_fn": _limit_file_size(600)}
+        popen = {"file_size": 600}
         how = "RLIMIT_FSIZE = 600 bytes"
     case = stability_case("disk full: rrcache instance", AREA, f"rrcache instance --out on {how}")
     code, _, lines = rrcache(case_dir, "instance", "scene.frag", "--node", node, "--out", "full/i", **popen)
@@ -120,7 +111,7 @@ def test_full_disk_profile_store(case_dir, mounts, stability_case):
         how = "a 96 KiB tmpfs"
     else:
         full.mkdir()
-        popen = {"preexec_fn": _limit_file_size(40 * 1024)}
+        popen = {"file_size": 40 * 1024}
         how = "RLIMIT_FSIZE = 40 KiB"
     case = stability_case("disk full: rrcache profile's store", AREA, f"rrcache profile --out on {how}, then again")
     code, _, lines = rrcache(case_dir, "profile", "scene.frag", "scene.json", "--out", "full/p", *QUICK_PROFILE, **popen)

@@ -28,6 +28,7 @@ import time
 
 import pytest
 
+from child import python_argv
 from safety_cli import (QUICK_PROFILE, REFUSAL_PEAK_MIB, RUN_PEAK_MIB, env, launched, made_profile,  # noqa: F401
                         one_error_line, peak_mib, rrcache, rrcache_traced, stored_error_runs, write_case)
 from scene_files import CLI_SETTINGS, write_scene
@@ -95,21 +96,18 @@ def test_debug_keeps_exit_2(tmp_path, stability_case):
     assert code2 == 2 and lines2[-1].startswith("rrcache: error:"), lines2
 
 
-def _closed_stdout():
-    os.close(1)
-
-
 def test_closed_stdout(tmp_path, stability_case):
     write_case(tmp_path)
-    proc = subprocess.run(launched(tmp_path / "usage", "nodes", "scene.frag"), cwd=tmp_path, env=env(),
-                          stderr=subprocess.PIPE, text=True, preexec_fn=_closed_stdout)
+    # launched(...)[1:]: the launcher's arguments to python, which python_argv starts with stdout closed
+    proc = subprocess.run(python_argv(launched(tmp_path / "usage", "nodes", "scene.frag")[1:], close_stdout=True),
+                          cwd=tmp_path, env=env(), stderr=subprocess.PIPE, text=True)
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     line = one_error_line(proc.returncode, lines)
     peak = peak_mib(tmp_path / "usage")
     # a profile run with no stdout keeps what it computed: the folder is written, then the table fails
-    prof = subprocess.run(launched(tmp_path / "usage", "profile", "scene.frag", "scene.json", "--out", "p",
-                                   *QUICK_PROFILE), cwd=tmp_path, env=env(), stderr=subprocess.PIPE, text=True,
-                          preexec_fn=_closed_stdout)
+    prof = subprocess.run(python_argv(launched(tmp_path / "usage", "profile", "scene.frag", "scene.json", "--out", "p",
+                                               *QUICK_PROFILE)[1:], close_stdout=True),
+                          cwd=tmp_path, env=env(), stderr=subprocess.PIPE, text=True)
     prof_lines = [x for x in prof.stderr.splitlines() if x.strip() and x.startswith("rrcache:")]
     stability_case("stdout closed", AREA, "rrcache nodes >&-; rrcache profile >&-").observe(
         exit=proc.returncode, stderr=line, profile_exit=prof.returncode, profile_stderr=prof_lines[-1:],
