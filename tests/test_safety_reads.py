@@ -122,6 +122,7 @@ SPARSE = {
     "shader": ("x.frag", ["nodes", "x.frag"], "--max-source-bytes", b"#version 330\n"),
     "include": ("lib.glsl", ["nodes", "inc.frag"], "--max-source-bytes", b"float f() { return 1.0; }\n"),
     "session": ("s.json", ["render", "scene.frag", "s.json"], "--max-document-bytes", b'{"rrcache_session": 1, '),
+    "profile.json": ("p/profile.json", ["report", "p"], "--max-document-bytes", b'{"shader": "scene.frag", '),
 }
 
 
