@@ -88,3 +88,48 @@ def test_levels_met_tries_and_the_predictions_error(runs, capsys):
     assert predictions_markdown(found).splitlines()[-1].startswith("| all | 2 profiles |")
     main(["bench-repeats", "--predictions", str(runs[0])])
     assert "models alone" in capsys.readouterr().out
+
+
+def test_a_level_shipped_below_says_why(runs):
+    """The table's 'level met' cell: the profile table's words for a met level or an original
+    after tries, and 'below: <why>' for a selection under its level (a profile from before
+    validation enforced levels: the measured PSNR against the level)."""
+    from rrcache.bench.repeats import _met, _status
+    from rrcache.profiles import load_profile
+    from rrcache.selection import Selection
+
+    cached = next(s for s in load_profile(runs[0]).selections if s.parts)
+    old = cached.replace(min_psnr=45.0, measured_psnr=37.7, measured_psnr_uncertainty=None, level_met=None,
+                         level_note=None, exact=False)
+    assert _met(old) == "below" and _status(old, "below") == "below: measured 37.7 dB, below the level 45 dB"
+    missed = cached.replace(level_met=False, level_note="measured 40.7 ± 0.3 dB, below the level 45 dB")
+    assert _status(missed, _met(missed)) == "below: measured 40.7 ± 0.3 dB, below the level 45 dB"
+    second = cached.replace(level_met=True, tries=2)
+    assert _status(second, _met(second)) == "met, try 2"
+    original = Selection.original(1.0, level_met=True, tries=2, fallback="n1 refused")
+    assert _status(original, _met(original)) == "original (2 tried)"
+
+
+def test_the_flip_sheet_lists_every_validated_choice(runs, tmp_path, capsys):
+    """tools/flip_sheet.py (docs/levels.md's FLIP table and images) on the same folders, table
+    only: one line per distinct validated choice with FLIP beside PSNR, the nearest to the
+    visible-artifact threshold on each side picked."""
+    import importlib.util
+    from pathlib import Path
+
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    path = Path(__file__).resolve().parents[1] / "tools" / "flip_sheet.py"
+    spec = importlib.util.spec_from_file_location("flip_sheet", path)
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    assert tool.main([str(runs[0]), "--no-sheet", "--json", str(tmp_path / "flip.json")]) == 0
+    out = capsys.readouterr().out
+    data = json.loads((tmp_path / "flip.json").read_text())
+    assert data["threshold"] == VISIBLE_FLIP
+    assert out.count("\n| marbled_sphere |") == len(data["validated"]) > 0
+    flips = [r["flip"] for r in data["validated"]]
+    below = [f for f in flips if f < VISIBLE_FLIP]
+    shown = [r["flip"] for r in data["shown"]]
+    assert sorted(f for f in shown if f < VISIBLE_FLIP) == sorted(below)[-2:]
+    assert sorted(f for f in shown if f >= VISIBLE_FLIP) == sorted(f for f in flips if f >= VISIBLE_FLIP)[:2]

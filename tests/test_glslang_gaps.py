@@ -388,21 +388,34 @@ def test_gl_fragcoord_redeclared_again_with_the_same_qualifiers():
 
 # ----------------------------------------------------------------- the measuring tool
 
-def _tool():
+def _stages() -> tuple:
+    """The tool's stage names, read from the module (loaded, not run)."""
     import importlib.util
-    import sys
     from pathlib import Path
     tool = Path(__file__).resolve().parent.parent / "tools" / "glsl_conformance.py"
     spec = importlib.util.spec_from_file_location("glsl_conformance", tool)
     mod = importlib.util.module_from_spec(spec)
-    sys.modules["glsl_conformance"] = mod  # the worker pool pickles its functions by module name
     spec.loader.exec_module(mod)
-    return mod
+    return tuple(mod.STAGES)
 
 
-def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
+def _tool(argv) -> tuple:
+    """Run tools/glsl_conformance.py in a process of its own: (exit status, stdout). Its worker
+    pool forks, and a fork of this test process (GL driver threads running) can deadlock in the
+    child on a lock another thread held at the fork; a fresh interpreter forks single-threaded."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    root = Path(__file__).resolve().parent.parent
+    env = dict(os.environ, PYTHONPATH=str(root))
+    p = subprocess.run([sys.executable, str(root / "tools" / "glsl_conformance.py"), *argv], cwd=root, env=env,
+                       capture_output=True, text=True, timeout=300)
+    return p.returncode, p.stdout
+
+
+def test_conformance_tool_verdicts_exclude_and_categories(tmp_path):
     import json
-    mod = _tool()
     shaders = {
         "plain.frag": "void main() { gl_FragColor = vec4(1.0); }",
         "spv.sep.frag": VULKAN,
@@ -416,9 +429,8 @@ def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
         "plain.frag\tvalid\tsuite\nspv.sep.frag\tvalid\tsuite\next.frag\tvalid\tsuite\n"
         "bad.frag\tinvalid\tcomment\n")
     report = tmp_path / "report.json"
-    rc = mod.main([str(tmp_path), "--frontend-only", "--exclude", "hlsl.*",
-                   "--verdicts", str(tmp_path / "verdicts.tsv"), "--json", str(report)])
-    out = capsys.readouterr().out
+    rc, out = _tool([str(tmp_path), "--frontend-only", "--exclude", "hlsl.*",
+                     "--verdicts", str(tmp_path / "verdicts.tsv"), "--json", str(report)])
     assert rc == 0
     assert "valid shaders accepted: 3/3" in out and "invalid shaders also rejected: 1/1" in out
     rows = {r["file"]: r for r in json.loads(report.read_text())["results"]}
@@ -429,11 +441,11 @@ def test_conformance_tool_verdicts_exclude_and_categories(tmp_path, capsys):
     assert (rows["bad.frag"]["parse"], rows["bad.frag"]["check"]) == ("ok", "rejected")
 
 
-def test_conformance_tool_stages_opengl_rule_and_time_limit(tmp_path, capsys):
+def test_conformance_tool_stages_opengl_rule_and_time_limit(tmp_path):
     """Each stage is counted, the OpenGL rule drops Vulkan/HLSL names, a slow shader is cut off
     by the per-shader limit without stopping the others."""
     import json
-    mod = _tool()
+    stages = _stages()
     many_defines = "".join(f"#define M{i}(x) M{i - 1}(x)+M{i - 1}(x)\n" for i in range(1, 40))
     shaders = {
         "lit.frag": "varying vec3 n;\nvoid main() { gl_FragColor = vec4(sin(n) * cos(n), 1.0); }",
@@ -449,13 +461,12 @@ def test_conformance_tool_stages_opengl_rule_and_time_limit(tmp_path, capsys):
     for name, text in shaders.items():
         (tmp_path / name).write_text(text)
     report = tmp_path / "report.json"
-    rc = mod.main([str(tmp_path), "--opengl", "--timeout", "3", "--json", str(report)])
-    out = capsys.readouterr().out
+    rc, out = _tool([str(tmp_path), "--opengl", "--timeout", "3", "--json", str(report)])
     rows = {r["file"]: r for r in json.loads(report.read_text())["results"]}
     assert set(rows) == {"lit.frag", "two.frag", "badtype.frag", "syntax.frag", "slow.frag"}
-    assert [rows["lit.frag"][s] for s in mod.STAGES] == ["ok"] * 4 and rows["lit.frag"]["listed"] >= 1
-    assert [rows["two.frag"][s] for s in mod.STAGES] == ["ok", "ok", "unsupported", "skipped"]
-    assert [rows["badtype.frag"][s] for s in mod.STAGES] == ["ok", "rejected", "skipped", "skipped"]
+    assert [rows["lit.frag"][s] for s in stages] == ["ok"] * 4 and rows["lit.frag"]["listed"] >= 1
+    assert [rows["two.frag"][s] for s in stages] == ["ok", "ok", "unsupported", "skipped"]
+    assert [rows["badtype.frag"][s] for s in stages] == ["ok", "rejected", "skipped", "skipped"]
     assert rows["syntax.frag"]["parse"] == "rejected" and rows["syntax.frag"]["stage"] == "parse"
     assert rows["slow.frag"]["parse"] in ("timeout", "rejected"), rows["slow.frag"]
     assert rc == 0 and "crashes (non-rrcache exceptions, bugs): 0" in out

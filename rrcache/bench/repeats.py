@@ -75,7 +75,7 @@ def rows(folders: Iterable) -> list[dict]:
                 predicted_psnr=sel.predicted_psnr, fallback=sel.fallback,
                 cls="original" if not sel.parts else classify(speedups, exact_original=False),
                 ceiling=(profile.ceiling or {}).get("speedup"), tries=int(sel.tries or (1 if sel.parts else 0)),
-                met=met, psnr_uncertainty=sel.measured_psnr_uncertainty, flip=sel.measured_flip,
+                met=met, status=_status(sel, met), psnr_uncertainty=sel.measured_psnr_uncertainty, flip=sel.measured_flip,
                 visible=bool(sel.visible_artifacts), temporal_psnr=sel.measured_temporal_psnr))
     return out
 
@@ -93,6 +93,24 @@ def _met(sel) -> str:
         return "met"
     psnr = sel.measured_psnr if sel.measured_psnr is not None else float("inf")
     return "met" if psnr + float(sel.measured_psnr_uncertainty or 0.0) >= sel.min_psnr else "below"
+
+
+def _status(sel, met: str) -> str:
+    """The row's word on its level, as the profile table says it (``met``, ``met, try 2``,
+    ``original (2 tried)``), or ``below: <why>`` for a selection shipped below its level (a
+    profile whose validation did not enforce the level: its note, else the measured PSNR)."""
+    if met == "below":
+        why = sel.level_note or (f"measured {sel.measured_psnr:.1f}"
+                                 + (f" ± {sel.measured_psnr_uncertainty:.1f}" if sel.measured_psnr_uncertainty else "")
+                                 + f" dB, below the level {sel.min_psnr:g} dB" if sel.min_psnr is not None
+                                 and sel.measured_psnr is not None else "measured above its error level")
+        return f"below: {why}"
+    if met != "met":
+        return met
+    tries = int(sel.tries or 0)
+    if not sel.parts:
+        return f"original ({tries} tried)" if tries else "met"
+    return f"met, try {tries}" if tries > 1 else "met"
 
 
 def predictions(folders: Iterable) -> list[dict]:
@@ -161,7 +179,7 @@ def markdown(table: list[dict]) -> str:
         flip = "0" if r["kind"] == "original" or r.get("exact") else (
             "–" if r.get("flip") is None else f"{r['flip']:.3f}" + (" (visible)" if r.get("visible") else ""))
         lines.append(f"| {r['scene']} | {r['run']} | {level} | {cached} | {_x(r['predicted_speedup'])} | "
-                     f"{measured} | {psnr} | {flip} | {r.get('met', '–')} | {r.get('tries', '–')} | {r['cls']} |")
+                     f"{measured} | {psnr} | {flip} | {r.get('status', r.get('met', '–'))} | {r.get('tries', '–')} | {r['cls']} |")
     bad = slowdowns(table)
     lines.append("")
     lines.append(f"{len(table)} shipped selections in {len({(r['scene'], r['run']) for r in table})} profiles; "
