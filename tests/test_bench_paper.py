@@ -20,7 +20,7 @@ import time
 
 import pytest
 
-from test_cli_profile import default_sigint
+from child import python_argv
 
 from rrcache.bench import paper
 from rrcache.bench.scenes import PAPER_SCENES, Scene, default_root, resolve_scenes, scaled_session
@@ -163,10 +163,9 @@ def test_interrupted_run_keeps_finished_scenes(tmp_path):
     second = write_scene(tmp_path, "second")
     out = tmp_path / "out"
     env = dict(os.environ, LP_NUM_THREADS="1", PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, "-m", "rrcache", "bench", "--quick", "--out", str(out), "--scenes",
-                             f"{first[0]}:{first[1]},{second[0]}:{second[1]}"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                            preexec_fn=default_sigint)
+    proc = subprocess.Popen(python_argv(["-m", "rrcache", "bench", "--quick", "--out", out, "--scenes",
+                                         f"{first[0]}:{first[1]},{second[0]}:{second[1]}"], sigint_default=True),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     deadline = time.time() + 180
     while not (out / "bench.json").exists() and proc.poll() is None and time.time() < deadline:
         time.sleep(0.05)
