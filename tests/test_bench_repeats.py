@@ -79,6 +79,10 @@ def test_levels_met_tries_and_the_predictions_error(runs, capsys):
     assert all(r["met"] in ("met", "below", "–") and r["tries"] >= 0 for r in table)
     assert all(r["met"] == "met" for r in table if r["kind"] == "original")
     assert "levels needed a second candidate" in markdown(table)
+    later = sum(1 for r in table if r["kind"] != "original" and r["tries"] > 1)
+    kept = sum(1 for r in table if r["kind"] == "original" and r["tries"] > 0)
+    assert f"{later + kept} levels needed a second candidate ({later} stood with a later candidate, {kept} kept the " \
+           "original after its candidates were refused)" in markdown(table)
     found = predictions(runs)
     assert [r["run"] for r in found] == ["demo-r1.rrprofile", "demo-r2.rrprofile"]
     for r in found:
@@ -133,3 +137,27 @@ def test_the_flip_sheet_lists_every_validated_choice(runs, tmp_path, capsys):
     shown = [r["flip"] for r in data["shown"]]
     assert sorted(f for f in shown if f < VISIBLE_FLIP) == sorted(below)[-2:]
     assert sorted(f for f in shown if f >= VISIBLE_FLIP) == sorted(f for f in flips if f >= VISIBLE_FLIP)[:2]
+
+
+def test_one_line_per_scene_a_column_per_level(runs, capsys):
+    """--by-scene (the README's table): one line per scene, each level's cell holding every
+    run's measured figures and how its level stood."""
+    from rrcache.bench.repeats import scenes_markdown
+
+    table = rows(runs)
+    text = scenes_markdown(table)
+    lines = text.splitlines()
+    assert lines[0].startswith("| scene | e1") and len(lines) == 3
+    cells = [c.strip() for c in lines[2].strip("|").split("|")][1:]
+    assert len(cells) == 4
+    for cell, level in zip(cells, [r for r in table if r["run"] == "demo-r1.rrprofile"]):
+        assert cell.count("; ") == 1
+        if level["kind"] != "original" and not level.get("exact"):
+            assert f"{level['psnr']:.1f}" in cell and f"{level['speedup']:.2f}×" in cell
+    try:
+        main(["bench-repeats", "--by-scene", *map(str, runs)])
+        code = 0
+    except SystemExit as stop:  # exit 1 while a run shipped a slowdown (this module fakes one)
+        code = stop.code
+    assert code == (1 if slowdowns(table) else 0)
+    assert capsys.readouterr().out.strip() == text

@@ -90,6 +90,16 @@ def test_the_library_table_is_the_run_recorded_in_docs():
     assert len(rows) >= 7 and all(row in record for row in rows)
 
 
+def test_the_levels_table_is_the_run_recorded_in_docs():
+    """The README's 'Do the levels hold?' table is the measured run docs/levels.md records with
+    its commands (issue 29): every row of it, as written there."""
+    section = README.split("## Do the levels hold?", 1)[1].split("\n## ", 1)[0]
+    cited = re.search(r"\((docs/[\w.]+\.md), with the commands", section).group(1)
+    record = (ROOT / cited).read_text(encoding="utf-8")
+    rows = [r for r in section.splitlines() if r.startswith("| ") and "---" not in r]
+    assert len(rows) >= 2 and all(row in record for row in rows)
+
+
 #: a figure: a number (with its uncertainty, '37.3 ± 2.7 dB') and the unit of a speed-up, a PSNR or a
 #: time (not a size such as 640×480 or 4×4)
 FIGURE = re.compile(r"(?<![\w.×])(\d+(?:\.\d+)?)(?: ± \d+(?:\.\d+)?)? ?(×|dB|ms|s|min|minutes|seconds|h|hours)"

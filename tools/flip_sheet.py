@@ -101,6 +101,12 @@ def sheet(rows: list[dict], out: Path, threshold: float) -> list[dict]:
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=80)
     plt.close(fig)
+    # a 256-colour palette (no dithering) keeps a four-row sheet near 250 KB for docs/
+    from PIL import Image
+
+    with Image.open(out) as image:
+        small = image.convert("RGB").quantize(256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    small.save(out, optimize=True)
     return rows
 
 
@@ -113,7 +119,11 @@ def main(argv=None) -> int:
     parser.add_argument("--json", type=Path, default=None, help="write every validated choice's figures here")
     parser.add_argument("--no-sheet", action="store_true", help="only the table: render no images")
     args = parser.parse_args(argv)
-    rows = validated(args.profiles)
+    done = [p for p in args.profiles if (p / "profile.json").is_file()]
+    for p in args.profiles:
+        if p not in done:
+            print(f"note: {p}: skipped, no profile.json yet (still running, or interrupted)", file=sys.stderr)
+    rows = validated(done)
     picked = nearest(rows, VISIBLE_FLIP)
     if not args.no_sheet:
         picked = sheet(picked, args.out, VISIBLE_FLIP)
