@@ -134,18 +134,17 @@ def write(prof, sel: Selection, out_dir, work=None) -> list[str]:
 
 
 def describe_options(prof, sel: Selection) -> str:
-    """The cache's options for ``sel`` in words: 'two-pass (the profile's choice: auto measured
-    two-pass 0.377, three-pass 0.41 of the original's time), bilinear filter, refresh block 4,
-    random refresh, depth tolerance 0.001'."""
+    """The cache's options for ``sel`` in words: 'two-pass (the profile's choice: auto, from the
+    ceiling: two-pass 1.60× against three-pass 1.30× ...), bilinear filter, refresh block 4,
+    random refresh, depth tolerance 0.001' (how ``auto`` decided: :func:`algorithm_line`)."""
+    from rrcache.profiles.document import algorithm_line
+
     algorithm = algorithm_of(prof, sel)
-    times = prof.algorithm_times or {}
+    how = algorithm_line(prof)[len(prof.algorithm):].strip()[1:-1]  # 'auto, from …' of 'two-pass (auto, from …)'
     if sel.algorithm and sel.algorithm != prof.algorithm:
         why = "this level's"
-    elif prof.settings.algorithm == "auto" and times:
-        measured = ", ".join(f"{name} {value:.3f}" for name, value in sorted(times.items(), key=lambda kv: kv[1]))
-        why = f"the profile's choice: auto measured {measured} of the original's time"
     else:
-        why = "the profile's"
+        why = f"the profile's choice: {how}" if how else "the profile's"
     opts = runtime_options(prof, sel)
     part = sel.parts[0] if sel.parts else None
     filter_ = getattr(part, "filter", None) or getattr(prof, "filter", None) or "bilinear"

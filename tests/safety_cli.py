@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from child import python_argv
+
 ROOT = Path(__file__).resolve().parent.parent
 
 SHADER = """#version 330
@@ -32,6 +34,13 @@ SESSION = {
                              {"frame": 5, "eye": [1, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0]}]},
     "objects": [{"procedural": {"type": "icosphere", "subdivisions": 1}}],
 }
+
+#: the most memory (MiB) a command that refuses its input may take (measured: 44-118 MiB: the
+#: interpreter, numpy and, for textures, OpenImageIO); reading a hostile input would take gigabytes
+REFUSAL_PEAK_MIB = 300
+#: the most memory (MiB) a command that renders or profiles this module's 32×24 scene may take
+#: (GL through llvmpipe, the profile's plots and report)
+RUN_PEAK_MIB = 1024
 
 #: the smallest profile run: a few seconds on llvmpipe
 QUICK_PROFILE = ["--budget", "3", "--periods", "2,4", "--timing-periods", "2", "--timing-frames", "2",
@@ -57,10 +66,11 @@ def env() -> dict:
     return {**os.environ, "LP_NUM_THREADS": "1", "PYTHONPATH": str(ROOT)}
 
 
-def rrcache(cwd, *args, stdout=subprocess.PIPE, timeout=300, **popen):
-    """``python -m rrcache ARGS`` in ``cwd``: (exit code, stdout, the non-empty stderr lines)."""
-    proc = subprocess.run([sys.executable, "-m", "rrcache", *map(str, args)], cwd=cwd, env=env(),
-                          stdout=stdout, stderr=subprocess.PIPE, text=True, timeout=timeout, **popen)
+def rrcache(cwd, *args, stdout=subprocess.PIPE, timeout=300, file_size=None):
+    """``python -m rrcache ARGS`` in ``cwd``: (exit code, stdout, the non-empty stderr lines);
+    ``file_size``: a limit in bytes on the files it writes (tests/child.py)."""
+    proc = subprocess.run(python_argv(["-m", "rrcache", *args], file_size=file_size), cwd=cwd, env=env(),
+                          stdout=stdout, stderr=subprocess.PIPE, text=True, timeout=timeout)
     return proc.returncode, proc.stdout, [line for line in proc.stderr.splitlines() if line.strip()]
 
 
@@ -104,16 +114,29 @@ main(sys.argv[1:])
 #: memory count from its parent's resident size at the fork, so the command is forked from this
 #: fresh interpreter (tens of MiB), not from the test process, and its own peak is what is measured
 _LAUNCH = """
-import os, sys
+import os, signal, sys
 usage_file, argv = sys.argv[1], sys.argv[2:]
 pid = os.fork()
 if pid == 0:
     os.execv(sys.executable, [sys.executable, *argv])
+for sig in (signal.SIGTERM, signal.SIGINT):  # a signal to the launcher is the command's
+    signal.signal(sig, lambda number, _frame: os.kill(pid, number))
 _, status, usage = os.wait4(pid, 0)
 with open(usage_file, "w") as f:
     f.write(str(usage.ru_maxrss))
 sys.exit(os.waitstatus_to_exitcode(status) % 256)
 """
+
+
+def launched(usage_file, *args) -> list:
+    """The command line running ``python -m rrcache ARGS`` under the launcher, which writes the
+    command's peak resident memory (KiB) to ``usage_file`` when it ends and passes SIGTERM and
+    SIGINT on to it (for a test that starts it with ``Popen``; :func:`peak_mib` reads it)."""
+    return [sys.executable, "-c", _LAUNCH, str(usage_file), "-m", "rrcache", *map(str, args)]
+
+
+def peak_mib(usage_file) -> float:
+    return int(open(usage_file).read()) / 1024
 
 
 def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
@@ -132,7 +155,7 @@ def rrcache_traced(cwd, *args, timeout=300, stdin=subprocess.DEVNULL):
                                   stdout=out, stderr=err, timeout=timeout)
         read = lambda k: open(names[k], encoding="utf-8", errors="replace").read()  # noqa: E731
         lines = [line for line in read("err").splitlines() if line.strip()]
-        return proc.returncode, read("out"), lines, int(read("usage")) / 1024, read("opens").splitlines()
+        return proc.returncode, read("out"), lines, peak_mib(names["usage"]), read("opens").splitlines()
 
 
 @pytest.fixture(scope="module")

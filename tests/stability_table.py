@@ -159,7 +159,8 @@ def pytest_sessionfinish(session, exitstatus):
         "    tests/test_model_fuzz.py tests/test_frontend_fuzz.py tests/test_session_fuzz.py \\",
         "    tests/test_safety_includes.py tests/test_safety_cli.py tests/test_safety_store.py \\",
         "    tests/test_safety_budgets.py tests/test_safety_profile_doc.py tests/test_safety_fuzz.py \\",
-        "    --stability-table docs/stability.md",
+        "    tests/test_safety_reads.py tests/test_safety_writes.py tests/test_safety_exits.py \\",
+        "    tests/test_inline_shaders.py --stability-table docs/stability.md",
         "```",
         "",
         f"Run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; GL renderer: {_renderer()}; "

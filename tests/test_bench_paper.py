@@ -20,7 +20,7 @@ import time
 
 import pytest
 
-from test_cli_profile import default_sigint
+from child import python_argv
 
 from rrcache.bench import paper
 from rrcache.bench.scenes import PAPER_SCENES, Scene, default_root, resolve_scenes, scaled_session
@@ -163,10 +163,9 @@ def test_interrupted_run_keeps_finished_scenes(tmp_path):
     second = write_scene(tmp_path, "second")
     out = tmp_path / "out"
     env = dict(os.environ, LP_NUM_THREADS="1", PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen([sys.executable, "-m", "rrcache", "bench", "--quick", "--out", str(out), "--scenes",
-                             f"{first[0]}:{first[1]},{second[0]}:{second[1]}"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                            preexec_fn=default_sigint)
+    proc = subprocess.Popen(python_argv(["-m", "rrcache", "bench", "--quick", "--out", out, "--scenes",
+                                         f"{first[0]}:{first[1]},{second[0]}:{second[1]}"], sigint_default=True),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     deadline = time.time() + 180
     while not (out / "bench.json").exists() and proc.poll() is None and time.time() < deadline:
         time.sleep(0.05)
@@ -257,3 +256,43 @@ def test_paper_size_measures_the_shipped_selections_again(quick_run):
         assert (row.limit_speedup is not None) == (row.label == scene["medium"])
     assert result.markdown().count("| noise |") == 2 * len(cached)
     assert paper_size.main([str(folder / "nowhere")]) == 2
+
+
+def test_render_cache_equal_time_measures_the_bench_medium_selection(quick_run, tmp_path):
+    """python -m rrcache.bench.render_cache equal-time --bench OUT --scene S: the reprojection
+    cache row is the bench's medium selection (compiled with its profile's filter) measured again,
+    beside dynamic resolution and the render cache tuned to it; a scene the bench has not measured,
+    or whose medium selection caches nothing, is a clear error."""
+    import shutil
+
+    from rrcache.bench import render_cache as bench
+    from rrcache.pipeline import load_for_session
+
+    doc, folder, shader, session = quick_run
+    bench_out = tmp_path / "out"
+    shutil.copytree(folder / "out", bench_out)
+    scene = doc["scenes"][0]
+    scene["profile"] = str(bench_out / "noise.rrprofile")
+    work = load_for_session(shader, load_session(session))
+    node = max((n for n in work.table.nodes if not n.final), key=lambda n: n.cost)
+    # the quick bench's own medium selection depends on its timings (it may cache nothing): set one
+    scene["medium"] = "e3"
+    e3 = next(s for s in scene["selections"] if s["label"] == "e3")
+    e3.update(parts=[{"kind": "cache", "node": node.id, "period": 4}], algorithm="two-pass")
+    (bench_out / "bench.json").write_text(json.dumps(doc))
+    out = tmp_path / "rc"
+    assert bench.main(["equal-time", "--bench", str(bench_out), "--scene", f"{shader}:{session}",
+                       "--search-frames", "3", "--out", str(out)]) == 0
+    (row,) = json.loads((out / "equal_time.json").read_text())["scenes"]
+    assert row["name"] == "noise" and row["frames"] == scene["frames"]
+    assert row["choice"].startswith(f"e3: {node.id} Δn=4, two-pass, {scene['filter']} filter")
+    assert row["texts"] == [node.text]
+    assert [r["method"] for r in row["rows"]] == ["reprojection cache (ours)", "dynamic resolution",
+                                                   "render cache (Walter 2002)"]
+    assert row["rows"][0]["speedup"] == row["target_speedup"] > 0
+    with pytest.raises(RRCacheError, match="no scene 'marble'"):
+        bench.equal_time(resolve_scenes("marble")[0], bench_out, out)
+    e3["parts"] = []
+    (bench_out / "bench.json").write_text(json.dumps(doc))
+    with pytest.raises(RRCacheError, match="no medium selection that caches"):
+        bench.equal_time(resolve_scenes(f"{shader}:{session}")[0], bench_out, out)

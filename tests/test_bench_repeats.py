@@ -79,6 +79,10 @@ def test_levels_met_tries_and_the_predictions_error(runs, capsys):
     assert all(r["met"] in ("met", "below", "–") and r["tries"] >= 0 for r in table)
     assert all(r["met"] == "met" for r in table if r["kind"] == "original")
     assert "levels needed a second candidate" in markdown(table)
+    later = sum(1 for r in table if r["kind"] != "original" and r["tries"] > 1)
+    kept = sum(1 for r in table if r["kind"] == "original" and r["tries"] > 0)
+    assert f"{later + kept} levels needed a second candidate ({later} stood with a later candidate, {kept} kept the " \
+           "original after its candidates were refused)" in markdown(table)
     found = predictions(runs)
     assert [r["run"] for r in found] == ["demo-r1.rrprofile", "demo-r2.rrprofile"]
     for r in found:
@@ -88,3 +92,72 @@ def test_levels_met_tries_and_the_predictions_error(runs, capsys):
     assert predictions_markdown(found).splitlines()[-1].startswith("| all | 2 profiles |")
     main(["bench-repeats", "--predictions", str(runs[0])])
     assert "models alone" in capsys.readouterr().out
+
+
+def test_a_level_shipped_below_says_why(runs):
+    """The table's 'level met' cell: the profile table's words for a met level or an original
+    after tries, and 'below: <why>' for a selection under its level (a profile from before
+    validation enforced levels: the measured PSNR against the level)."""
+    from rrcache.bench.repeats import _met, _status
+    from rrcache.profiles import load_profile
+    from rrcache.selection import Selection
+
+    cached = next(s for s in load_profile(runs[0]).selections if s.parts)
+    old = cached.replace(min_psnr=45.0, measured_psnr=37.7, measured_psnr_uncertainty=None, level_met=None,
+                         level_note=None, exact=False)
+    assert _met(old) == "below" and _status(old, "below") == "below: measured 37.7 dB, below the level 45 dB"
+    missed = cached.replace(level_met=False, level_note="measured 40.7 ± 0.3 dB, below the level 45 dB")
+    assert _status(missed, _met(missed)) == "below: measured 40.7 ± 0.3 dB, below the level 45 dB"
+    second = cached.replace(level_met=True, tries=2)
+    assert _status(second, _met(second)) == "met, try 2"
+    original = Selection.original(1.0, level_met=True, tries=2, fallback="n1 refused")
+    assert _status(original, _met(original)) == "original (2 tried)"
+
+
+def test_the_flip_sheet_lists_every_validated_choice(runs, tmp_path, capsys):
+    """tools/flip_sheet.py (docs/levels.md's FLIP table and images) on the same folders, table
+    only: one line per distinct validated choice with FLIP beside PSNR, the nearest to the
+    visible-artifact threshold on each side picked."""
+    import importlib.util
+    from pathlib import Path
+
+    from rrcache.model.levels import VISIBLE_FLIP
+
+    path = Path(__file__).resolve().parents[1] / "tools" / "flip_sheet.py"
+    spec = importlib.util.spec_from_file_location("flip_sheet", path)
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    assert tool.main([str(runs[0]), "--no-sheet", "--json", str(tmp_path / "flip.json")]) == 0
+    out = capsys.readouterr().out
+    data = json.loads((tmp_path / "flip.json").read_text())
+    assert data["threshold"] == VISIBLE_FLIP
+    assert out.count("\n| marbled_sphere |") == len(data["validated"]) > 0
+    flips = [r["flip"] for r in data["validated"]]
+    below = [f for f in flips if f < VISIBLE_FLIP]
+    shown = [r["flip"] for r in data["shown"]]
+    assert sorted(f for f in shown if f < VISIBLE_FLIP) == sorted(below)[-2:]
+    assert sorted(f for f in shown if f >= VISIBLE_FLIP) == sorted(f for f in flips if f >= VISIBLE_FLIP)[:2]
+
+
+def test_one_line_per_scene_a_column_per_level(runs, capsys):
+    """--by-scene (the README's table): one line per scene, each level's cell holding every
+    run's measured figures and how its level stood."""
+    from rrcache.bench.repeats import scenes_markdown
+
+    table = rows(runs)
+    text = scenes_markdown(table)
+    lines = text.splitlines()
+    assert lines[0].startswith("| scene | e1") and len(lines) == 3
+    cells = [c.strip() for c in lines[2].strip("|").split("|")][1:]
+    assert len(cells) == 4
+    for cell, level in zip(cells, [r for r in table if r["run"] == "demo-r1.rrprofile"]):
+        assert cell.count("; ") == 1
+        if level["kind"] != "original" and not level.get("exact"):
+            assert f"{level['psnr']:.1f}" in cell and f"{level['speedup']:.2f}×" in cell
+    try:
+        main(["bench-repeats", "--by-scene", *map(str, runs)])
+        code = 0
+    except SystemExit as stop:  # exit 1 while a run shipped a slowdown (this module fakes one)
+        code = stop.code
+    assert code == (1 if slowdowns(table) else 0)
+    assert capsys.readouterr().out.strip() == text

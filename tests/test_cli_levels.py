@@ -107,3 +107,29 @@ def test_level_needs_a_profile(tmp_path, capsys):
         assert info.value.code == 2
         assert "--level needs a PROFILE" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_a_level_takes_the_profiles_cache_filter(demo, tmp_path, capsys):
+    """A profile trained with the other cache filter than the demo's (bilinear or plane, both
+    real profiles): ``instance``/``render PROFILE --level`` and ``--node`` use the profile's
+    filter, not the commands' default, and ``instance --level`` still writes its optimized/eN."""
+    from rrcache.profiler.demo import DEMO_SETTINGS
+    from rrcache.profiler.run import profile
+    from rrcache.profiles import TrainingSettings
+
+    other = "plane" if demo.filter != "plane" else "bilinear"
+    prof = profile(DEMO_SHADER, DEMO_SESSION, tmp_path / "other.rrprofile",
+                   TrainingSettings(**DEMO_SETTINGS, filter=other), plots=False)
+    assert prof.filter == other
+    sel = next((s for s in prof.selections if s.parts and len(s.parts) == 1), None)
+    assert sel is not None, "the profile cached no single node at any level"
+    out = tmp_path / "level"
+    main(["instance", str(prof.path), "--level", sel.label, "--out", str(out)])
+    assert f"{other} filter" in capsys.readouterr().out
+    assert json.loads((out / "manifest.json").read_text())["filter"] == other
+    match, mismatch, errors = filecmp.cmpfiles(out, prof.path / sel.files, _files(out), shallow=False)
+    assert mismatch == [] and errors == []
+    main(["render", str(prof.path), "--level", sel.label, "--frames", "3", "--json", "--quiet"])
+    assert json.loads(capsys.readouterr().out)["filter"] == other
+    main(["render", str(prof.path), "--node", sel.node, "--frames", "3", "--json", "--quiet"])
+    assert json.loads(capsys.readouterr().out)["filter"] == other

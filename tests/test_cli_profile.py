@@ -19,6 +19,7 @@ import time
 
 import pytest
 
+from child import python_argv
 from safety_cli import stored_error_runs
 from scene_files import CLI_SETTINGS, write_scene
 
@@ -42,16 +43,10 @@ def rrcache(*args, check=True, **kw):
     return proc
 
 
-def default_sigint() -> None:
-    """In the child before exec: SIGINT back to its default. A test run started in the
-    background by a non-interactive shell inherits SIGINT ignored, and Python then installs no
-    KeyboardInterrupt handler, so the signal the test sends would do nothing."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
 def _spawn(*args):
-    return subprocess.Popen([sys.executable, *ENTRY, *map(str, args)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=_env(), preexec_fn=default_sigint)
+    # SIGINT at its default in the child: the test sends it (tests/child.py)
+    return subprocess.Popen(python_argv([*ENTRY, *args], sigint_default=True), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=_env())
 
 
 def _wait_for_runs(proc, path, at_least: int) -> int:

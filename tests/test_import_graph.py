@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 import importlib
 import inspect
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -239,6 +240,32 @@ def test_each_package_imports_only_lower_layers():
 def test_no_forbidden_import():
     wrong = forbidden_imports(GRAPH)
     assert not wrong, "\n".join(wrong)
+
+
+def _doc_rows(heading: str) -> list[list[str]]:
+    """The cells of the table under ``## heading`` in docs/architecture.md."""
+    text = (ROOT.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    section = text.split(f"## {heading}\n", 1)[1].split("\n## ", 1)[0]
+    return [[c.strip() for c in line.strip().strip("|").split("|")] for line in section.splitlines()
+            if line.startswith("|") and not set(line) <= set("|- ")][1:]
+
+
+def _names(cell: str) -> set[str]:
+    """``errors.py``, ``glsl/``, ``rrcache/__init__.py`` → the package names the test uses."""
+    return {"rrcache" if n == "rrcache/__init__.py" else n.removesuffix(".py").rstrip("/")
+            for n in re.findall(r"`([^`]+)`", cell)}
+
+
+def test_the_documented_tables_are_the_tested_ones():
+    """docs/architecture.md's "Layers" and "Forbidden imports" tables say what LAYERS and
+    FORBIDDEN hold, row for row."""
+    layers: dict[int, set] = {}
+    for number, package, _ in _doc_rows("Layers"):
+        layers.setdefault(int(number), set()).update(_names(package))
+    assert [layers[i] for i in sorted(layers)] == LAYERS
+    documented = {(i, f) for importer, forbidden, _ in _doc_rows("Forbidden imports")
+                  for i in _names(importer) for f in _names(forbidden)}
+    assert documented == {(a, b) for a, b, _ in FORBIDDEN}
 
 
 def test_public_names_survive_importing_every_module():

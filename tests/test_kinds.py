@@ -78,19 +78,16 @@ def test_each_chosen_variant_is_compiled_once_per_profile(tmp_path):
     each variant once, and says how many it compiled. Every render of training and validation is
     a run of the profile's one executor."""
     from test_profile import SETTINGS, write_scene
-    from rrcache.harness.execute import Bench, LocalExecutor
+    from test_runs import RecordingExecutor
+    from rrcache.harness.execute import Bench
     from rrcache.profiler import profile
 
     made = []
 
-    class Recording(LocalExecutor):
-        def run(self, specs, on_frame=None):
-            specs = list(specs)
-            made.extend(specs)
-            return super().run(specs, on_frame)
-
     def factory(work, session):
-        return Recording(Bench(work, session))
+        executor = RecordingExecutor(Bench(work, session))
+        executor.made = made
+        return executor
 
     shader, session = write_scene(tmp_path)
     kinds.clear_compile_cache()

@@ -68,7 +68,7 @@ def test_every_command_of_the_reference_exists_with_its_options(capsys):
 
 
 def test_the_results_table_cites_its_figures():
-    section = README.split("## Results", 1)[1]
+    section = README.split("## Results", 1)[1].split("\n## ", 1)[0]
     cited = re.search(r"\((docs/[\w.]+\.md), with the command", section).group(1)
     record = (ROOT / cited).read_text(encoding="utf-8")
     paper = (ROOT / "docs" / "design.md").read_text(encoding="utf-8")
@@ -88,3 +88,79 @@ def test_the_library_table_is_the_run_recorded_in_docs():
     record = (ROOT / cited).read_text(encoding="utf-8")
     rows = [r for r in section.splitlines() if r.startswith("| ") and "---" not in r]
     assert len(rows) >= 7 and all(row in record for row in rows)
+
+
+def test_the_levels_table_is_the_run_recorded_in_docs():
+    """The README's 'Do the levels hold?' table is the measured run docs/levels.md records with
+    its commands (issue 29): every row of it, as written there."""
+    section = README.split("## Do the levels hold?", 1)[1].split("\n## ", 1)[0]
+    cited = re.search(r"\((docs/[\w.]+\.md), with the commands", section).group(1)
+    record = (ROOT / cited).read_text(encoding="utf-8")
+    rows = [r for r in section.splitlines() if r.startswith("| ") and "---" not in r]
+    assert len(rows) >= 2 and all(row in record for row in rows)
+
+
+#: a figure: a number (with its uncertainty, '37.3 ± 2.7 dB') and the unit of a speed-up, a PSNR or a
+#: time (not a size such as 640×480 or 4×4)
+FIGURE = re.compile(r"(?<![\w.×])(\d+(?:\.\d+)?)(?: ± \d+(?:\.\d+)?)? ?(×|dB|ms|s|min|minutes|seconds|h|hours)"
+                    r"(?![\w×\d])")
+
+
+def _settings() -> dict:
+    """The README's figures that are defaults, not measurements, each with the code's value."""
+    import inspect
+
+    from rrcache.cli.progress import Reporter
+    from rrcache.model.psnr import DEFAULT_LEVELS_DB
+    from rrcache.profiles import TrainingSettings
+
+    defaults = TrainingSettings()
+    levels = {f"{db:g} dB": db for db in DEFAULT_LEVELS_DB}  # e1 ≥ 45 dB … e4 ≥ 30 dB
+    return {**levels, "1.1×": defaults.min_gain, "360 s": defaults.budget_s,
+            "10 seconds": inspect.signature(Reporter).parameters["interval"].default}
+
+
+def test_every_figure_comes_from_a_run_recorded_in_the_docs_it_cites():
+    """Each section's figures (speed-ups, PSNRs, times) are in a docs/ page the section cites (the
+    run, with its command), or are defaults whose values the code has: a figure added without
+    its record fails here."""
+    settings = _settings()
+    for name, value in settings.items():
+        assert float(FIGURE.match(name).group(1)) == float(value), (name, value)
+    checked = 0
+    for section in re.split(r"\n(?=## )", README):
+        prose = re.sub(r"```.*?```", "", section, flags=re.S)
+        title = section.splitlines()[0]
+        cited = sorted(set(re.findall(r"docs/[\w-]+\.md", prose)))
+        records = [" ".join((ROOT / c).read_text(encoding="utf-8").split()) for c in cited]
+        for found in FIGURE.finditer(prose):
+            figure = found.group(0)
+            if figure in settings:
+                continue
+            assert cited, f"{title}: {figure} is stated, but the section cites no docs/ page recording it"
+            assert any(figure in record for record in records), \
+                f"{title}: {figure} is in none of the pages the section cites ({', '.join(cited)})"
+            checked += 1
+    assert checked >= 40  # the results and library tables, the set-up's times, re-selection
+
+
+def test_the_session_example_loads_with_its_files_in_place(tmp_path):
+    """The README's session, copied as printed beside a mesh and a texture at the paths it
+    names, is a valid session: its camera, light, object, keyframed uniform and texture."""
+    import numpy as np
+    from PIL import Image
+
+    from rrcache.session import load_session
+
+    block = _blocks("json")[0]
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "textures").mkdir()
+    (tmp_path / "meshes" / "statue.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    Image.fromarray(np.full((4, 4, 3), 128, np.uint8)).save(tmp_path / "textures" / "albedo.png")
+    (tmp_path / "my.json").write_text(block)
+    session = load_session(tmp_path / "my.json")
+    assert session.resolution == (640, 480) and session.frames == 150
+    assert [o.name for o in session.objects] == ["statue"] and list(session.textures) == ["u_albedo"]
+    values = session.uniform_values(149)
+    assert values["u_roughness"] == 0.4 and values["u_wave"] == 1.0
+    assert not np.allclose(session.camera_at(0).eye, session.camera_at(10).eye)  # the orbit moves

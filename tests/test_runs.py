@@ -36,6 +36,19 @@ def _node(bench):
     return max(bench.work.table.nodes, key=lambda n: n.cost).id
 
 
+class RecordingExecutor(LocalExecutor):
+    """The local executor, keeping every spec it was given in ``made`` (in order)."""
+
+    def __init__(self, bench):
+        super().__init__(bench)
+        self.made: list = []
+
+    def run(self, specs, on_frame=None):
+        specs = list(specs)
+        self.made.extend(specs)
+        return super().run(specs, on_frame)
+
+
 def test_an_error_run_measures_what_the_renderers_measure(gl_ctx, bench):
     """An error run's rows are the error of each frame of the cached variant (from an empty
     cache, in order) against the original's frame, as the harness computes it by hand."""
@@ -163,19 +176,12 @@ def test_validation_measures_through_the_executor_it_is_given(gl_ctx, bench, tmp
     from rrcache.profiles.store import ProfileStore, StoreKey
     from rrcache.selection import CachedNode, Selection
 
-    made = []
-
-    class Recording(LocalExecutor):
-        def run(self, specs, on_frame=None):
-            specs = list(specs)
-            made.extend(specs)
-            return super().run(specs, on_frame)
-
     node = _node(bench)
     settings = TrainingSettings(periods=(2, 4), resolution=SIZE, validation_frames=5).resolved(bench.session)
     choice = Selection((CachedNode(node, 4),), 0.01, 1.0, 2.0, label="e1", max_error=0.02, algorithm="two-pass")
     key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
-    executor = Recording(bench)
+    executor = RecordingExecutor(bench)
+    made = executor.made
     with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
         [row] = validate(bench.work, bench.session, settings, store, [choice], fallback=False, executor=executor)
     assert [s.measure for s in made] == ["compare"] * (1 + REPEATS)

@@ -28,8 +28,9 @@ import time
 
 import pytest
 
-from safety_cli import (QUICK_PROFILE, env, made_profile, one_error_line, rrcache, rrcache_traced,  # noqa: F401
-                        stored_error_runs, write_case)
+from child import python_argv
+from safety_cli import (QUICK_PROFILE, REFUSAL_PEAK_MIB, RUN_PEAK_MIB, env, launched, made_profile,  # noqa: F401
+                        one_error_line, peak_mib, rrcache, rrcache_traced, stored_error_runs, write_case)
 from scene_files import CLI_SETTINGS, write_scene
 
 AREA = "safety: exits, signals and damaged documents"
@@ -45,8 +46,9 @@ def test_sigterm_is_handled_like_sigint(tmp_path, stability_case, watchdog):
     out = tmp_path / "out"
     settings = [*CLI_SETTINGS, "--min-saving", "0", "--periods", "2,3,4,5,6,7,8,10,12,14,16,20,24,28,32,40"]
     head = ["--frame-timeout", "60"] if watchdog else []
-    proc = subprocess.Popen([sys.executable, "-m", "rrcache", *head, "profile", str(shader), str(session), "--out",
-                             str(out), *settings], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env())
+    usage = tmp_path / "usage"
+    proc = subprocess.Popen(launched(usage, *head, "profile", shader, session, "--out", out, *settings),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env())
     deadline = time.monotonic() + 120
     while stored_error_runs(out / "profile.sqlite") < 2:
         if proc.poll() is not None:
@@ -60,8 +62,10 @@ def test_sigterm_is_handled_like_sigint(tmp_path, stability_case, watchdog):
     lines = [line for line in stderr.splitlines() if line.strip()]
     case = stability_case(f"SIGTERM during a profile{' (frame watchdog)' if watchdog else ''}", AREA,
                           "rrcache profile, SIGTERM after 2 stored error runs, then the same command again")
-    case.observe(exit=proc.returncode, stderr=" | ".join(lines).replace(str(tmp_path), "TMP"))
+    case.observe(exit=proc.returncode, stderr=" | ".join(lines).replace(str(tmp_path), "TMP"),
+                 peak_mib=round(peak_mib(usage)))
     assert proc.returncode == 143, stderr
+    assert peak_mib(usage) < RUN_PEAK_MIB
     assert "Traceback" not in stderr
     said = [line for line in lines if line.startswith("rrcache:")]
     assert len(said) == 1 and said[0].startswith("rrcache: terminated (SIGTERM); the run in flight was dropped"), lines
@@ -80,36 +84,36 @@ def test_sigterm_is_handled_like_sigint(tmp_path, stability_case, watchdog):
 
 def test_debug_keeps_exit_2(tmp_path, stability_case):
     write_case(tmp_path)
-    code, _, lines = rrcache(tmp_path, "--debug", "nodes", "missing.frag")
-    assert code == 2 and "Traceback" in "\n".join(lines)
+    code, _, lines, peak, _ = rrcache_traced(tmp_path, "--debug", "nodes", "missing.frag")
+    assert code == 2 and "Traceback" in "\n".join(lines) and peak < REFUSAL_PEAK_MIB
     assert lines[-1].startswith("rrcache: error: cannot read shader file 'missing.frag': not found")
     with open(os.devnull, "w") as null:  # an OSError (the output folder is a file) is exit 2 as well
         (tmp_path / "afile").write_text("x")
         code2, _, lines2 = rrcache(tmp_path, "--debug", "instance", "scene.frag", "--node", "n1", "--out",
                                    "afile/x", stdout=null)
     stability_case("--debug on a bad input", AREA, "rrcache --debug nodes missing.frag; instance --out afile/x").observe(
-        exit=code, last_line=lines[-1], instance_exit=code2)
+        exit=code, last_line=lines[-1], instance_exit=code2, peak_mib=round(peak))
     assert code2 == 2 and lines2[-1].startswith("rrcache: error:"), lines2
-
-
-def _closed_stdout():
-    os.close(1)
 
 
 def test_closed_stdout(tmp_path, stability_case):
     write_case(tmp_path)
-    proc = subprocess.run([sys.executable, "-m", "rrcache", "nodes", "scene.frag"], cwd=tmp_path, env=env(),
-                          stderr=subprocess.PIPE, text=True, preexec_fn=_closed_stdout)
+    # launched(...)[1:]: the launcher's arguments to python, which python_argv starts with stdout closed
+    proc = subprocess.run(python_argv(launched(tmp_path / "usage", "nodes", "scene.frag")[1:], close_stdout=True),
+                          cwd=tmp_path, env=env(), stderr=subprocess.PIPE, text=True)
     lines = [line for line in proc.stderr.splitlines() if line.strip()]
     line = one_error_line(proc.returncode, lines)
+    peak = peak_mib(tmp_path / "usage")
     # a profile run with no stdout keeps what it computed: the folder is written, then the table fails
-    prof = subprocess.run([sys.executable, "-m", "rrcache", "profile", "scene.frag", "scene.json", "--out", "p",
-                           *QUICK_PROFILE], cwd=tmp_path, env=env(), stderr=subprocess.PIPE, text=True,
-                          preexec_fn=_closed_stdout)
+    prof = subprocess.run(python_argv(launched(tmp_path / "usage", "profile", "scene.frag", "scene.json", "--out", "p",
+                                               *QUICK_PROFILE)[1:], close_stdout=True),
+                          cwd=tmp_path, env=env(), stderr=subprocess.PIPE, text=True)
     prof_lines = [x for x in prof.stderr.splitlines() if x.strip() and x.startswith("rrcache:")]
     stability_case("stdout closed", AREA, "rrcache nodes >&-; rrcache profile >&-").observe(
-        exit=proc.returncode, stderr=line, profile_exit=prof.returncode, profile_stderr=prof_lines[-1:])
+        exit=proc.returncode, stderr=line, profile_exit=prof.returncode, profile_stderr=prof_lines[-1:],
+        peak_mib=round(peak), profile_peak_mib=round(peak_mib(tmp_path / "usage")))
     assert "standard output is closed" in line
+    assert peak < REFUSAL_PEAK_MIB and peak_mib(tmp_path / "usage") < RUN_PEAK_MIB
     assert prof.returncode == 2 and (tmp_path / "p" / "profile.json").exists(), prof.stderr
     assert prof_lines and "standard output is closed" in prof_lines[-1]
 
@@ -133,10 +137,10 @@ BAD_OPTIONS = {
 def test_unchecked_options_are_checked(tmp_path, stability_case, name):
     write_case(tmp_path)
     args, option = BAD_OPTIONS[name]
-    code, _, lines = rrcache(tmp_path, *args)
+    code, _, lines, peak, _ = rrcache_traced(tmp_path, *args)
     line = one_error_line(code, lines)
-    stability_case(name, AREA, "rrcache " + " ".join(args)).observe(exit=code, stderr=line)
-    assert option in line
+    stability_case(name, AREA, "rrcache " + " ".join(args)).observe(exit=code, stderr=line, peak_mib=round(peak))
+    assert option in line and peak < REFUSAL_PEAK_MIB
 
 
 # ----------------------------------------------------------------------------- damaged documents
@@ -163,10 +167,12 @@ def test_damaged_store_rows_are_refused_on_resume(made_profile, tmp_path, stabil
     conn.commit()
     conn.close()
     assert changed > 0
-    code, _, lines = rrcache(tmp_path / "case", "profile", "scene.frag", "scene.json", "--out", "p", *QUICK_PROFILE)
+    code, _, lines, peak, _ = rrcache_traced(tmp_path / "case", "profile", "scene.frag", "scene.json", "--out", "p",
+                                             *QUICK_PROFILE)
     line = one_error_line(code, lines)
-    stability_case(f"damaged store on resume: {name}", AREA, sql).observe(exit=code, stderr=line)
+    stability_case(f"damaged store on resume: {name}", AREA, sql).observe(exit=code, stderr=line, peak_mib=round(peak))
     assert table in line and column in line and "--fresh" in line, line
+    assert peak < RUN_PEAK_MIB
 
 
 def test_profile_json_lists_of_different_lengths(made_profile, tmp_path, stability_case):
@@ -176,12 +182,15 @@ def test_profile_json_lists_of_different_lengths(made_profile, tmp_path, stabili
     i = next(k for k, n in enumerate(doc["nodes"]) if n["trained"])
     doc["nodes"][i]["periods"], doc["nodes"][i]["errors"] = [2, 6, 10], [0.1]
     path.write_text(json.dumps(doc))
-    seen = {}
+    seen, peaks = {}, []
     for command in (["select", "p", "--max-error", "0.1"], ["report", "p"], ["accuracy", "p"]):
-        code, _, lines = rrcache(tmp_path / "case", *command)
+        code, _, lines, peak, _ = rrcache_traced(tmp_path / "case", *command)
         seen[command[0]] = one_error_line(code, lines)
+        peaks.append(round(peak))
         assert f"profile.json: nodes[{i}].errors: has 1 value, but nodes[{i}].periods has 3" in seen[command[0]]
-    stability_case("profile.json: periods [2,6,10], errors [0.1]", AREA, "select, report, accuracy").observe(**seen)
+    stability_case("profile.json: periods [2,6,10], errors [0.1]", AREA, "select, report, accuracy").observe(
+        **seen, peak_mib=max(peaks))
+    assert max(peaks) < REFUSAL_PEAK_MIB, peaks
 
 
 # ----------------------------------------------------------------------------- macro bombs
@@ -204,7 +213,7 @@ def test_macro_bombs_are_refused_small(tmp_path, stability_case, name):
     stability_case(f"macro bomb: {name}", AREA, "rrcache nodes bomb.frag").observe(
         exit=code, stderr=line.replace(str(tmp_path), "TMP"), peak_mib=round(peak))
     assert "macro expansion too large" in line and "200,000 tokens" in line
-    assert peak < 300, peak
+    assert peak < REFUSAL_PEAK_MIB, peak
 
 
 # ----------------------------------------------------------------------------- a refused variant

@@ -216,27 +216,31 @@ def _check(code, lines, before_outside, before_inputs, base: Path, work: Path, l
     assert after == before_inputs, (label, set(after) ^ set(before_inputs))
 
 
-@settings(max_examples=80, deadline=None, suppress_health_check=list(HealthCheck))
-@given(command=st.sampled_from(list(COMMANDS)), shader=damaged_shader(),
-       session_text=damaged_json(FUZZ_SESSION, SESSION_PATHS), profile_text=damaged_json(PROFILE, PROFILE_PATHS))
-def test_cli_survives_damaged_inputs(command, shader, session_text, profile_text):
+def _fuzz(command, shader, session_text, profile_text, run) -> None:
+    """One fuzz case: the workspace made, ``run(work, args)`` → (exit code, stderr lines), checked."""
     with tempfile.TemporaryDirectory(prefix="rrfuzz-") as tmp:
         base = Path(tmp)
         work = _workspace(base, shader, session_text, profile_text)
         before_outside, before_inputs = tree(base / "outside"), tree(work)
-        code, lines = _main(work, COMMANDS[command])
+        code, lines = run(work, COMMANDS[command])
         event(f"{command}: exit {code}")
         _check(code, lines, before_outside, before_inputs, base, work, command)
+
+
+def _subprocess(work, args):
+    code, _, lines = rrcache(work, *args)
+    return code, lines
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=list(HealthCheck))
+@given(command=st.sampled_from(list(COMMANDS)), shader=damaged_shader(),
+       session_text=damaged_json(FUZZ_SESSION, SESSION_PATHS), profile_text=damaged_json(PROFILE, PROFILE_PATHS))
+def test_cli_survives_damaged_inputs(command, shader, session_text, profile_text):
+    _fuzz(command, shader, session_text, profile_text, _main)
 
 
 @settings(max_examples=3, deadline=None, suppress_health_check=list(HealthCheck))
 @given(command=st.sampled_from(list(COMMANDS)), shader=damaged_shader(),
        session_text=damaged_json(FUZZ_SESSION, SESSION_PATHS), profile_text=damaged_json(PROFILE, PROFILE_PATHS))
 def test_cli_survives_damaged_inputs_in_a_subprocess(command, shader, session_text, profile_text):
-    with tempfile.TemporaryDirectory(prefix="rrfuzz-") as tmp:
-        base = Path(tmp)
-        work = _workspace(base, shader, session_text, profile_text)
-        before_outside, before_inputs = tree(base / "outside"), tree(work)
-        code, _, lines = rrcache(work, *COMMANDS[command])
-        event(f"{command}: exit {code}")
-        _check(code, lines, before_outside, before_inputs, base, work, command)
+    _fuzz(command, shader, session_text, profile_text, _subprocess)

@@ -19,15 +19,13 @@ import subprocess
 import numpy as np
 import pytest
 
-from safety_cli import made_profile, one_error_line, rrcache_traced, session, write_case  # noqa: F401 (a fixture)
+from safety_cli import (REFUSAL_PEAK_MIB, RUN_PEAK_MIB, made_profile, one_error_line, rrcache_traced,  # noqa: F401
+                        session, write_case)
 
 AREA = "safety: the one rule for reading"
 
 TEX_SHADER = ("#version 330\nuniform sampler2D u_t;\nin vec3 v_normal;\nout vec4 c;\n"
               "void main() { c = texture(u_t, v_normal.xy * 0.5 + 0.5); }\n")
-#: the most memory a refusal may take (measured here: 44-118 MiB: the interpreter, numpy and, for
-#: textures, OpenImageIO); reading any of these inputs would take gigabytes
-PEAK_MIB = 300
 
 
 def _png(path, value=0.5, size=4):
@@ -59,6 +57,7 @@ ROLES = {
     "texture": ("t.png", ["render", "tex.frag", "tex.json", "--frames", "1"], "textures.u_t"),
     "vertex": ("v.vert", ["render", "scene.frag", "vert.json", "--frames", "1"], "vertex"),
     "profile.json": ("p/profile.json", ["report", "p"], "profile.json"),
+    "profile.json (select)": ("p/profile.json", ["select", "p", "--max-error", "0.1"], "profile.json"),
 }
 
 
@@ -85,7 +84,7 @@ def test_not_a_regular_file_is_refused_as_what_it_is(tmp_path, stability_case, r
     case.observe(exit=code, stderr=line.replace(str(tmp_path), "TMP"), peak_mib=round(peak))
     assert words in line and place in line, line
     assert "not found" not in line
-    assert peak < PEAK_MIB
+    assert peak < REFUSAL_PEAK_MIB
 
 
 def test_own_stdin_as_a_session(tmp_path, stability_case):
@@ -102,7 +101,7 @@ def test_own_stdin_as_a_session(tmp_path, stability_case):
     line = one_error_line(code, lines)
     stability_case("session from the process's own stdin", AREA, "rrcache render scene.frag /proc/self/fd/0, "
                    "stdin a pipe held open").observe(exit=code, stderr=line, peak_mib=round(peak))
-    assert "FIFO" in line and peak < PEAK_MIB
+    assert "FIFO" in line and peak < REFUSAL_PEAK_MIB
 
 
 def _sparse(path, size=100 * 1024 ** 3, head=b""):
@@ -123,6 +122,7 @@ SPARSE = {
     "shader": ("x.frag", ["nodes", "x.frag"], "--max-source-bytes", b"#version 330\n"),
     "include": ("lib.glsl", ["nodes", "inc.frag"], "--max-source-bytes", b"float f() { return 1.0; }\n"),
     "session": ("s.json", ["render", "scene.frag", "s.json"], "--max-document-bytes", b'{"rrcache_session": 1, '),
+    "profile.json": ("p/profile.json", ["report", "p"], "--max-document-bytes", b'{"shader": "scene.frag", '),
 }
 
 
@@ -137,7 +137,7 @@ def test_sparse_100_gb_file_is_refused_before_reading(tmp_path, stability_case, 
     code, _, lines, peak, _ = rrcache_traced(tmp_path, *args, timeout=120)
     line = one_error_line(code, lines)
     case.observe(exit=code, stderr=line.replace(str(tmp_path), "TMP"), peak_mib=round(peak))
-    assert option in line and "107,374,182,400" in line and peak < PEAK_MIB, (line, peak)
+    assert option in line and "107,374,182,400" in line and peak < REFUSAL_PEAK_MIB, (line, peak)
 
 
 MESHES = {
@@ -165,7 +165,7 @@ def test_mesh_headers_and_vertices(tmp_path, stability_case, name):
     code, _, lines, peak, _ = rrcache_traced(tmp_path, "render", "scene.frag", "scene.json", "--frames", "1")
     line = one_error_line(code, lines)
     case.observe(exit=code, stderr=line.replace(str(tmp_path), "TMP"), peak_mib=round(peak))
-    assert expected in line and "objects[0].mesh" in line and peak < PEAK_MIB
+    assert expected in line and "objects[0].mesh" in line and peak < REFUSAL_PEAK_MIB
 
 
 def test_nul_in_a_texture_path(tmp_path, stability_case):
@@ -173,8 +173,8 @@ def test_nul_in_a_texture_path(tmp_path, stability_case):
     code, _, lines, peak, _ = rrcache_traced(tmp_path, "render", "scene.frag", "scene.json", "--frames", "1")
     line = one_error_line(code, lines)
     stability_case("NUL in a texture path", AREA, '"textures": {"u_t": "a\\u0000b.png"}').observe(
-        exit=code, stderr=line.replace(str(tmp_path), "TMP"))
-    assert "NUL" in line and "textures.u_t" in line and "\x00" not in line
+        exit=code, stderr=line.replace(str(tmp_path), "TMP"), peak_mib=round(peak))
+    assert "NUL" in line and "textures.u_t" in line and "\x00" not in line and peak < REFUSAL_PEAK_MIB
 
 
 #: writes a huge session in a process of its own (this test process stays small: a child's peak
@@ -211,7 +211,7 @@ def test_huge_schema_valid_sessions_are_refused_by_a_budget(tmp_path, stability_
                                              timeout=120)
     line = one_error_line(code, lines)
     case.observe(exit=code, stderr=line.replace(str(tmp_path), "TMP"), peak_mib=round(peak), json_bytes=size)
-    assert option in line and peak < PEAK_MIB, (line, peak)
+    assert option in line and peak < REFUSAL_PEAK_MIB, (line, peak)
 
 
 def test_a_session_just_inside_the_budgets_loads(tmp_path):
@@ -394,12 +394,12 @@ def test_a_tampered_profile_reads_nothing_it_names(made_profile, tmp_path, stabi
     doc[key] = str(tmp_path / target)
     (case_dir / "p" / "profile.json").write_text(json.dumps(doc))
     args = [command, "p"] + (["--nodes", "n1"] if command == "accuracy" else [])
-    code, out, lines, _, opened = rrcache_traced(case_dir, *args, timeout=300)
+    code, out, lines, peak, opened = rrcache_traced(case_dir, *args, timeout=300)
     text = out + "\n".join(lines) + "".join(p.read_text(errors="replace") for p in case_dir.rglob("*.html"))
     stability_case(f"tampered profile.json: {name} ({command})", AREA,
                    f"profile.json's {key!r} -> {target}; rrcache {' '.join(args)}").observe(
-        exit=code, stderr=" | ".join(lines).replace(str(tmp_path), "TMP"))
-    assert SECRET not in text
+        exit=code, stderr=" | ".join(lines).replace(str(tmp_path), "TMP"), peak_mib=round(peak))
+    assert SECRET not in text and peak < RUN_PEAK_MIB
     assert code in (0, 2)
     if code == 2:
         one_error_line(code, lines)

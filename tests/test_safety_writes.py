@@ -19,16 +19,17 @@ import pytest
 
 from rrcache.atomic import OutputFolder, write_text
 from rrcache.errors import RRCacheError
-from safety_cli import QUICK_PROFILE, made_profile, one_error_line, rrcache, tree  # noqa: F401 (a fixture)
+from safety_cli import (QUICK_PROFILE, REFUSAL_PEAK_MIB, RUN_PEAK_MIB, made_profile, one_error_line,  # noqa: F401
+                        rrcache_traced, tree)
 
 AREA = "safety: the one rule for writing"
 
 
-def _device(path) -> bool:
-    """A private character device node with /dev/null's numbers (1, 3), made here; False
-    without the privilege."""
+def _device(path, minor: int = 3) -> bool:
+    """A private character device node with the numbers (1, ``minor``) of /dev/null (3) or
+    /dev/full (7), made here; False without the privilege."""
     try:
-        os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+        os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, minor))
         return True
     except (PermissionError, OSError):
         return False
@@ -150,21 +151,23 @@ def test_report_out_to_a_private_device_fifo_or_folder(case, stability_case):
     (folder / "dir.html").mkdir()
     if _device(folder / "null"):
         targets["null"] = "character device"
-    if _device(folder / "full"):
+    if _device(folder / "full", 7):
         os.chmod(folder / "full", 0o666)
         targets["full"] = "character device"
     tc = stability_case("report --out a device, a FIFO, a folder", AREA,
-                        "rrcache report P --out X, X a private mknod(1,3) node, a FIFO, a folder")
-    seen = {}
+                        "rrcache report P --out X, X a private mknod(1,3) or (1,7) node, a FIFO, a folder")
+    seen, peaks = {}, []
     for name, kind in targets.items():
         before = os.lstat(folder / name)
-        code, _, lines = rrcache(folder, "report", "p", "--out", name, timeout=120)
+        code, _, lines, peak, _ = rrcache_traced(folder, "report", "p", "--out", name, timeout=120)
         line = one_error_line(code, lines)
         after = os.lstat(folder / name)
         assert (after.st_mode, after.st_ino, after.st_rdev) == (before.st_mode, before.st_ino, before.st_rdev)
         assert kind in line and name in line, line
         seen[name] = line.replace(str(folder), "TMP")
-    tc.observe(**seen)
+        peaks.append(round(peak))
+    tc.observe(**seen, peak_mib=max(peaks))
+    assert max(peaks) < REFUSAL_PEAK_MIB, peaks
 
 
 @pytest.mark.parametrize("name", ["optimized", "optimized/e1", "profile.lock", "profile.sqlite",
@@ -187,10 +190,16 @@ def test_links_inside_a_profile_folder_send_no_write_outside(case, stability_cas
     contents = {p: open(p, "rb").read() for p in before}
     tc = stability_case(f"a link inside the profile folder: {name}", AREA,
                         f"p/{name} -> outside; rrcache profile --out p again, then rrcache report p")
-    code, _, lines = rrcache(folder, "profile", "scene.frag", "scene.json", "--out", "p", *QUICK_PROFILE)
+    code, _, lines, peak, _ = rrcache_traced(folder, "profile", "scene.frag", "scene.json", "--out", "p",
+                                             *QUICK_PROFILE)
     line = one_error_line(code, lines)
-    report, _, report_lines = rrcache(folder, "report", "p", timeout=120)
+    report, _, report_lines, report_peak, _ = rrcache_traced(folder, "report", "p", timeout=120)
     assert tree(outside) == before and {p: open(p, "rb").read() for p in before} == contents
     assert os.path.islink(link)
     assert "symbolic link" in line and name.split("/")[-1] in line, line
-    tc.observe(exit=code, stderr=line.replace(str(folder), "TMP"), report_exit=report)
+    assert report in (0, 2), report_lines
+    if report == 2:
+        one_error_line(report, report_lines)
+    tc.observe(exit=code, stderr=line.replace(str(folder), "TMP"), report_exit=report, peak_mib=round(peak),
+               report_peak_mib=round(report_peak))
+    assert max(peak, report_peak) < RUN_PEAK_MIB, (peak, report_peak)

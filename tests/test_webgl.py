@@ -133,6 +133,14 @@ def test_page_draws_what_the_harness_draws_with_textures(browser, tmp_path, caps
     assert _psnr(_harness_image(shader, session, size, 2), frames[2][0]) >= 30.0
     assert all(np.abs(o.astype(int) - c.astype(int)).max() <= 2 for o, c in frames)
     assert browser.errors() == [] and browser.requests() == []
+    # each label over its half of a canvas narrower than the page (the labels spread over the
+    # page's width before)
+    left = browser.evaluate("[document.getElementById('view').getBoundingClientRect()]"
+                            ".concat([...document.querySelectorAll('.labels span')].map(s => s.getBoundingClientRect()))"
+                            ".map(r => [r.left, r.width])")
+    (canvas_left, canvas_width), (original_left, _), (cached_left, _) = left
+    assert canvas_width == 160 and original_left == canvas_left
+    assert abs(cached_left - (canvas_left + canvas_width / 2)) <= 1
 
 
 def test_page_caches_at_a_longer_period(browser, tmp_path, capsys):

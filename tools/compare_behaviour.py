@@ -31,6 +31,11 @@ and counters left out), the files of ``optimized/`` and ``rrcache select --json`
 
 ``compare`` prints one line per dumped item (``same``/``DIFF``, with the first differing keys) and
 exits 1 when any differ. Use it to check that a refactoring changes no output.
+
+Every run of a ``ROOT`` is ``python -P`` (from Python 3.11): neither the current folder (``-m``) nor the
+driver's folder is put before ``PYTHONPATH``, so a run from inside a checkout cannot import that
+checkout for both sides; the driver (and make-profile, beforehand) exits 2 when the ``rrcache`` it
+imported is not ``ROOT``'s.
 """
 from __future__ import annotations
 
@@ -63,6 +68,11 @@ VOLATILE = {"run_wall_s", "precompute_s", "invocations", "counts", "training_wal
 _DRIVER = r'''
 import contextlib, io, json, os, sys, tempfile, traceback
 from pathlib import Path
+import rrcache
+_job = json.loads(sys.argv[1])
+if not os.path.realpath(rrcache.__file__).startswith(os.path.join(os.path.realpath(_job["root"]), "rrcache", "")):
+    print(f"{_job['root']}: imported rrcache from {rrcache.__file__}, not from this root", file=sys.stderr)
+    sys.exit(2)
 from rrcache.cli import cli
 
 def run(args):
@@ -191,7 +201,7 @@ def dump_training(scenes):
     return out
 
 if __name__ == "__main__":
-    job = json.loads(sys.argv[1])
+    job = _job
     out = Path(job["out"])
     out.mkdir(parents=True, exist_ok=True)
     for shader, session in job["shaders"]:
@@ -218,15 +228,35 @@ def _shaders(inputs: Path) -> list[tuple[str, str]]:
     return out
 
 
+def _python(root: str) -> tuple[list[str], dict]:
+    """The interpreter's command line and environment that import ``root``'s rrcache only."""
+    safe = ["-P"] if sys.version_info >= (3, 11) else []
+    return [sys.executable, *safe], dict(os.environ, PYTHONPATH=os.path.abspath(root))
+
+
+def _imports_its_own(root: str, cwd: Path) -> bool:
+    """Whether ``python -m rrcache`` started in ``cwd`` imports ``root``'s rrcache (``-c`` puts the
+    current folder first as ``-m`` does)."""
+    python, env = _python(root)
+    p = subprocess.run([*python, "-c", "import os, rrcache; print(os.path.realpath(rrcache.__file__))"],
+                       capture_output=True, text=True, env=env, cwd=cwd)
+    if p.stdout.strip().startswith(os.path.join(os.path.realpath(root), "rrcache", "")):
+        return True
+    print(f"{root}: run from {cwd}, rrcache is imported from {p.stdout.strip() or p.stderr.strip()}, "
+          "not from this root", file=sys.stderr)
+    return False
+
+
 def _run_driver(root: str, inputs: Path, job: dict) -> int:
-    env = dict(os.environ, PYTHONPATH=os.path.abspath(root))
-    with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
-        f.write(_DRIVER)
-        driver = f.name
+    python, env = _python(root)
+    folder = tempfile.mkdtemp(prefix="rrcache-driver-")
+    driver = Path(folder) / "driver.py"
+    driver.write_text(_DRIVER)
     try:
-        return subprocess.run([sys.executable, driver, json.dumps(job)], cwd=inputs, env=env).returncode
+        return subprocess.run([*python, str(driver), json.dumps(dict(job, root=os.path.abspath(root)))],
+                              cwd=inputs, env=env).returncode
     finally:
-        os.unlink(driver)
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 #: the amortization tests' scene (tests/test_profile_amortize.py at 14ed2e0): a soft light summed
@@ -264,8 +294,10 @@ def dump(root: str, out: str, inputs: str = ".", profile: str | None = None, qui
 
 def make_profile(root: str, out: str, inputs: str = ".") -> int:
     """Profile the demo scene with ``ROOT``'s rrcache into ``OUT`` (measured: run it once)."""
-    env = dict(os.environ, PYTHONPATH=os.path.abspath(root))
-    return subprocess.run([sys.executable, "-m", "rrcache", "profile", DEMO_SHADER, DEMO_SESSION, *DEMO_ARGS,
+    if not _imports_its_own(root, Path(inputs).resolve()):
+        return 2
+    python, env = _python(root)
+    return subprocess.run([*python, "-m", "rrcache", "profile", DEMO_SHADER, DEMO_SESSION, *DEMO_ARGS,
                            "--out", os.path.abspath(out)], cwd=Path(inputs).resolve(), env=env).returncode
 
 

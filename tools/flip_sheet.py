@@ -101,6 +101,12 @@ def sheet(rows: list[dict], out: Path, threshold: float) -> list[dict]:
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=80)
     plt.close(fig)
+    # a 256-colour palette (no dithering) keeps a four-row sheet near 250 KB for docs/
+    from PIL import Image
+
+    with Image.open(out) as image:
+        small = image.convert("RGB").quantize(256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    small.save(out, optimize=True)
     return rows
 
 
@@ -111,14 +117,40 @@ def main(argv=None) -> int:
     parser.add_argument("profiles", nargs="+", type=Path)
     parser.add_argument("--out", type=Path, default=Path("docs/levels_flip_threshold.png"))
     parser.add_argument("--json", type=Path, default=None, help="write every validated choice's figures here")
+    parser.add_argument("--no-sheet", action="store_true", help="only the table: render no images")
     args = parser.parse_args(argv)
-    rows = validated(args.profiles)
-    picked = sheet(nearest(rows, VISIBLE_FLIP), args.out, VISIBLE_FLIP)
+    done = [p for p in args.profiles if (p / "profile.json").is_file()]
+    for p in args.profiles:
+        if p not in done:
+            print(f"note: {p}: skipped, no profile.json yet (still running, or interrupted)", file=sys.stderr)
+    rows = validated(done)
+    picked = nearest(rows, VISIBLE_FLIP)
+    if not args.no_sheet:
+        picked = sheet(picked, args.out, VISIBLE_FLIP)
     if args.json is not None:
         args.json.write_text(json.dumps({"threshold": VISIBLE_FLIP, "validated": rows, "shown": picked}, indent=1))
-    for r in sorted(rows, key=lambda r: r["flip"]):
-        print(f"{r['flip']:.4f}  {r['psnr']:5.1f} dB  {r['scene']:>16} {r['choice']}  {r['run']}")
+    print(markdown(rows, picked))
     return 0
+
+
+def markdown(rows: list[dict], picked: list[dict]) -> str:
+    """Every validated choice, lowest mean FLIP first, as a Markdown table (PSNR and FLIP side
+    by side, each with its uncertainty); the ones the sheet shows marked."""
+    def pm(value, u, fmt):
+        return "–" if value is None else fmt.format(value) + ("" if not u else " ± " + fmt.format(u))
+
+    shown = {(r["profile"], r["key"]) for r in picked}
+    lines = ["| scene | run | level | choice | PSNR dB (predicted) | mean FLIP | temporal PSNR dB | speed-up | "
+             "in the sheet |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in sorted(rows, key=lambda r: r["flip"]):
+        psnr = pm(r["psnr"], r["psnr_uncertainty"], "{:.1f}") + (
+            "" if r["predicted_psnr"] is None else f" ({r['predicted_psnr']:.1f})")
+        lines.append(f"| {r['scene']} | {r['run']} | {r['label']} | {r['choice']} | {psnr} | "
+                     f"{pm(r['flip'], r['flip_uncertainty'], '{:.3f}')}{' (visible)' if r['visible'] else ''} | "
+                     f"{'–' if r['temporal_psnr'] is None else format(r['temporal_psnr'], '.1f')} | "
+                     f"{'–' if r['speedup'] is None else format(r['speedup'], '.2f') + '×'} | "
+                     f"{'yes' if (r['profile'], r['key']) in shown else ''} |")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@ on the bench scenes with its contact sheet and per-stage times, what a scattered
 costs llvmpipe, and the tiled against the untiled z-buffer.
 
     python -m rrcache.bench.render_cache equal-time --choice marble=n2442:50 --out OUT
+    python -m rrcache.bench.render_cache equal-time --bench BENCH_OUT --scene marble --out OUT
     python -m rrcache.bench.render_cache mask --scene marble --out OUT
     python -m rrcache.bench.render_cache zbuffer --scene marble --out OUT
     python -m rrcache.bench.render_cache sweep --scene marble --config block=1 --config block=2 --out OUT
@@ -10,8 +11,9 @@ costs llvmpipe, and the tiled against the untiled z-buffer.
     python -m rrcache.bench.render_cache filters --scene marble --out OUT
 
 ``equal-time``: per scene, the reprojection cache's choice (``--choice NAME=NODE:PERIOD[+NODE:PERIOD]
-[@ALGORITHM]``: a bench profile's medium selection, e.g. from ``rrcache bench``'s table) measured
-beside the original over the scene's frames; dynamic resolution and the render cache tuned to
+[@ALGORITHM]``: a bench profile's medium selection, e.g. from ``rrcache bench``'s table; or
+``--bench BENCH_OUT --scene NAME``: the medium selection that run measured, compiled as it
+compiled it, with its profile's filter) measured beside the original over the scene's frames; dynamic resolution and the render cache tuned to
 its measured speed-up over the first ``--search-frames`` frames and measured beside the original
 over the same frames (:func:`rrcache.bench.paper.dynres_row`,
 :func:`rrcache.bench.paper.render_cache_row`, as ``rrcache bench`` does); one frame of each
@@ -148,18 +150,96 @@ def _load() -> str:
         return "unknown"
 
 
-def equal_time(scene, choice: Choice, out, search_frames: int = 24, sheet_frame: Optional[int] = None,
-               progress=print) -> tuple[SceneComparison, dict]:
-    """The equal-time comparison of one scene (see the module docstring); returns it and the
-    sheet frame's images (method → H×W×4)."""
-    from rrcache.bench.paper import BenchSettings, MethodRow, dynres_row, render_cache_row
-    from rrcache.harness.cached import compare
+@dataclass
+class _Cached:
+    """What the reprojection cache runs in an equal-time comparison: the session and work it
+    renders, its compiled variant and period(s), its description, the cached nodes' texts and the
+    cache's run-time options."""
+
+    session: object
+    work: object
+    variant: object
+    period: object
+    describe: str
+    texts: list
+    options: dict = field(default_factory=dict)
+
+
+def _from_choice(scene, choice: Choice, out) -> _Cached:
+    """The reprojection cache of ``--choice``: compiled with the default cache filter."""
     from rrcache.pipeline import load_for_session, variant_for, variant_for_nodes
     from rrcache.session import load_session
 
-    started = time.time()
     session = load_session(_sizes(scene, out))
     work = load_for_session(scene.shader, session)
+    texts = [work.node(n).text for n in choice.nodes]
+    if len(choice.nodes) == 1:
+        variant, period = variant_for(work, choice.nodes[0], choice.algorithm), choice.periods[0]
+    else:
+        variant, period = variant_for_nodes(work, choice.nodes, choice.algorithm), tuple(choice.periods)
+    return _Cached(session, work, variant, period, choice.describe(), texts)
+
+
+def _from_bench(bench_out, scene) -> _Cached:
+    """The medium selection ``rrcache bench`` measured for scene ``name`` (``BENCH_OUT/bench.json``),
+    compiled as the bench compiled it: over the session it ran (chess: its smaller copy), with the
+    scene profile's cache filter, term order and cache options."""
+    from rrcache.bench.paper_size import _selection
+    from rrcache.files import read_bytes
+    from rrcache.pipeline import load_for_session, variant_for_selection
+    from rrcache.profiles import load_profile
+    from rrcache.session import load_session
+
+    bench_out = Path(bench_out)
+    doc = json.loads(read_bytes(bench_out / "bench.json", None))
+    name = scene.name
+    record = next((s for s in doc.get("scenes", []) if s.get("name") == name), None)
+    if record is None:
+        raise RRCacheError(f"no scene {name!r} in the bench's results (yet)", str(bench_out / "bench.json"),
+                           hint="wait until rrcache bench has finished the scene, or give --choice")
+    medium = record.get("medium")
+    sel_doc = next((s for s in record.get("selections", []) if medium and s.get("label") == medium), None)
+    if sel_doc is None or not sel_doc.get("parts"):
+        raise RRCacheError(f"scene {name!r} has no medium selection that caches something",
+                           str(bench_out / "bench.json"), hint="give --choice NAME=NODE:PERIOD instead")
+    prof = load_profile(_bench_path(bench_out, record["profile"]))
+    session = load_session(_bench_path(bench_out, record["session"], scene.session))
+    shader = _bench_path(bench_out, record["shader"], scene.shader)
+    work = load_for_session(shader, session, term_scores=prof.term_scores)
+    work.filter = prof.filter
+    sel = _selection(sel_doc)
+    variant, period = variant_for_selection(work, sel)
+    texts = [work.node(n).text for n in sel.nodes]
+    measured = sel_doc.get("measured_speedup")
+    describe = (f"{medium}: {sel.describe()}, {sel.algorithm or 'three-pass'}, {prof.filter} filter"
+                + (f" (the bench measured {measured:.2f}×)" if measured else ""))
+    return _Cached(session, work, variant, period, describe, texts, dict(prof.settings.cache_options()))
+
+
+def _bench_path(bench_out: Path, text: str, fallback=None) -> str:
+    """A file the bench recorded (``text``: as it wrote it, maybe relative to where it ran): as
+    written when it exists, else the same name in ``bench_out`` (a profile) or
+    ``bench_out/sessions`` (a session it scaled), else ``fallback`` (the scene's own file)."""
+    path = Path(text)
+    if path.exists():
+        return str(path)
+    inside = bench_out / path.name if path.suffix == ".rrprofile" else bench_out / "sessions" / path.name
+    if inside.exists() or fallback is None:
+        return str(inside)
+    return str(fallback)
+
+
+def equal_time(scene, choice, out, search_frames: int = 24, sheet_frame: Optional[int] = None,
+               progress=print) -> tuple[SceneComparison, dict]:
+    """The equal-time comparison of one scene (see the module docstring); ``choice``: a
+    :class:`Choice`, or the folder of an ``rrcache bench`` run whose medium selection of the scene
+    is measured. Returns it and the sheet frame's images (method → H×W×4)."""
+    from rrcache.bench.paper import BenchSettings, MethodRow, dynres_row, render_cache_row
+    from rrcache.harness.cached import compare
+
+    started = time.time()
+    cached_setup = _from_choice(scene, choice, out) if isinstance(choice, Choice) else _from_bench(choice, scene)
+    session, work = cached_setup.session, cached_setup.work
     frames = list(range(session.frames))
     keep = frames[len(frames) // 2] if sheet_frame is None else min(int(sheet_frame), frames[-1])
     images: dict = {}
@@ -172,19 +252,16 @@ def equal_time(scene, choice: Choice, out, search_frames: int = 24, sheet_frame:
                 result.sheet[method] = (float(row.mean_error), float(row.psnr))
         return on_frame
 
-    texts = [work.node(n).text for n in choice.nodes]
-    if len(choice.nodes) == 1:
-        variant, period = variant_for(work, choice.nodes[0], choice.algorithm), choice.periods[0]
-    else:
-        variant, period = variant_for_nodes(work, choice.nodes, choice.algorithm), tuple(choice.periods)
-    result = SceneComparison(scene.name, tuple(session.resolution), len(frames), choice.describe(), texts, 0.0,
-                             sheet_frame=keep, load=_load())
-    progress(f"{scene.name}: reprojection cache {choice.describe()}")
-    cached = compare(variant, session, work.prepared, frames, period=period, on_frame=capture("reprojection cache"))
+    result = SceneComparison(scene.name, tuple(session.resolution), len(frames), cached_setup.describe,
+                             cached_setup.texts, 0.0, sheet_frame=keep, load=_load())
+    progress(f"{scene.name}: reprojection cache {cached_setup.describe}")
+    cached = compare(cached_setup.variant, session, work.prepared, frames, period=cached_setup.period,
+                     on_frame=capture("reprojection cache"), **cached_setup.options)
     target = cached.speedup
     result.target_speedup = target
-    result.rows.append(MethodRow("reprojection cache (ours)", choice.describe(), cached.speedup, cached.mean_error,
-                                 min(cached.psnr, 100.0), cached.ms_per_frame, cached.original_ms_per_frame, True))
+    result.rows.append(MethodRow("reprojection cache (ours)", cached_setup.describe, cached.speedup,
+                                 cached.mean_error, min(cached.psnr, 100.0), cached.ms_per_frame,
+                                 cached.original_ms_per_frame, True))
     settings = BenchSettings(search_frames=search_frames)
     search = frames[:search_frames]
     say = lambda stage, done=None, total=None: progress(f"{scene.name}: {stage}")  # noqa: E731
@@ -667,8 +744,12 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m rrcache.bench.render_cache", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="what", required=True)
     eq = sub.add_parser("equal-time", help="the equal-time table, per-stage times and contact sheet")
-    eq.add_argument("--choice", action="append", required=True, metavar="NAME=NODE:PERIOD",
+    eq.add_argument("--choice", action="append", default=[], metavar="NAME=NODE:PERIOD",
                     help="a scene (a bench name or SHADER:SESSION) and the reprojection cache's choice for it")
+    eq.add_argument("--bench", metavar="BENCH_OUT", default=None,
+                    help="an rrcache bench output folder: measure its medium selection of each --scene")
+    eq.add_argument("--scene", action="append", default=[], metavar="NAME",
+                    help="with --bench: a scene of the bench's results (repeat for several)")
     eq.add_argument("--search-frames", type=int, default=24)
     eq.add_argument("--sheet-frame", type=int, default=None)
     eq.add_argument("--out", required=True)
@@ -684,12 +765,20 @@ def main(argv=None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     if args.what == "equal-time":
+        if not args.choice and not (args.bench and args.scene):
+            parser.error("give --choice NAME=NODE:PERIOD, or --bench BENCH_OUT with --scene NAME")
+        if args.scene and not args.bench:
+            parser.error("--scene takes --bench BENCH_OUT")
+        jobs = []
         for item in args.choice:
             name, sep, spec = item.partition("=")
             if not sep:
                 parser.error(f"--choice {item!r}: give NAME=NODE:PERIOD")
+            jobs.append((name, Choice.parse(spec)))
+        jobs += [(name, Path(args.bench)) for name in args.scene]
+        for name, choice in jobs:
             (scene,) = resolve_scenes(name)
-            result, shots = equal_time(scene, Choice.parse(spec), out, args.search_frames, args.sheet_frame)
+            result, shots = equal_time(scene, choice, out, args.search_frames, args.sheet_frame)
             _write(out, result, shots)
             print(f"{result.name}: done in {result.wall_s:.0f} s; {out / 'equal_time.md'} updated", flush=True)
         return 0

@@ -75,7 +75,7 @@ def rows(folders: Iterable) -> list[dict]:
                 predicted_psnr=sel.predicted_psnr, fallback=sel.fallback,
                 cls="original" if not sel.parts else classify(speedups, exact_original=False),
                 ceiling=(profile.ceiling or {}).get("speedup"), tries=int(sel.tries or (1 if sel.parts else 0)),
-                met=met, psnr_uncertainty=sel.measured_psnr_uncertainty, flip=sel.measured_flip,
+                met=met, status=_status(sel, met), psnr_uncertainty=sel.measured_psnr_uncertainty, flip=sel.measured_flip,
                 visible=bool(sel.visible_artifacts), temporal_psnr=sel.measured_temporal_psnr))
     return out
 
@@ -93,6 +93,24 @@ def _met(sel) -> str:
         return "met"
     psnr = sel.measured_psnr if sel.measured_psnr is not None else float("inf")
     return "met" if psnr + float(sel.measured_psnr_uncertainty or 0.0) >= sel.min_psnr else "below"
+
+
+def _status(sel, met: str) -> str:
+    """The row's word on its level, as the profile table says it (``met``, ``met, try 2``,
+    ``original (2 tried)``), or ``below: <why>`` for a selection shipped below its level (a
+    profile whose validation did not enforce the level: its note, else the measured PSNR)."""
+    if met == "below":
+        why = sel.level_note or (f"measured {sel.measured_psnr:.1f}"
+                                 + (f" ± {sel.measured_psnr_uncertainty:.1f}" if sel.measured_psnr_uncertainty else "")
+                                 + f" dB, below the level {sel.min_psnr:g} dB" if sel.min_psnr is not None
+                                 and sel.measured_psnr is not None else "measured above its error level")
+        return f"below: {why}"
+    if met != "met":
+        return met
+    tries = int(sel.tries or 0)
+    if not sel.parts:
+        return f"original ({tries} tried)" if tries else ("original" if sel.fallback else "met")
+    return f"met, try {tries}" if tries > 1 else "met"
 
 
 def predictions(folders: Iterable) -> list[dict]:
@@ -161,14 +179,26 @@ def markdown(table: list[dict]) -> str:
         flip = "0" if r["kind"] == "original" or r.get("exact") else (
             "–" if r.get("flip") is None else f"{r['flip']:.3f}" + (" (visible)" if r.get("visible") else ""))
         lines.append(f"| {r['scene']} | {r['run']} | {level} | {cached} | {_x(r['predicted_speedup'])} | "
-                     f"{measured} | {psnr} | {flip} | {r.get('met', '–')} | {r.get('tries', '–')} | {r['cls']} |")
+                     f"{measured} | {psnr} | {flip} | {r.get('status', r.get('met', '–'))} | {r.get('tries', '–')} | {r['cls']} |")
     bad = slowdowns(table)
+    later = sum(1 for r in table if _needed_second(r) and r["kind"] != "original")
+    kept = sum(1 for r in table if _needed_second(r) and r["kind"] == "original")
+    unmeasured = sum(1 for r in table if r["kind"] == "original" and not r.get("tries") and r.get("fallback"))
     lines.append("")
     lines.append(f"{len(table)} shipped selections in {len({(r['scene'], r['run']) for r in table})} profiles; "
                  f"{len(bad)} measured slower than the original in every repeat; "
                  f"{sum(1 for r in table if r.get('met') == 'below')} shipped below their level; "
-                 f"{sum(1 for r in table if (r.get('tries') or 0) > 1)} levels needed a second candidate.")
+                 f"{later + kept} levels needed a second candidate ({later} stood with a later candidate, "
+                 f"{kept} kept the original after its candidates were refused); {unmeasured} kept the original "
+                 "with no candidate measured for it (its fallback says why).")
     return "\n".join(lines)
+
+
+def _needed_second(row: dict) -> bool:
+    """Whether the row's level measured its first candidate and refused it: a later candidate
+    stood (tries > 1), or the original stands after a candidate was tried."""
+    tries = row.get("tries") or 0
+    return tries > 1 or (row["kind"] == "original" and tries > 0)
 
 
 def summary_markdown(table: list[dict]) -> str:
@@ -194,7 +224,36 @@ def summary_markdown(table: list[dict]) -> str:
         lines.append(f"| {scene} | {label} | {len(rs)} | {shipped} | {speed} | "
                      f"{'–' if not lows else f'{min(lows):.2f}×'} | {psnr} | "
                      f"{sum(1 for r in rs if r.get('met') == 'met')}/{len(rs)} | "
-                     f"{sum(1 for r in rs if r.get('fallback'))} | {sum(1 for r in rs if (r.get('tries') or 0) > 1)} |")
+                     f"{sum(1 for r in rs if r.get('fallback'))} | {sum(1 for r in rs if _needed_second(r))} |")
+    return "\n".join(lines)
+
+
+def scenes_markdown(table: list[dict]) -> str:
+    """One line per scene, one column per level (the README's table): each run's shipped
+    selection as measured (PSNR ± its uncertainty, speed-up, mean FLIP) and how its level stood
+    (``met``, ``met, try 2``, ``original (N tried)``, ``below: …``); runs of a scene separated by
+    ``;``."""
+    levels: dict = {}
+    scenes: dict = {}
+    for r in table:
+        levels.setdefault(r["level"], r.get("min_psnr"))
+        scenes.setdefault(r["scene"], {}).setdefault(r["level"], []).append(r)
+
+    def cell(r) -> str:
+        status = r.get("status") or r.get("met", "–")
+        if r["kind"] == "original" or r.get("exact"):
+            return status if status.startswith("original") else "original"
+        psnr = "–" if r["psnr"] is None else f"{r['psnr']:.1f}" + (
+            f" ± {r['psnr_uncertainty']:.1f}" if r.get("psnr_uncertainty") else "")
+        flip = "" if r.get("flip") is None else f", FLIP {r['flip']:.3f}"
+        return f"{psnr} dB, {_x(r['speedup'])}{flip}: " + ("BELOW the level" if status.startswith("below") else status)
+
+    names = list(levels)
+    lines = ["| scene | " + " | ".join(n + (f" ≥ {levels[n]:g} dB" if levels[n] else "") for n in names) + " |",
+             "|---|" + "---|" * len(names)]
+    for scene, by_level in scenes.items():
+        lines.append(f"| {scene} | " + " | ".join("; ".join(cell(r) for r in by_level.get(n, [])) or "–"
+                                               for n in names) + " |")
     return "\n".join(lines)
 
 

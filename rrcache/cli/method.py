@@ -18,14 +18,12 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import click
 from rich.console import Console
 
-from rrcache.cli.repeats import run_repeats
+from rrcache.cli.repeats import frames_and_folder, run_repeats
 from rrcache.cli.tables import TextTable
-from rrcache.harness.renderer import frame_indices
 from rrcache.harness.timing import load_warning
 from rrcache.jsonable import finite_json
 
@@ -65,16 +63,10 @@ def render_cache(source, loaded, samples, out_dir, frame_count, resolution, as_j
     """The render cache at ``samples`` beside the original: table and summary (or JSON)."""
     from rrcache.alternatives.render_cache import RenderCacheSettings
     from rrcache.alternatives.render_cache.tune import compare
-    from rrcache.compiler.prepared import prepare_file
-    from rrcache.pipeline import all_include_dirs
 
     settings = RenderCacheSettings(samples=DEFAULT_SAMPLES if samples is None else samples).checked()
-    prepared = prepare_file(source.shader, loaded, source.defines, all_include_dirs(source.include_dirs, loaded),
-                            vertex=source.vertex)
-    indices = frame_indices(loaded, frame_count)
-    out = Path(out_dir) if out_dir else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+    prepared = source.prepare(loaded)
+    indices, out = frames_and_folder(loaded, frame_count, out_dir)
     said = (f"{settings.describe().replace('render cache', 'render cache (Walter et al. 2002)', 1)}, a cache of "
             f"{settings.points_per_pixel:g}× the pixels in points, prediction {'on' if settings.predict else 'off'}")
     if not quiet:

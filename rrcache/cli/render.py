@@ -45,7 +45,6 @@ from __future__ import annotations
 import json
 import math
 from typing import Optional
-from pathlib import Path
 
 import click
 from rich.console import Console
@@ -57,17 +56,15 @@ from rrcache.cli.tables import TextTable
 from rrcache.gl.formats import COLOR_FORMATS, DEFAULT_TIMING_FORMAT, ERROR_FORMAT
 from rrcache.harness.timing import frame_noise, load_warning
 from rrcache.jsonable import finite_json
-from rrcache.pipeline import all_include_dirs
 from rrcache.harness.images import write_image
 from rrcache.harness.metrics import nonfinite_count
-from rrcache.compiler.prepared import prepare_file
-from rrcache.harness.renderer import frame_indices, render
+from rrcache.harness.renderer import render
 from rrcache.runtime import (ALGORITHMS, BLOCK_SIZES, DEFAULT_BLOCK, DEFAULT_DEPTH_EPSILON, DEFAULT_FILTER, DEFAULT_PERIOD,
                              DEFAULT_REFRESH, FILTERS, REFRESH_MODES)
 from rrcache.session import load_session
 from rrcache.cli.adaptive import adaptive_kwargs, adaptive_options, check_adaptive
 from rrcache.cli.method import check_method, method_option, render_cache, samples_option
-from rrcache.cli.repeats import run_repeats
+from rrcache.cli.repeats import frames_and_folder, run_repeats
 
 #: the options --level takes from the profile (parameter name -> option as typed)
 _LEVEL_OWNS = {"node": "--node", "period": "--period", "algorithm": "--algorithm", "block": "--block",
@@ -213,12 +210,8 @@ def command(ctx, shader, session, out_dir, frame_count, resolution, as_json, def
 
 def _replay(source, loaded, out_dir, frame_count, resolution, as_json, color_format, err_console, quiet) -> None:
     """The shader alone over the session: time and coverage per frame."""
-    prepared = prepare_file(source.shader, loaded, source.defines, all_include_dirs(source.include_dirs, loaded),
-                            vertex=source.vertex)
-    indices = frame_indices(loaded, frame_count)
-    out = Path(out_dir) if out_dir else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+    prepared = source.prepare(loaded)
+    indices, out = frames_and_folder(loaded, frame_count, out_dir)
 
     with Reporter(err_console, quiet=quiet or len(indices) < 2) as reporter:
         nonfinite = []
@@ -274,10 +267,7 @@ def _compare(work, loaded, variant, what: str, setup: dict, out_dir, frame_count
     (them in words) and, for a level, ``level`` and ``choice``."""
     from rrcache.harness.cached import compare
 
-    indices = frame_indices(loaded, frame_count)
-    out = Path(out_dir) if out_dir else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+    indices, out = frames_and_folder(loaded, frame_count, out_dir)
     if not quiet:
         err_console.print(f"{what}\n  with {setup['said']}; colour target {color_format}, {len(indices)} frames",
                           highlight=False, markup=False, soft_wrap=True)

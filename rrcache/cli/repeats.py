@@ -9,6 +9,16 @@ from typing import Callable, Optional
 
 from rrcache.cli.progress import Reporter
 from rrcache.harness.images import write_image
+from rrcache.harness.renderer import frame_indices
+
+
+def frames_and_folder(loaded, frame_count: Optional[int], out_dir) -> tuple[list, Optional[Path]]:
+    """The frames a render of the session ``loaded`` runs (its first ``frame_count``; None: all)
+    and its ``--out`` folder (made; None when not given)."""
+    out = Path(out_dir) if out_dir else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    return frame_indices(loaded, frame_count), out
 
 
 def run_repeats(compare: Callable, frames: int, repeats: int, out: Optional[Path], label: str, err_console,

@@ -30,6 +30,15 @@ class Source:
     include_dirs: tuple = ()
     vertex: Optional[str] = None
 
+    def prepare(self, loaded):
+        """The shader prepared for the loaded session ``loaded`` (with these defines, include
+        folders and vertex shader): :func:`rrcache.compiler.prepared.prepare_file`."""
+        from rrcache.compiler.prepared import prepare_file
+        from rrcache.pipeline import all_include_dirs
+
+        return prepare_file(self.shader, loaded, self.defines, all_include_dirs(self.include_dirs, loaded),
+                            vertex=self.vertex)
+
 
 def is_profile(path) -> bool:
     """Whether ``path`` is a profile folder (with ``profile.json``) or a ``profile.json``."""

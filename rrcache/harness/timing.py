@@ -41,6 +41,7 @@ True
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 import time
 from typing import ClassVar, Sequence
 
@@ -50,7 +51,7 @@ import numpy as np
 DEFAULT_CLOCK = "wall"
 
 
-class FrameClock:
+class FrameClock(ABC):
     """Times one frame (see the module docstring). Subclasses set :attr:`name` and implement
     :meth:`_begin` and :meth:`_end` (the frame's ms)."""
 
@@ -82,11 +83,13 @@ class FrameClock:
         self.ctx.finish()
         return time.perf_counter()
 
+    @abstractmethod
     def _begin(self) -> None:
-        raise NotImplementedError
+        """Start the frame's measurement (after :meth:`start`'s wall-clock mark)."""
 
+    @abstractmethod
     def _end(self) -> float:
-        raise NotImplementedError
+        """End it: the frame's ms."""
 
 
 class WallClock(FrameClock):

@@ -12,6 +12,7 @@ these methods.
 from __future__ import annotations
 
 import html
+from abc import ABC, abstractmethod
 from typing import ClassVar, Optional
 
 from rrcache.errors import RRCacheError
@@ -51,7 +52,7 @@ def id_of(data: dict, key: str, where: str, example: str) -> str:
     return value
 
 
-class Kind:
+class Kind(ABC):
     """One kind of choice (see the module docstring). Subclasses set the class attributes and
     override what differs; an instance is registered in :mod:`rrcache.kinds`."""
 
@@ -79,16 +80,16 @@ class Kind:
         exactly one part of :attr:`part`."""
         return self.part is not None and len(parts) == 1 and isinstance(parts[0], self.part)
 
+    @abstractmethod
     def spec(self, parts: tuple, algorithm: str, filter: Optional[str] = None, **runtime) -> VariantSpec:
         """The variant spec of ``parts`` run with ``algorithm``, the profile's cache ``filter`` where
         the kind caches nodes with it (None: the default; an amortized loop's part names its own),
         and the runtime's fields ``runtime`` (``block``, ``refresh``, ``depth_epsilon``)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def compile(self, work, spec: VariantSpec):
         """The compiled :class:`~rrcache.compiler.variant.Variant` of ``spec`` over ``work`` (a
         :class:`~rrcache.pipeline.ShaderWork`); :func:`rrcache.kinds.compile` caches it."""
-        raise NotImplementedError
 
     # ---------------------------------------------------------------- training and the store
     def training(self, subject, settings, algorithm: str, filter: str = DEFAULT_FILTER) -> list:

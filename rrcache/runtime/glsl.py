@@ -230,19 +230,24 @@ vec4 rr_planeTexels(vec2 p, float expected, vec2 dpx, vec2 dpy, vec2 de, float t
 }
 """
 
+#: the inputs of ``rr_planeTexels`` (statements of a function body): this fragment's place ``p``
+#: and inverse depth ``expected`` in the previous frame's texels, and their screen-space
+#: derivatives, taken in uniform control flow (shared with the miss classifier)
+PLANE_INPUTS = """    ivec2 size = textureSize(rr_prevInvDepth, 0);
+    vec2 p = (rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5) * vec2(size) - 0.5;
+    float expected = 1.0 / rr_prevClip.w;
+    vec2 dpx = dFdx(p);
+    vec2 dpy = dFdy(p);
+    vec2 de = vec2(dFdx(expected), dFdy(expected));
+"""
+
 _PLANE = PLANE_TEXELS + """
 vec4 rr_edgeWeights;
 ivec2 rr_edgeBase;
 bool rr_edgeFull;
 
 bool rr_hit() {
-    ivec2 size = textureSize(rr_prevInvDepth, 0);
-    vec2 p = (rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5) * vec2(size) - 0.5;
-    float expected = 1.0 / rr_prevClip.w;
-    vec2 dpx = dFdx(p);
-    vec2 dpy = dFdy(p);
-    vec2 de = vec2(dFdx(expected), dFdy(expected));
-    if (!rr_valid || rr_prevClip.w <= 0.0) return false;
+""" + PLANE_INPUTS + """    if (!rr_valid || rr_prevClip.w <= 0.0) return false;
     rr_uv = (p + 0.5) / vec2(size);
     if (any(lessThan(rr_uv, vec2(0.0))) || any(greaterThan(rr_uv, vec2(1.0)))) return false;
     vec4 weights;

@@ -41,6 +41,7 @@ import moderngl
 import numpy as np
 
 from rrcache.gl.window import crop_rows
+from rrcache.runtime.glsl import PLANE_INPUTS
 
 #: the causes, in order of precedence (a code's index + 1 in the classifier's output is its
 #: geometric code; refresh is decided from the hit map)
@@ -61,13 +62,7 @@ void main() {
     // this fragment's place and inverse depth in the previous frame's texels, and their
     // derivatives (taken here, in uniform control flow), to tell which texels hold this surface
     // (the plane filter's test, rrcache.runtime.glsl.PLANE_TEXELS)
-    ivec2 size = textureSize(rr_prevInvDepth, 0);
-    vec2 p = (rr_prevClip.xy / rr_prevClip.w * 0.5 + 0.5) * vec2(size) - 0.5;
-    float expected = 1.0 / rr_prevClip.w;
-    vec2 dpx = dFdx(p);
-    vec2 dpy = dFdy(p);
-    vec2 de = vec2(dFdx(expected), dFdy(expected));
-    bool hit = rr_hit();
+""" + PLANE_INPUTS + """    bool hit = rr_hit();
     if (!rr_valid) {
         code = 5.0;
     } else if (hit) {

@@ -25,7 +25,8 @@ header { background: #1d2330; color: #fff; padding: 14px 24px; }
 header h1 { margin: 0; font-size: 19px; }
 header p { margin: 4px 0 0; color: #c9cfdb; }
 main { padding: 12px 24px 32px; }
-.labels { display: flex; max-width: 1280px; }
+.pair { display: inline-block; max-width: 100%; }  /* as wide as the canvas: each label over its half */
+.labels { display: flex; }
 .labels span { flex: 1; font-weight: 600; color: #5d6678; }
 canvas { display: block; max-width: 100%; image-rendering: pixelated; background: #000; }
 #times { font-size: 16px; font-variant-numeric: tabular-nums; }
@@ -42,8 +43,8 @@ def page_html(title: str, subtitle: str, data: dict, explain: str) -> str:
             '<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<title>{e(title)}</title><style>{_CSS}</style></head><body>"
             f"<header><h1>{e(title)}</h1><p>{e(subtitle)}</p></header><main>"
-            '<div class="labels"><span>original</span><span>cached</span></div>'
-            '<canvas id="view" width="2" height="1"></canvas>'
+            '<div class="pair"><div class="labels"><span>original</span><span>cached</span></div>'
+            '<canvas id="view" width="2" height="1"></canvas></div>'
             '<p id="times">starting…</p>'
             '<p><button id="playpause">pause</button> refresh period Δn '
             '<input type="range" id="period" min="1" max="50"> <b id="periodText"></b> · <span id="frame"></span></p>'
