@@ -245,7 +245,7 @@ def scenes_markdown(table: list[dict]) -> str:
             return status if status.startswith("original") else "original"
         psnr = "–" if r["psnr"] is None else f"{r['psnr']:.1f}" + (
             f" ± {r['psnr_uncertainty']:.1f}" if r.get("psnr_uncertainty") else "")
-        flip = "" if r.get("flip") is None else f", FLIP {r['flip']:.3f}"
+        flip = "" if r.get("flip") is None else f", FLIP {r['flip']:.3f}" + (" (visible)" if r.get("visible") else "")
         return f"{psnr} dB, {_x(r['speedup'])}{flip}: " + ("BELOW the level" if status.startswith("below") else status)
 
     names = list(levels)
