@@ -51,9 +51,9 @@ def nearest(rows: list[dict], threshold: float, each: int = 2) -> list[dict]:
     return sorted(below + above, key=lambda r: r["flip"])
 
 
-def render_row(row: dict) -> tuple[np.ndarray, float, int]:
-    """(original | cached | FLIP map) of one validated choice at its shown frame, and the frame's
-    mean FLIP and index."""
+def render_row(row: dict, at: int = None) -> tuple[np.ndarray, float, int]:
+    """(original | cached | FLIP map) of one validated choice at its shown frame (``at``, else the
+    session's middle; at least two refresh periods in), and the frame's mean FLIP and index."""
     import flip_evaluator
 
     from rrcache.harness.cached import CachedRenderer
@@ -66,7 +66,8 @@ def render_row(row: dict) -> tuple[np.ndarray, float, int]:
     sel = next(s for s in list(prof.measured) + list(prof.selections) if json.dumps(s.key) == row["key"])
     work, session = load_work(prof)
     variant, period = variant_for_selection(work, sel.replace(algorithm=sel.algorithm or prof.algorithm))
-    frame = min(int(session.frames) - 1, max(int(session.frames) // 2, 2 * int(period or 1) + 2))
+    start = int(session.frames) // 2 if at is None else int(at)
+    frame = min(int(session.frames) - 1, max(start, 2 * int(period or 1) + 2))
     with CachedRenderer(variant, session, work.prepared, session.resolution, period=period,
                         **prof.settings.cache_options()) as cached, \
             Renderer(work.prepared, session, session.resolution) as original:
@@ -80,14 +81,15 @@ def render_row(row: dict) -> tuple[np.ndarray, float, int]:
     return np.concatenate([a, b, np.clip(fmap, 0, 1)], axis=1), float(mean), frame
 
 
-def sheet(rows: list[dict], out: Path, threshold: float) -> list[dict]:
-    """Write the rows' images as one PNG (each row labelled) and return the rows with their frame."""
+def sheet(rows: list[dict], out: Path, threshold: float, at: int = None) -> list[dict]:
+    """Write the rows' images as one PNG (each row labelled) and return the rows with their frame
+    (``at``: see :func:`render_row`)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    images = [render_row(r) for r in rows]
+    images = [render_row(r, at) for r in rows]
     fig, axes = plt.subplots(len(rows), 1, figsize=(12, 3.6 * len(rows)), squeeze=False)
     for ax, row, (image, frame_flip, frame) in zip(axes[:, 0], rows, images):
         ax.imshow(image, interpolation="nearest")
@@ -118,6 +120,9 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=Path("docs/levels_flip_threshold.png"))
     parser.add_argument("--json", type=Path, default=None, help="write every validated choice's figures here")
     parser.add_argument("--no-sheet", action="store_true", help="only the table: render no images")
+    parser.add_argument("--frame", type=int, default=None,
+                        help="the frame shown (at least two refresh periods in; default: the session's middle); "
+                             "an earlier one renders fewer frames of a costly shader")
     args = parser.parse_args(argv)
     done = [p for p in args.profiles if (p / "profile.json").is_file()]
     for p in args.profiles:
@@ -126,7 +131,7 @@ def main(argv=None) -> int:
     rows = validated(done)
     picked = nearest(rows, VISIBLE_FLIP)
     if not args.no_sheet:
-        picked = sheet(picked, args.out, VISIBLE_FLIP)
+        picked = sheet(picked, args.out, VISIBLE_FLIP, args.frame)
     if args.json is not None:
         args.json.write_text(json.dumps({"threshold": VISIBLE_FLIP, "validated": rows, "shown": picked}, indent=1))
     print(markdown(rows, picked))
