@@ -427,6 +427,8 @@ def test_the_equal_time_tool_writes_its_table_sheet_and_stages(gl_ctx, tmp_path)
     assert (tmp_path / "out" / "contact_sheet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(RRCacheError, match="not a choice"):
         bench.Choice.parse("n66")
+    with pytest.raises(RRCacheError, match="'blurry' is not a cache filter"):
+        bench.Choice.parse("n66:4@two-pass/blurry")
 
 
 def test_the_render_cache_is_a_registered_kind_that_is_never_compiled():

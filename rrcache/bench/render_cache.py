@@ -11,7 +11,7 @@ costs llvmpipe, and the tiled against the untiled z-buffer.
     python -m rrcache.bench.render_cache filters --scene marble --out OUT
 
 ``equal-time``: per scene, the reprojection cache's choice (``--choice NAME=NODE:PERIOD[+NODE:PERIOD]
-[@ALGORITHM]``: a bench profile's medium selection, e.g. from ``rrcache bench``'s table; or
+[@ALGORITHM[/FILTER]]``: a bench profile's medium selection, e.g. from ``rrcache bench``'s table; or
 ``--bench BENCH_OUT --scene NAME``: the medium selection that run measured, compiled as it
 compiled it, with its profile's filter) measured beside the original over the scene's frames; dynamic resolution and the render cache tuned to
 its measured speed-up over the first ``--search-frames`` frames and measured beside the original
@@ -73,32 +73,45 @@ SCENE_SIZES = {"chess": ((320, 240), 60)}
 
 @dataclass
 class Choice:
-    """The reprojection cache's choice for a scene: nodes with their periods, and the algorithm."""
+    """The reprojection cache's choice for a scene: nodes with their periods, the algorithm and the
+    cache filter (None: the default)."""
 
     nodes: list
     periods: list
     algorithm: str = "two-pass"
+    filter: Optional[str] = None
 
     @classmethod
     def parse(cls, text: str) -> "Choice":
-        """``NODE:PERIOD[+NODE:PERIOD...][@ALGORITHM]``.
+        """``NODE:PERIOD[+NODE:PERIOD...][@ALGORITHM[/FILTER]]``.
 
         >>> Choice.parse("n215:50+n108:50@three-pass")
-        Choice(nodes=['n215', 'n108'], periods=[50, 50], algorithm='three-pass')
+        Choice(nodes=['n215', 'n108'], periods=[50, 50], algorithm='three-pass', filter=None)
+        >>> Choice.parse("n324:3@three-pass/plane").describe()
+        'n324 Δn=3, three-pass, plane filter'
         """
-        body, _, algorithm = text.partition("@")
+        from rrcache.runtime.glsl import FILTERS
+
+        body, _, tail = text.partition("@")
+        algorithm, _, filter_ = tail.partition("/")
         nodes, periods = [], []
         for part in body.split("+"):
             node, sep, period = part.partition(":")
             if not sep or not node.strip() or not period.strip().isdigit():
                 raise RRCacheError(f"{text!r} is not a choice", "--choice",
-                                   hint="give NAME=NODE:PERIOD, several nodes joined by +, optionally @ALGORITHM")
+                                   hint="give NAME=NODE:PERIOD, several nodes joined by +, optionally "
+                                        "@ALGORITHM or @ALGORITHM/FILTER")
             nodes.append(node.strip())
             periods.append(int(period))
-        return cls(nodes, periods, algorithm.strip() or "two-pass")
+        filter_ = filter_.strip() or None
+        if filter_ is not None and filter_ not in FILTERS:
+            raise RRCacheError(f"{text!r}: {filter_!r} is not a cache filter", "--choice",
+                               hint=f"give one of {', '.join(FILTERS)}")
+        return cls(nodes, periods, algorithm.strip() or "two-pass", filter_)
 
     def describe(self) -> str:
-        return " + ".join(f"{n} Δn={p}" for n, p in zip(self.nodes, self.periods)) + f", {self.algorithm}"
+        return (" + ".join(f"{n} Δn={p}" for n, p in zip(self.nodes, self.periods)) + f", {self.algorithm}"
+                + (f", {self.filter} filter" if self.filter else ""))
 
 
 @dataclass
@@ -166,12 +179,14 @@ class _Cached:
 
 
 def _from_choice(scene, choice: Choice, out) -> _Cached:
-    """The reprojection cache of ``--choice``: compiled with the default cache filter."""
+    """The reprojection cache of ``--choice``: compiled with its filter (else the default)."""
     from rrcache.pipeline import load_for_session, variant_for, variant_for_nodes
     from rrcache.session import load_session
 
     session = load_session(_sizes(scene, out))
     work = load_for_session(scene.shader, session)
+    if choice.filter is not None:
+        work.filter = choice.filter
     texts = [work.node(n).text for n in choice.nodes]
     if len(choice.nodes) == 1:
         variant, period = variant_for(work, choice.nodes[0], choice.algorithm), choice.periods[0]
