@@ -89,6 +89,11 @@ def test_levels_met_tries_and_the_predictions_error(runs, capsys):
         assert r["raw"]["n"] == len(r["pairs"]) and (r["raw"]["n"] == 0 or r["raw"]["worst"] >= r["raw"]["mean"])
         for _, raw, calibrated, measured in r["pairs"]:
             assert all(isinstance(v, float) for v in (raw, calibrated, measured))
+    for r, folder in zip(found, runs):  # today's rule replayed on a profile made by it: what it predicted
+        points = json.loads((folder / "profile.json").read_text())["calibration"]["points"]
+        assert r["replayed"]["n"] == len(points)
+        replayed, made = sorted(r["replayed_pairs"]), sorted((c, m) for _, _, c, m in r["pairs"])
+        assert [v for pair in replayed for v in pair] == pytest.approx([v for pair in made for v in pair])
     assert predictions_markdown(found).splitlines()[-1].startswith("| all | 2 profiles |")
     main(["bench-repeats", "--predictions", str(runs[0])])
     assert "models alone" in capsys.readouterr().out

@@ -275,3 +275,23 @@ def test_a_flip_level_is_answered_from_the_measured_choices(trained, tmp_path):
         assert met.min_psnr is None and met.measured_flip == 0.012
         strict = flip_level(prof, validator, 0.001)
         assert not strict.parts and strict.label == "flip" and strict.max_flip == 0.001
+
+
+def test_the_calibration_borrows_only_a_shift_its_family_agrees_on():
+    """The validated points of many_lights' default profile at 7af0467 (docs/levels.md), in the
+    order they were measured: a cached node 5.5 dB under its prediction, then an amortized
+    estimator 10.6 dB over it. The estimator has no point of its own and is of another family:
+    it is predicted by its model alone (the node's shift had put it 16.2 dB off); the second
+    cached node borrows the first's; once cached nodes disagree in sign nothing is borrowed."""
+    from rrcache.model.calibration import Calibration, prediction_errors, replay
+
+    cal = (Calibration().add("n3839", 71.74, 66.21, "n3839 Δn=50").add("est:e1", 47.98, 58.62, "e1 m=16")
+           .add("est:e1", 43.33, 49.02, "e1 m=8").add("n10886", 39.15, 36.53, "n10886 Δn=2"))
+    again = replay(cal)
+    assert again[1] == (47.98, 58.62)  # the estimator: the models alone
+    assert again[2][0] == pytest.approx(43.33 + 10.64)  # its own point's shift
+    assert again[3][0] == pytest.approx(39.15 - 5.53)  # the cached node's
+    assert prediction_errors(again)["worst"] == pytest.approx(10.64)
+    disagree = cal.add("n20", 40.0, 42.0)
+    assert disagree.shift("n99") == 0.0 and disagree.shift("n20") == pytest.approx(2.0)
+    assert cal.add("n3839", 71.74, 66.0, "n3839 Δn=50").points[0].measured == 66.0  # replaced in its place

@@ -117,8 +117,10 @@ def predictions(folders: Iterable) -> list[dict]:
     """Per profile folder, |predicted − measured| PSNR (dB) over the distinct choices its
     validation measured (``Profile.measured``; a profile from before it: its shipped selections):
     ``raw`` from the models alone, ``calibrated`` as predicted when each was measured
-    (:mod:`rrcache.model.calibration`), each ``{"n", "mean", "worst"}``, and the pairs."""
-    from rrcache.model.calibration import prediction_errors
+    (:mod:`rrcache.model.calibration`), ``replayed`` the profile's calibration points as today's
+    rule predicts each from those before it (:func:`rrcache.model.calibration.replay`), each
+    ``{"n", "mean", "worst"}``, and the pairs (and ``replayed_pairs``)."""
+    from rrcache.model.calibration import Calibration, prediction_errors, replay
 
     out = []
     for folder in folders:
@@ -130,9 +132,11 @@ def predictions(folders: Iterable) -> list[dict]:
             seen.add(sel.key)
             raw = sel.predicted_psnr - float(sel.calibration_db or 0.0)
             pairs.append((sel.describe(), raw, sel.predicted_psnr, sel.measured_psnr))
+        again = replay(Calibration.from_json(getattr(profile, "calibration", None)))
         out.append(dict(scene=f"{Path(profile.shader).stem} / {Path(profile.session).stem}", run=Path(folder).name,
                         raw=prediction_errors([(r, m) for _, r, _, m in pairs]),
-                        calibrated=prediction_errors([(c, m) for _, _, c, m in pairs]), pairs=pairs))
+                        calibrated=prediction_errors([(c, m) for _, _, c, m in pairs]), pairs=pairs,
+                        replayed=prediction_errors(again), replayed_pairs=again))
     return out
 
 
@@ -144,12 +148,15 @@ def predictions_markdown(table: list[dict]) -> str:
         return "–" if not e["n"] else f"{e['mean']:.2f} / {e['worst']:.2f}"
 
     lines = ["| scene | run | validated choices | |pred − meas| dB, models alone (mean / worst) | "
-             "calibrated when measured (mean / worst) |", "|---|---|---|---|---|"]
+             "calibrated when measured (mean / worst) | today's calibration rule, replayed (mean / worst) |",
+             "|---|---|---|---|---|---|"]
     for r in table:
-        lines.append(f"| {r['scene']} | {r['run']} | {r['raw']['n']} | {cell(r['raw'])} | {cell(r['calibrated'])} |")
+        lines.append(f"| {r['scene']} | {r['run']} | {r['raw']['n']} | {cell(r['raw'])} | {cell(r['calibrated'])} | "
+                     f"{cell(r['replayed'])} |")
     raw = prediction_errors([(p[1], p[3]) for r in table for p in r["pairs"]])
     cal = prediction_errors([(p[2], p[3]) for r in table for p in r["pairs"]])
-    lines.append(f"| all | {len(table)} profiles | {raw['n']} | {cell(raw)} | {cell(cal)} |")
+    again = prediction_errors([p for r in table for p in r["replayed_pairs"]])
+    lines.append(f"| all | {len(table)} profiles | {raw['n']} | {cell(raw)} | {cell(cal)} | {cell(again)} |")
     return "\n".join(lines)
 
 
