@@ -383,3 +383,74 @@ def test_the_cache_filter_is_measured_and_kept(trained):
     # a resumed profile keeps the choice without measuring again
     reread = load_profile(prof.path)
     assert reread.filter == prof.filter
+
+
+
+def test_the_window_check_is_one_error_run_where_validation_measures(trained, tmp_path):
+    """rrcache.profiler.window_check: the first level's cached node, one error run over the
+    training frames in the region validation measures, becomes a point of the validation's
+    calibration (equal to that run made directly) and is kept in the store: a later validator on
+    the store adds it without rendering."""
+    import rrcache.model as model
+    from rrcache.gl.formats import ERROR_FORMAT
+    from rrcache.harness.cached import runtime_spec
+    from rrcache.harness.execute import Bench, execute
+    from rrcache.pipeline import load_for_session, variant_for_selection
+    from rrcache.profiler.validate import Validator
+    from rrcache.profiler.window_check import META, check_window, probe_choice
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.runs import RunSpec
+    from rrcache.session import load_session
+
+    prof, _, folder = trained
+    node = prof.nodes[0]
+    session = load_session(folder / "orbit.json")
+    work = load_for_session(folder / "noise.frag", session)
+    errors, perfs, hit = prof.fits()
+    cheap = model.fit_performance([100, 50, 10], [10, 50, 100], [1.1, 1.5, 2.0], overhead_ms=0.1)
+    table = model.ModelTable.from_fits([node.id], [errors[0]], [cheap], hit, prof.pixels, 1000.0)
+    settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
+    choices = [model.select(table, float(t)).replace(label=label, max_error=float(t), algorithm="three-pass")
+               for label, t in zip(("e1", "e2", "e3", "e4"), model.thresholds(table, 4))]
+    # the error-level table predicts no PSNR: give each cached choice one, as the PSNR levels do
+    choices = [c.replace(predicted_psnr=40.0 - i) if c.parts else c for i, c in enumerate(choices)]
+    choice = probe_choice(choices)
+    assert choice is not None and choice.node == node.id, choices
+    frames = tuple(range(8))
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        events = []
+        validator = Validator(work, session, settings, store, events.append)
+        point = check_window(validator, choices, frames)
+        validator.close()
+        assert point["key"] == f"window check: {choice.describe()}" and point["node"] == node.id
+        assert point["predicted"] == pytest.approx(choice.predicted_psnr) and events
+        assert [(p.key, p.measured) for p in validator.calibration.points] == [(point["key"], point["measured"])]
+        variant, period = variant_for_selection(work, choice)
+        spec = runtime_spec(variant, None, period=period, **settings.cache_options())
+        with Bench(work, session) as bench:
+            direct = execute(RunSpec("error", spec, frames, tuple(session.resolution), None, ERROR_FORMAT), bench)
+        assert point["measured"] == pytest.approx(min(direct.steady_psnr, 100.0), abs=1e-9)
+        assert json.loads(store.meta()[META])["key"] == point["key"]
+        events.clear()
+        again = Validator(work, session, settings, store, events.append)
+        assert check_window(again, choices, frames) == point and not events
+        assert again.calibration.shift(node.id) == pytest.approx(point["measured"] - point["predicted"])
+        again.close()
+
+
+def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkeypatch):
+    """Error runs in a window and validation on: the window check runs on the levels' choices over
+    the training frames before validation; not in a profile trained on whole frames."""
+    import rrcache.profiler.window_check as window_check
+
+    calls = []
+    monkeypatch.setattr(window_check, "check_window", lambda v, choices, frames: calls.append(list(frames)))
+    shader, session = write_scene(tmp_path)
+    windowed = TrainingSettings(**dict(SETTINGS, resolution=None), frames=10, validation_frames=4, max_sets=0)
+    first = profile(shader, session, tmp_path / "a", windowed, plots=False)
+    assert first.plan["error_window"] is not None and calls == [list(range(10))]
+    whole = TrainingSettings(**SETTINGS, frames=10, validation_frames=4, max_sets=0)
+    second = profile(shader, session, tmp_path / "b", whole, plots=False)
+    assert second.plan is None or second.plan["error_window"] is None
+    assert len(calls) == 1

@@ -303,6 +303,14 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
     validator = Validator(work, session, settings, store, progress,
                           window=result.plan.timing_window if result.plan is not None else None,
                           candidates=prof.front_candidates, executor=executor)
+    if result.plan is not None and result.plan.error_window is not None:  # trained in a window: check it first
+        from rrcache.profiler.window_check import check_window
+
+        try:
+            check_window(validator, choices, result.plan.error_frames(settings.frames))
+        except BaseException:
+            validator.close()
+            raise
     measured = validator.run(choices)
     if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first
         from rrcache.profiler.validate import flip_level
