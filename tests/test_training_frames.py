@@ -97,3 +97,23 @@ def test_uncovered_frames_widen_the_uncertainty():
     assert share({"error_segments": [[0, 150]]}, 150) == 0.0
     assert abs(share({"error_segments": [[0, 50], [100, 50]]}, 100) - 1 / 3) < 1e-9
     assert abs(share(None, 64) - 86 / 150) < 1e-9  # a profile planned before: its first 64 frames
+
+
+def test_the_window_regions_tool_prints_each_region(tmp_path):
+    """tools/window_regions.py (docs/levels.md, "The window check"): one row per window and one for
+    the whole frame, whose two columns are the same run."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from scene_files import write_scene
+
+    shader, session = write_scene(tmp_path)
+    tool = Path(__file__).resolve().parents[1] / "tools" / "window_regions.py"
+    p = subprocess.run([sys.executable, str(tool), str(shader), str(session), "n12", "4", "--frames", "6",
+                        "--window", "0,0,32,24"], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    rows = [line for line in p.stdout.splitlines() if line.startswith("| (")]
+    assert len(rows) == 2 and rows[0].startswith("| (0, 0, 32, 24) |"), p.stdout
+    whole = rows[1].split("|")
+    assert float(whole[2]) == float(whole[3]) and float(whole[2]) >= 0.0
