@@ -117,3 +117,26 @@ def test_the_window_regions_tool_prints_each_region(tmp_path):
     assert len(rows) == 2 and rows[0].startswith("| (0, 0, 32, 24) |"), p.stdout
     whole = rows[1].split("|")
     assert float(whole[2]) == float(whole[3]) and float(whole[2]) >= 0.0
+
+
+def test_a_later_segment_renders_the_same_on_a_new_renderer_and_a_used_one(tmp_path):
+    """An error run over frames 21..30 (warm-up from frame 13, the clock set there) measures the
+    same on a bench whose renderer is new (its first frame warms the driver up untimed) as on one
+    that served another run of the variant first: the warm-up leaves the clock where the run set
+    it (it once reset it to 0, which shifted the refresh schedule of a new renderer's run)."""
+    from rrcache.gl.formats import ERROR_FORMAT
+    from rrcache.harness.execute import execute
+    from rrcache.pipeline import WorkSource, load_bench
+    from rrcache.runs import RunSpec
+    from rrcache.runtime.spec import VariantSpec
+    from scene_files import session_doc
+
+    shader, session = write_scene(tmp_path, None, session_doc(frames=40))
+    spec = VariantSpec("cache", ("n12",), "three-pass", "bilinear", periods=(4,))
+    run = RunSpec("error", spec, tuple(range(21, 31)), (32, 24), None, ERROR_FORMAT)
+    with load_bench(WorkSource(str(shader), str(session))) as bench:
+        new = [f.error for f in execute(run, bench).frames]
+    with load_bench(WorkSource(str(shader), str(session))) as bench:
+        execute(RunSpec("error", spec.with_runtime(periods=(8,)), (0, 1, 2, 3, 4), (32, 24), None, ERROR_FORMAT), bench)
+        used = [f.error for f in execute(run, bench).frames]
+    assert len(new) == 10 and max(new) > 0 and new == used

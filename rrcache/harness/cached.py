@@ -248,12 +248,16 @@ class CachedRenderer:
         self.drawer.set_frame(index)
         if not self._warm:
             # an amortized variant has one program per phase (rrcache.compiler.amortize), each
-            # compiled by the driver when first drawn: draw every phase once here, untimed
+            # compiled by the driver when first drawn: draw every phase once here, untimed; the
+            # clock stays where it was set (a run restarted at a later frame keeps its refresh
+            # schedule whether this renderer is new or served runs before)
+            clock = self.runtime.clock
             for _ in range(max(1, int(self.runtime.phase_cycle))):
                 self._frame(None)
             if self._check_payload:
                 self._settle_payload()
             self.runtime.reset()
+            self.runtime.clock = clock
             self._warm = True
         hit_box = {} if self.hit_maps else None
         codes = self._classifier.classify(self.drawer.draw) if self._classifier is not None else None
