@@ -118,9 +118,11 @@ def predictions(folders: Iterable) -> list[dict]:
     validation measured (``Profile.measured``; a profile from before it: its shipped selections):
     ``raw`` from the models alone, ``calibrated`` as predicted when each was measured
     (:mod:`rrcache.model.calibration`), ``replayed`` the profile's calibration points as today's
-    rule predicts each from those before it (:func:`rrcache.model.calibration.replay`), each
+    rule predicts each from those before it (:func:`rrcache.model.calibration.replay`; the window
+    check's point calibrates the later ones and is left out of the figures), each
     ``{"n", "mean", "worst"}``, and the pairs (and ``replayed_pairs``)."""
     from rrcache.model.calibration import Calibration, prediction_errors, replay
+    from rrcache.profiler.window_check import CHECK_PREFIX
 
     out = []
     for folder in folders:
@@ -132,7 +134,9 @@ def predictions(folders: Iterable) -> list[dict]:
             seen.add(sel.key)
             raw = sel.predicted_psnr - float(sel.calibration_db or 0.0)
             pairs.append((sel.describe(), raw, sel.predicted_psnr, sel.measured_psnr))
-        again = replay(Calibration.from_json(getattr(profile, "calibration", None)))
+        # every point calibrates the later ones; the window check's is not a validated choice
+        again = [(c, m) for key, c, m in replay(Calibration.from_json(getattr(profile, "calibration", None)))
+                 if not key.startswith(CHECK_PREFIX)]
         out.append(dict(scene=f"{Path(profile.shader).stem} / {Path(profile.session).stem}", run=Path(folder).name,
                         raw=prediction_errors([(r, m) for _, r, _, m in pairs]),
                         calibrated=prediction_errors([(c, m) for _, _, c, m in pairs]), pairs=pairs,

@@ -272,7 +272,8 @@ def calibration_lines(prof) -> list[str]:
     return [f"PSNR predicted against measured on {raw['n']} validated choices: |error| mean {raw['mean']:.1f} dB, "
             f"worst {raw['worst']:.1f} dB (models alone); mean {calibrated['mean']:.1f}, worst "
             f"{calibrated['worst']:.1f} dB (calibrated by the choices measured before each); the profile now "
-            f"predicts with a {cal.get('shift', 0.0):+.1f} dB calibration (± {cal.get('spread', 0.0):.1f} dB)"]
+            f"predicts a measured node with its own shift, another cached node with a "
+            f"{cal.get('shift', 0.0):+.1f} dB calibration (± {cal.get('spread', 0.0):.1f} dB)"]
 
 
 def _estimator_lines(prof) -> list[str]:

@@ -120,6 +120,7 @@ class Calibration:
         return float(predicted + self.shift(node)), self.spread
 
     def to_json(self) -> dict:
+        """The points, ``shift`` (that of a cached node without points of its own) and ``spread``."""
         return {"points": [p.to_json() for p in self.points], "shift": self.shift(), "spread": self.spread}
 
     @classmethod
@@ -130,18 +131,18 @@ class Calibration:
                          for p in data.get("points", ())))
 
 
-def replay(calibration: "Calibration") -> list[tuple[float, float]]:
-    """``(calibrated, measured)`` PSNR of every point of ``calibration`` as the rule of this
-    module predicts it from the points before it (in the order they were measured): how a
+def replay(calibration: "Calibration") -> list[tuple[str, float, float]]:
+    """``(key, calibrated, measured)`` of every point of ``calibration``, its PSNR as the rule of
+    this module predicts it from the points before it (in the order they were measured): how a
     profile made under an earlier rule would have been calibrated under this one, for the same
     points (a different calibration may have chosen other candidates to measure).
 
     >>> cal = Calibration().add("n1", 45.0, 40.0).add("est:e1", 40.0, 44.0).add("n2", 40.0, 36.0)
     >>> replay(cal)
-    [(45.0, 40.0), (40.0, 44.0), (35.0, 36.0)]
+    [('n1', 45.0, 40.0), ('est:e1', 40.0, 44.0), ('n2', 35.0, 36.0)]
     """
     points = calibration.points
-    return [(p.predicted + Calibration(points[:i]).shift(p.node), p.measured) for i, p in enumerate(points)]
+    return [(p.key, p.predicted + Calibration(points[:i]).shift(p.node), p.measured) for i, p in enumerate(points)]
 
 
 def family(node: Optional[str]) -> str:

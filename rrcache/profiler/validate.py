@@ -325,7 +325,9 @@ class Validator:
     def run(self, choices: list[Selection]) -> list[Selection]:
         """Measure each labelled choice (see the module docstring); store every measurement and
         return the selections that stand, in order."""
-        self.state["total"] = 2 * self.per * len({c.key for c in choices if c.parts} - set(self._stored))
+        # what ran before (the window check) stays counted
+        self.state["total"] = self.state["done"] + 2 * self.per * len({c.key for c in choices if c.parts}
+                                                                      - set(self._stored))
         out = []
         try:
             for choice in choices:

@@ -290,7 +290,8 @@ def _prediction_errors(prof) -> str:
     return (f'<p class="muted">PSNR predicted against measured on the {raw["n"]} choices validation measured: '
             f"|predicted − measured| mean {raw['mean']:.1f} dB, worst {raw['worst']:.1f} dB from the models alone; "
             f"mean {calibrated['mean']:.1f} dB, worst {calibrated['worst']:.1f} dB as predicted with the calibration "
-            f"of the choices measured before each. The profile now predicts with a "
+            f"of the choices measured before each. The profile now predicts a node measured by validation with "
+            f"its own shift, and a cached node without points of its own with a "
             f"{float(cal.get('shift') or 0.0):+.1f} dB calibration (± {float(cal.get('spread') or 0.0):.1f} dB; "
             "docs/levels.md).</p>")
 
