@@ -15,9 +15,13 @@ apart from amortized estimators, whose models are another kind) when those all m
 disagree on: on many_lights a cached node missed by −5.5 dB and an estimator by +10.6 dB, and
 the estimator predicted with the node's shift missed by 16.2 dB, further than the models alone;
 on Trashcan every node missed by −7 to −8 dB, and a node without points of its own predicted
-with the others' shift missed by under 1 dB. Its ± (:attr:`Calibration.spread`) is the RMS of the residuals around the
-shift (each point left out of its own shift when there are several), at least
-:data:`MIN_SPREAD_DB`, and :data:`ONE_POINT_SPREAD_DB` while one point is all there is.
+with the others' shift missed by under 1 dB. Its ± (:meth:`Calibration.spread_for`) comes from
+the points of the node's family: the RMS of their residuals around the shift (each point left out
+of its own shift), at least :data:`MIN_SPREAD_DB`; :data:`ONE_POINT_SPREAD_DB` while the family
+has one point; 0 while it has none (no shift is applied then either). Taken over every point, a
+family without peers would count its first point's whole miss as the ± of the others: on
+Trashcan, after the window check (−7.4 dB, a cached node) and an estimator (−8.5 dB), that made
+a ± of 8 dB and no cached node could be offered for any level.
 
 The calibration is refitted as points arrive (:meth:`Calibration.add` returns the new one):
 validation uses it to re-check the next levels' choices and the candidates after a miss
@@ -100,27 +104,36 @@ class Calibration:
             return self._shift_of(kin)
         return 0.0
 
-    @property
-    def spread(self) -> float:
-        """The ± (dB) of a calibrated prediction (see the module docstring); 0 without points."""
-        if not self.points:
-            return 0.0
-        if len(self.points) == 1:
-            return ONE_POINT_SPREAD_DB
+    def spread_for(self, node: Optional[str] = None) -> float:
+        """The ± (dB) of a calibrated prediction for ``node``, from its family's points (see the
+        module docstring); 0 while the family has none.
+
+        >>> cal = Calibration().add("n1", 45.0, 37.6).add("est:e1", 37.8, 29.3)
+        >>> cal.spread_for("n2"), cal.spread_for("est:e2"), Calibration().spread_for("n1")
+        (1.5, 1.5, 0.0)
+        """
+        kin = tuple(p for p in self.points if family(p.node) == family(node))
+        if len(kin) <= 1:
+            return ONE_POINT_SPREAD_DB if kin else 0.0
         residuals = []
-        for i, p in enumerate(self.points):
-            others = Calibration(self.points[:i] + self.points[i + 1:])
+        for i, p in enumerate(kin):
+            others = Calibration(kin[:i] + kin[i + 1:])
             residuals.append(p.measured - (p.predicted + others.shift(p.node)))
         return max(MIN_SPREAD_DB, float(math.sqrt(np.mean(np.square(residuals)))))
+
+    @property
+    def spread(self) -> float:
+        """The ± (dB) of a cached node's calibrated prediction (:meth:`spread_for`)."""
+        return self.spread_for(None)
 
     def predict(self, node: Optional[str], predicted: float) -> tuple[float, float]:
         """(calibrated PSNR, its ±) of a raw prediction for ``node``."""
         if predicted is None or not math.isfinite(predicted):
             return predicted, 0.0
-        return float(predicted + self.shift(node)), self.spread
+        return float(predicted + self.shift(node)), self.spread_for(node)
 
     def to_json(self) -> dict:
-        """The points, ``shift`` (that of a cached node without points of its own) and ``spread``."""
+        """The points, ``shift`` and ``spread`` (those of a cached node without points of its own)."""
         return {"points": [p.to_json() for p in self.points], "shift": self.shift(), "spread": self.spread}
 
     @classmethod

@@ -143,7 +143,7 @@ def predictions(prof, choice: Selection) -> dict:
         # psnr_fits carries the node's calibration shift: say how much, and widen the ± by its spread
         out["calibration_db"] = cal.shift(choice.node)
         if math.isfinite(spread):
-            out["predicted_psnr_uncertainty"] = math.hypot(spread, cal.spread)
+            out["predicted_psnr_uncertainty"] = math.hypot(spread, cal.spread_for(choice.node))
     return out
 
 

@@ -260,7 +260,7 @@ class Validator:
             return True
         if sel.predicted_psnr is None:
             return False
-        return sel.predicted_psnr - self.calibration.spread >= sel.min_psnr
+        return sel.predicted_psnr - self.calibration.spread_for(calibration_group(sel)) >= sel.min_psnr
 
     def miss(self, sel: Selection) -> Optional[str]:
         """Why the measured ``sel`` may not stand at its level, or None."""
