@@ -433,10 +433,13 @@ def test_the_window_check_is_one_error_run_where_validation_measures(trained, tm
         assert point["measured"] == pytest.approx(min(direct.steady_psnr, 100.0), abs=1e-9)
         assert json.loads(store.meta()[META])["key"] == point["key"]
         events.clear()
-        again = Validator(work, session, settings, store, events.append)
+        again = Validator(work, session, settings, store, events.append, fallback=False)
         assert check_window(again, choices, frames) == point and not events
         assert again.calibration.shift(node.id) == pytest.approx(point["measured"] - point["predicted"])
-        again.close()
+        # then validation: its progress ends at its total, each render counted once
+        again.run(choices)
+        steps = [e for e in events if e.stage == "validate"]
+        assert steps and steps[-1].done == steps[-1].total, steps[-1]
 
 
 def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkeypatch):
@@ -454,3 +457,4 @@ def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkey
     second = profile(shader, session, tmp_path / "b", whole, plots=False)
     assert second.plan is None or second.plan["error_window"] is None
     assert len(calls) == 1
+

@@ -130,6 +130,7 @@ class Validator:
         self._stored = {row.key: row for row in store.validations() if row.parts}
         self._extras = self._read_extras()
         self.state = {"done": 0, "total": 0}
+        self._counted: set = set()  # the choices whose frames the total counts
 
     # ------------------------------------------------------------------ measuring
     def _read_extras(self) -> dict:
@@ -180,7 +181,9 @@ class Validator:
             sel = self._from_store(choice)
             self.measured[choice.key] = sel
             return sel
-        self.state["total"] += 2 * self.per
+        if choice.key not in self._counted:  # a candidate run() did not count in advance
+            self._counted.add(choice.key)
+            self.state["total"] += 2 * self.per
         variant, period = variant_for_selection(self.work, choice)
         spec = runtime_spec(variant, None, period=period, **self.settings.cache_options())
         size = tuple(self.session.resolution)
@@ -326,8 +329,9 @@ class Validator:
         """Measure each labelled choice (see the module docstring); store every measurement and
         return the selections that stand, in order."""
         # what ran before (the window check) stays counted
-        self.state["total"] = self.state["done"] + 2 * self.per * len({c.key for c in choices if c.parts}
-                                                                      - set(self._stored))
+        new = {c.key for c in choices if c.parts} - set(self._stored) - self._counted
+        self._counted |= new
+        self.state["total"] = self.state["done"] + 2 * self.per * len(new)
         out = []
         try:
             for choice in choices:
