@@ -218,3 +218,22 @@ def test_a_static_part_written_in_one_expression_is_named():
                      "the static part of aoStatic * aoKing (without u_kingOffset)"]
     bare = cacheable_nodes(load_shader(root / "shaders" / "ambient_occlusion.glsl"))
     assert not any("static part" in n.text for n in bare.nodes)
+
+
+def test_the_static_part_is_trained_second():
+    """Rule 3 of rrcache.profiler.order: chess's static part (the paper's ε1) reads no per-frame
+    uniform, so it is trained right after the costliest node (round-robin had it fifth, past a
+    budget under load); the rest keep their order."""
+    from rrcache.profiler.order import diversity_order
+    from rrcache.profiler.train import training_order
+    from rrcache.profiles import TrainingSettings
+
+    root = Path(__file__).resolve().parents[1]
+    session = load_session(root / "sessions" / "chess.json")
+    work = load_for_session(root / "shaders" / "ambient_occlusion.glsl", session)
+    order = training_order(work, session, TrainingSettings().resolved(session))
+    assert "the static part" in order.nodes[1].text, [n.text for n in order.nodes[:3]]
+    assert "u_kingOffset" not in order.signatures[order.nodes[1].id]
+    plain = diversity_order(order.nodes, order.signatures)
+    assert plain.index(order.nodes[1]) > 1
+    assert [n.id for n in order.nodes if n is not order.nodes[1]] == [n.id for n in plain if n is not order.nodes[1]]

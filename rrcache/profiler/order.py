@@ -24,6 +24,14 @@ noise, the final colour) never gets measured. Two rules replace it:
    first (``vec4(toneMap(c), 1.0)`` costs what its operand does, and it is the one users ask
    about).
 
+3. **Invariant second.** The costliest node whose value depends on no per-frame uniform (only
+   varyings: at a surface point it is the same in every frame, so caching it errs only by
+   resampling, at any Δn) is trained second, right after the costliest node
+   (:func:`invariant_early`). Round-robin reached it second or third on Marble, the temple,
+   many_lights and sdf_material, but fifth on chess, where it is the paper's ε1 (the static
+   pieces' occlusion, n108): a bench under load whose budget trained three chess nodes never
+   measured it (docs/bench_full_run_6.md).
+
 >>> from types import SimpleNamespace as N
 >>> nodes = [N(id=f"n{c}", cost=c) for c in (100, 98, 60, 30, 5)]
 >>> [n.id for n in diversity_order(nodes, {n.id: "a" for n in nodes})]
@@ -114,6 +122,26 @@ def signature(expr, deps: dict[str, set[str]], inputs: set[str], changing: set[s
 def shader_inputs(source: str) -> set[str]:
     """The ``in`` variables a core fragment shader declares."""
     return set(_INPUT.findall(source))
+
+
+def invariant_early(order: list, signatures: dict, changing) -> list:
+    """``order`` with its first node whose signature names none of ``changing`` (the per-frame
+    uniforms) moved to second place (rule 3 of the module docstring); unchanged when there is
+    none or it is first or second.
+
+    >>> from types import SimpleNamespace as N
+    >>> nodes = [N(id=i) for i in ("a", "b", "c", "d")]
+    >>> sig = {"a": "u_camera v_position", "b": "u_light v_normal", "c": "u_camera", "d": "v_position"}
+    >>> [n.id for n in invariant_early(nodes, sig, {"u_camera", "u_light"})]
+    ['a', 'd', 'b', 'c']
+    """
+    changing = set(changing)
+    for i, node in enumerate(order):
+        if not set(signatures.get(node.id, "").split()) & changing:
+            if i <= 1:
+                return list(order)
+            return [order[0], node] + [n for j, n in enumerate(order[1:], 1) if j != i]
+    return list(order)
 
 
 def diversity_order(nodes, signatures: dict) -> list:

@@ -60,8 +60,8 @@ from rrcache.model.ceiling import Ceiling
 from rrcache.profiler.ceiling import measure_ceiling
 from rrcache.profiler.filters import choose_filter
 from rrcache.runtime.cache import DEFAULT_FILTER
-from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, per_frame_uniforms,
-                                    shader_inputs, signature)
+from rrcache.profiler.order import (TrainingOrder, cost_filter, dependency_map, diversity_order, invariant_early,
+                                    per_frame_uniforms, shader_inputs, signature)
 from rrcache.profiler.plan import Plan, algorithm_by_ceiling, algorithm_by_timing, make_plan as _make_plan
 from rrcache.profiles.settings import TrainingSettings
 from rrcache.profiler.collect import Collector
@@ -134,7 +134,8 @@ def training_order(work: ShaderWork, session, settings: TrainingSettings) -> Tra
     deps = dependency_map(work.table.shader.unit)
     inputs = shader_inputs(work.prepared.source)
     signatures = {n.id: signature(n.node, deps, inputs, changing) for n in keep}
-    return TrainingOrder(diversity_order(keep, signatures), skipped, signatures)
+    order = invariant_early(diversity_order(keep, signatures), signatures, changing)
+    return TrainingOrder(order, skipped, signatures)
 
 
 def make_plan(work: ShaderWork, session, settings: TrainingSettings, original_ms: float, frames=None) -> Plan:
