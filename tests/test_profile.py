@@ -191,13 +191,12 @@ def test_error_runs_in_a_window_at_full_resolution(tmp_path):
     assert again.plan == first.plan and again.counts["error_runs_computed"] == 0
 
 
-def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
-    """Validation of a table whose best choice caches the costliest node (the models are replaced
-    by fits that make caching pay, so the choice does not depend on this machine's speed)."""
+def _cached_choices(trained):
+    """(node, session, work, settings, the e1..e4 choices) of the trained tiny profile with its
+    costliest node's performance model replaced by one that makes caching pay, so the choices
+    cache it whatever this machine's speed."""
     import rrcache.model as model
     from rrcache.pipeline import load_for_session
-    from rrcache.profiles.store import ProfileStore, StoreKey
-    from rrcache.profiler.validate import validate
     from rrcache.session import load_session
 
     prof, _, folder = trained
@@ -208,10 +207,19 @@ def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
     cheap = model.fit_performance([100, 50, 10], [10, 50, 100], [1.1, 1.5, 2.0], overhead_ms=0.1)
     table = model.ModelTable.from_fits([node.id], [errors[0]], [cheap], hit, prof.pixels, 1000.0)
     settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
-    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
-    levels = model.thresholds(table, 4)
     choices = [model.select(table, float(t)).replace(label=label, max_error=float(t), algorithm="three-pass")
-               for label, t in zip(("e1", "e2", "e3", "e4"), levels)]
+               for label, t in zip(("e1", "e2", "e3", "e4"), model.thresholds(table, 4))]
+    return node, session, work, settings, choices
+
+
+def test_validation_measures_a_cached_selection(trained, tmp_path, monkeypatch):
+    """Validation of a table whose best choice caches the costliest node (the models are replaced
+    by fits that make caching pay, so the choice does not depend on this machine's speed)."""
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.profiler.validate import validate
+
+    node, session, work, settings, choices = _cached_choices(trained)
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
     with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
         # measured as chosen (fallback=False): whatever this tiny scene measures, nothing is replaced
         rows = validate(work, session, settings, store, choices, fallback=False)
@@ -391,27 +399,16 @@ def test_the_window_check_is_one_error_run_where_validation_measures(trained, tm
     training frames in the region validation measures, becomes a point of the validation's
     calibration (equal to that run made directly) and is kept in the store: a later validator on
     the store adds it without rendering."""
-    import rrcache.model as model
     from rrcache.gl.formats import ERROR_FORMAT
     from rrcache.harness.cached import runtime_spec
     from rrcache.harness.execute import Bench, execute
-    from rrcache.pipeline import load_for_session, variant_for_selection
+    from rrcache.pipeline import variant_for_selection
     from rrcache.profiler.validate import Validator
     from rrcache.profiler.window_check import META, check_window, probe_choice
     from rrcache.profiles.store import ProfileStore, StoreKey
     from rrcache.runs import RunSpec
-    from rrcache.session import load_session
 
-    prof, _, folder = trained
-    node = prof.nodes[0]
-    session = load_session(folder / "orbit.json")
-    work = load_for_session(folder / "noise.frag", session)
-    errors, perfs, hit = prof.fits()
-    cheap = model.fit_performance([100, 50, 10], [10, 50, 100], [1.1, 1.5, 2.0], overhead_ms=0.1)
-    table = model.ModelTable.from_fits([node.id], [errors[0]], [cheap], hit, prof.pixels, 1000.0)
-    settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
-    choices = [model.select(table, float(t)).replace(label=label, max_error=float(t), algorithm="three-pass")
-               for label, t in zip(("e1", "e2", "e3", "e4"), model.thresholds(table, 4))]
+    node, session, work, settings, choices = _cached_choices(trained)
     # the error-level table predicts no PSNR: give each cached choice one, as the PSNR levels do
     choices = [c.replace(predicted_psnr=40.0 - i) if c.parts else c for i, c in enumerate(choices)]
     choice = probe_choice(choices)
