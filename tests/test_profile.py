@@ -454,4 +454,25 @@ def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkey
     second = profile(shader, session, tmp_path / "b", whole, plots=False)
     assert second.plan is None or second.plan["error_window"] is None
     assert len(calls) == 1
+    predicted = TrainingSettings(**dict(SETTINGS, resolution=None), frames=10, max_sets=0, validate=False)
+    profile(shader, session, tmp_path / "c", predicted, plots=False)
+    assert calls == [list(range(10))] * 2  # without validation too
+
+
+def test_a_predicted_only_profile_predicts_with_its_window_check(tmp_path):
+    """--no-validate on the demo scene (trained in a window): the window check's point is the
+    profile's calibration and the levels' choices are predicted with its shift."""
+    from rrcache.profiler.demo import DEMO_SESSION, DEMO_SETTINGS, DEMO_SHADER
+
+    prof = profile(DEMO_SHADER, DEMO_SESSION, tmp_path / "out", TrainingSettings(**DEMO_SETTINGS, validate=False),
+                   plots=False)
+    assert prof.plan["error_window"] is not None
+    points = prof.calibration["points"]
+    assert len(points) == 1 and points[0]["key"].startswith("window check: "), prof.calibration
+    shift = points[0]["measured"] - points[0]["predicted"]
+    cached = [s for s in prof.selections if s.parts]
+    assert cached, prof.selections
+    single = [s for s in cached if s.kind == "cache" and not s.multi]  # the check's node, or borrowing its shift
+    assert single and all(s.calibration_db == pytest.approx(shift) for s in single), single
+    assert all(s.measured_psnr is None for s in prof.selections)  # nothing validated
 

@@ -8,7 +8,7 @@ from typing import Callable
 @dataclass
 class ProgressEvent:
     """Sent to the ``progress`` callback: ``stage`` (``reference``, ``error``, ``timing``,
-    ``overhead``, ``validate``, ``sets``, ``amortize``, ``adaptive``), frames rendered ``done`` of ``total`` planned (the plan shrinks
+    ``overhead``, ``check`` (the window check), ``validate``, ``sets``, ``amortize``, ``adaptive``), frames rendered ``done`` of ``total`` planned (the plan shrinks
     when the budget stops the training), and a short ``detail`` (node and period)."""
 
     stage: str

@@ -292,12 +292,11 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
                 max_flip: Optional[float] = None, executor=None) -> list:
     """The e1..e4 selections: measured beside the original when ``settings.validate``
     (:mod:`rrcache.profiler.validate`, its renders run by ``executor``), else predicted only;
-    none without a trained node."""
+    none without a trained node. Training in a window is checked first either way
+    (:mod:`rrcache.profiler.window_check`)."""
     if not result.trained:
         return []
     choices = prof.threshold_selections()
-    if not settings.validate:
-        return choices
     from rrcache.profiler.validate import Validator
 
     validator = Validator(work, session, settings, store, progress,
@@ -311,6 +310,12 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
         except BaseException:
             validator.close()
             raise
+    if not settings.validate:  # predicted only: with what the window check taught the models
+        validator.close()
+        if validator.calibration.points:
+            prof.calibration = validator.calibration.to_json()
+            return prof.threshold_selections()
+        return choices
     measured = validator.run(choices)
     if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first
         from rrcache.profiler.validate import flip_level

@@ -12,7 +12,8 @@ and 0.00849 inside the frame rendered whole; it erred less for its place: the fr
 pixels measured 0.01331 (validation: 0.01331), the centre quarter's 0.0103
 (``tools/window_regions.py``, docs/levels.md).
 
-So when the error runs were windowed, :func:`check_window` makes one ``error`` run (no timing)
+So when the error runs were windowed, with validation or without (a profile that only predicts
+then predicts with the check's calibration), :func:`check_window` makes one ``error`` run (no timing)
 of the first of the levels' choices that caches a single node at Δn > 1, over the training
 frames, at the full resolution in the region validation measures, and adds it to the
 validation's calibration as a point of that node (:mod:`rrcache.model.calibration`: the models'
@@ -33,6 +34,7 @@ from typing import Optional
 
 from rrcache.gl.formats import ERROR_FORMAT
 from rrcache.harness.cached import runtime_spec
+from rrcache.profiler.events import ProgressEvent
 from rrcache.runs import RunSpec
 
 #: the store's meta key of the window check's point
@@ -72,8 +74,14 @@ def check_window(validator, choices, frames) -> Optional[dict]:
         run = RunSpec("error", spec, tuple(int(f) for f in frames), tuple(validator.session.resolution),
                       validator.window, ERROR_FORMAT, key=("window check",), label=key)
         executor = validator._executor()
-        validator.state["total"] += run.cost
-        (result,) = list(executor.run([run], on_frame=lambda r, n: validator._step(r.label, n)))
+        done = [0]
+
+        def step(_, units):  # the progress of a stage of its own (not validation's)
+            done[0] += units
+            if validator.progress is not None:
+                validator.progress(ProgressEvent("check", min(done[0], run.cost), run.cost, key))
+
+        (result,) = list(executor.run([run], on_frame=step))
         if getattr(executor, "release", None) is not None:  # the original's frames: validation draws its own
             executor.release()
         measured = {"key": key, "measured": float(result.steady_psnr), "error": float(result.steady_error),
