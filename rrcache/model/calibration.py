@@ -89,6 +89,10 @@ class Calibration:
             return Calibration(tuple(point if p.key == key else p for p in self.points))
         return Calibration(self.points + (point,))
 
+    def _kin(self, node: Optional[str]) -> tuple:
+        """The points of ``node``'s family (:func:`family`)."""
+        return tuple(p for p in self.points if family(p.node) == family(node))
+
     def _shift_of(self, points) -> float:
         return float(np.mean([p.measured - p.predicted for p in points])) if points else 0.0
 
@@ -98,7 +102,7 @@ class Calibration:
         own = [p for p in self.points if node is not None and p.node == node]
         if own:
             return self._shift_of(own)
-        kin = [p for p in self.points if family(p.node) == family(node)]
+        kin = self._kin(node)
         misses = [p.measured - p.predicted for p in kin]
         if all(d < 0 for d in misses) or all(d > 0 for d in misses):
             return self._shift_of(kin)
@@ -112,7 +116,7 @@ class Calibration:
         >>> cal.spread_for("n2"), cal.spread_for("est:e2"), Calibration().spread_for("n1")
         (1.5, 1.5, 0.0)
         """
-        kin = tuple(p for p in self.points if family(p.node) == family(node))
+        kin = self._kin(node)
         if len(kin) <= 1:
             return ONE_POINT_SPREAD_DB if kin else 0.0
         residuals = []
