@@ -418,7 +418,7 @@ def test_the_window_check_is_one_error_run_where_validation_measures(trained, tm
     with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
         events = []
         validator = Validator(work, session, settings, store, events.append)
-        point = check_window(validator, choices, frames)
+        (point,) = check_window(validator, choices, frames)  # no estimator among the choices
         validator.close()
         assert point["key"] == f"window check: {choice.describe()}" and point["node"] == node.id
         assert point["predicted"] == pytest.approx(choice.predicted_psnr) and events
@@ -428,15 +428,34 @@ def test_the_window_check_is_one_error_run_where_validation_measures(trained, tm
         with Bench(work, session) as bench:
             direct = execute(RunSpec("error", spec, frames, tuple(session.resolution), None, ERROR_FORMAT), bench)
         assert point["measured"] == pytest.approx(min(direct.steady_psnr, 100.0), abs=1e-9)
-        assert json.loads(store.meta()[META])["key"] == point["key"]
+        assert [p["key"] for p in json.loads(store.meta()[META])] == [point["key"]]
         events.clear()
         again = Validator(work, session, settings, store, events.append, fallback=False)
-        assert check_window(again, choices, frames) == point and not events
+        assert check_window(again, choices, frames) == [point] and not events
         assert again.calibration.shift(node.id) == pytest.approx(point["measured"] - point["predicted"])
         # then validation: its progress ends at its total, each render counted once
         again.run(choices)
         steps = [e for e in events if e.stage == "validate"]
         assert steps and steps[-1].done == steps[-1].total, steps[-1]
+
+
+def test_the_window_check_probes_each_levels_node_once_and_the_estimator():
+    """rrcache.profiler.window_check.probe_choices: each node the levels cache alone at Δn > 1,
+    at its highest level's choice, then the first amortized estimator; not Δn = 1, not a set, not
+    a choice without a PSNR prediction, not the original."""
+    from rrcache.profiler.window_check import probe_choices
+    from rrcache.selection import AmortizedLoop, CachedNode, Selection
+
+    def cache(node, period, psnr=40.0):
+        return Selection((CachedNode(node, period),), 0.01, 1.0, 2.0, predicted_psnr=psnr)
+
+    est = Selection((AmortizedLoop("e1", 4, 0.6),), 0.01, 1.0, 2.0, predicted_psnr=38.0)
+    pair = Selection((CachedNode("n7", 4), CachedNode("n8", 4)), 0.01, 1.0, 2.0, predicted_psnr=39.0)
+    original = Selection((), 0.0, 2.0, 1.0)
+    levels = [cache("n1", 1), cache("n2", 8), pair, cache("n2", 20), est, cache("n3", 4, None), cache("n4", 6),
+              est.replace(parts=(AmortizedLoop("e1", 2, 0.6),)), original]
+    assert [s.describe() for s in probe_choices(levels)] == ["n2 Δn=8", "n4 Δn=6", "e1 m=4 λ=0.6"]
+    assert probe_choices([original, cache("n1", 1)]) == []
 
 
 def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkeypatch):

@@ -79,6 +79,14 @@ def test_the_estimator_is_trained_against_m_and_lambda(trained):
     predicted = model.error.predict(np.array(est.run_samples), np.array(est.run_blends))
     assert est.error_fit["quality"] in ("ok", "poor") and est.error_fit["a"] > 0
     assert np.corrcoef(predicted, est.errors)[0, 1] > 0.8
+    # and is held to them: at a run's (m, λ) the model predicts what the run measured
+    # (rrcache.model.amortize.AnchoredFit), between them the fit's shape
+    assert predicted == pytest.approx(est.errors, rel=1e-9)
+    from rrcache.model.amortize import error_fit_from_json
+
+    raw = error_fit_from_json("blend", est.error_fit)
+    assert model.error.to_json() == raw.to_json() and model.error.quality == raw.quality
+    assert model.error.predict(8, 0.0) == 0.0  # every term each frame: the original
     assert est.timed_samples == [1, 2, 4] and all(ms > 0 for ms in est.timed_ms)
     # more terms evaluated at larger m
     assert est.timed_evaluated[0] < est.timed_evaluated[1] < est.timed_evaluated[2]
@@ -179,6 +187,43 @@ def test_validation_measures_an_amortized_selection(amortized_wins, tmp_path):
     assert 0 < row.hit_rate < 1
 
 
+def test_the_window_check_measures_an_amortized_choice_for_its_own_family(amortized_wins, tmp_path):
+    """rrcache.profiler.window_check: an estimator among the levels' choices gets an error run of
+    its own where validation measures; its point is of the estimator family (``est:e1``), equal to
+    that run made directly, and moves no cached node's prediction."""
+    from rrcache.gl.formats import ERROR_FORMAT
+    from rrcache.harness.cached import runtime_spec
+    from rrcache.harness.execute import Bench, execute
+    from rrcache.pipeline import load_for_session, variant_for_selection
+    from rrcache.profiler.validate import Validator
+    from rrcache.profiler.window_check import META, check_window
+    from rrcache.profiles.store import ProfileStore, StoreKey
+    from rrcache.runs import RunSpec
+    from rrcache.session import load_session
+
+    prof, folder = amortized_wins
+    session = load_session(folder / "orbit.json")
+    work = load_for_session(folder / "soft.frag", session)
+    settings = TrainingSettings(**SETTINGS, validation_frames=6).resolved(session)
+    choice = prof.select_psnr(20.0)
+    assert choice.kind == "amortize" and choice.predicted_psnr is not None
+    frames = tuple(range(8))
+    key = StoreKey("s" * 64, "t" * 64, settings.key_hash(), "0", settings.key_json())
+    with ProfileStore.open(tmp_path / "v.sqlite", key) as store:
+        validator = Validator(work, session, settings, store, None)
+        (point,) = check_window(validator, [choice], frames)
+        validator.close()
+        assert point["node"] == "est:e1" and point["key"] == f"window check: {choice.describe()}"
+        variant, period = variant_for_selection(work, choice)
+        spec = runtime_spec(variant, None, period=period, **settings.cache_options())
+        with Bench(work, session) as bench:
+            direct = execute(RunSpec("error", spec, frames, tuple(session.resolution), None, ERROR_FORMAT), bench)
+        assert point["measured"] == pytest.approx(min(direct.steady_psnr, 100.0), abs=1e-9)
+        assert validator.calibration.shift("est:e1") == pytest.approx(point["measured"] - point["predicted"])
+        assert validator.calibration.shift("n1") == 0.0 and validator.calibration.spread_for("n1") == 0.0
+        assert [p["key"] for p in json.loads(store.meta()[META])] == [point["key"]]
+
+
 def test_the_bench_measures_the_papers_amortized_setting(trained):
     """``rrcache bench`` measures each trained estimator at the paper's setting (N/4 terms per
     frame, λ = 3/5) beside the original and shows it in bench.md."""
@@ -243,7 +288,7 @@ def test_the_slots_history_is_trained_where_it_fits(trained):
     assert all(slots0[m] < blend0[m] for m in (2, 4)), (slots0, blend0)
     # its own model: one floor per trained m, the lag term shared; the nlopt fit follows the runs
     model = est.model("slots")
-    assert model.history == "slots" and isinstance(model.error, SlotsErrorFit)
+    assert model.history == "slots" and isinstance(model.error.fit, SlotsErrorFit)  # held to its runs
     assert list(model.error.samples) == [2, 4] and all(c >= 0 for c in model.error.base) and model.error.b >= 0
     predicted = model.error.predict(np.array(slots.run_samples), np.array(slots.run_blends))
     assert np.corrcoef(predicted, slots.errors)[0, 1] > 0.8

@@ -330,6 +330,72 @@ def fit_error(history: str, samples, blends, errors, total: int):
     return fit_amortized_error(samples, blends, errors, total)
 
 
+@dataclass(frozen=True)
+class AnchoredFit:
+    """An estimator's error ``fit`` held to its own error runs: ε̂ × the run's measured/predicted
+    ratio, interpolated in log between the runs (over λ at a trained m, then over log m between
+    trained m; held constant past the ends). At a run's (m, λ) it predicts what that run
+    measured; elsewhere the fit's shape carries the nearest runs' ratio.
+
+    Why: the fits are least squares on the error, so the small errors of many samples and a high
+    blend weigh nothing in them, while a level reads them in dB. On many_lights (N = 32, runs at
+    m = 1, 4, 16 × λ = 0, 0.6, 0.85) the fit was within 15% of the m = 1 runs and 3.6× over the
+    m = 16, λ = 0.85 run (11 dB), and validation measured `e1 m=16 λ=0.9` 10.6 dB over its
+    prediction (docs/levels.md). Everything else (``quality``, ``total``, ``samples``, ...) is the
+    fit's.
+
+    >>> fit = fit_amortized_error([1, 1, 4, 4], [0.0, 0.6, 0.0, 0.6], [0.02, 0.01, 0.01, 0.001], 16)
+    >>> held = anchored(fit, [1, 1, 4, 4], [0.0, 0.6, 0.0, 0.6], [0.02, 0.01, 0.01, 0.001])
+    >>> round(held.predict(4, 0.6), 6), round(held.predict(4, 0.9) / fit.predict(4, 0.9), 3), held.predict(16, 0.0)
+    (0.001, 0.226, 0.0)
+    >>> held.quality == fit.quality
+    True
+    """
+
+    fit: object
+    anchor_samples: tuple  # the m of the runs
+    anchor_ratios: tuple  # per m of anchor_samples: ((λ, log measured/predicted), ...) by λ
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(self.fit, name)
+
+    def _log_ratio(self, m: float, lam: float) -> float:
+        at = [float(np.interp(lam, [p[0] for p in row], [p[1] for p in row])) for row in self.anchor_ratios]
+        if len(at) == 1:
+            return at[0]
+        return float(np.interp(math.log(max(m, 1e-9)), [math.log(k) for k in self.anchor_samples], at))
+
+    def predict(self, samples, blend):
+        base = self.fit.predict(samples, blend)
+        m, lam = np.broadcast_arrays(np.asarray(samples, dtype=np.float64), np.asarray(blend, dtype=np.float64))
+        factor = np.array([math.exp(self._log_ratio(float(a), float(b))) for a, b in zip(m.ravel(), lam.ravel())])
+        out = np.asarray(base, dtype=np.float64) * factor.reshape(m.shape)
+        return float(out) if np.ndim(out) == 0 else out
+
+    def to_json(self) -> dict:
+        return self.fit.to_json()
+
+
+def anchored(fit, samples: Sequence[int], blends: Sequence[float], errors: Sequence[float]):
+    """``fit`` held to the runs (``samples[i]``, ``blends[i]``, ``errors[i]``)
+    (:class:`AnchoredFit`); ``fit`` itself where no run has a finite error > 0 and a prediction
+    > 0 to compare it with."""
+    by_m: dict[int, list] = {}
+    for m, lam, e in zip(samples, blends, errors):
+        if not (e is not None and math.isfinite(float(e)) and float(e) > 0):
+            continue
+        pred = float(fit.predict(int(m), float(lam)))
+        if not (math.isfinite(pred) and pred > 0):
+            continue
+        by_m.setdefault(int(m), []).append((float(lam), math.log(float(e) / pred)))
+    if not by_m:
+        return fit
+    ms = tuple(sorted(by_m))
+    return AnchoredFit(fit, ms, tuple(tuple(sorted(by_m[m])) for m in ms))
+
+
 def error_fit_from_json(history: str, data: dict):
     """The error fit of ``history`` from its ``error_fit`` record (what ``to_json`` wrote)."""
     if history == "slots":

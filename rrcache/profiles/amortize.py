@@ -109,13 +109,13 @@ class EstimatorProfile:
     def model(self, history: str = "blend"):
         """The :class:`~rrcache.model.amortize.AmortizeModel` of ``history`` when it was trained
         (None otherwise)."""
-        from rrcache.model.amortize import AmortizeModel, AmortizeTimeFit, error_fit_from_json
+        from rrcache.model.amortize import AmortizeModel, AmortizeTimeFit, anchored, error_fit_from_json
         from rrcache.model.psnr import fit_psnr
 
         runs = self.runs(history)
         if runs is None or not runs.trained or not runs.error_fit or not runs.time_fit:
             return None
-        ef = error_fit_from_json(history, runs.error_fit)
+        ef = anchored(error_fit_from_json(history, runs.error_fit), runs.run_samples, runs.run_blends, runs.errors)
         tf = AmortizeTimeFit(**{k: runs.time_fit[k] for k in ("fixed_ms", "t_sample", "rms", "n", "quality")})
         psnr = fit_psnr(runs.errors, runs.psnrs) if runs.errors else None
         return AmortizeModel(self.id, int(self.samples), ef, tf, float(runs.hit_rate or 0.0), float(runs.pixels or 0.0),
