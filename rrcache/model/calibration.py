@@ -16,12 +16,18 @@ disagree on: on many_lights a cached node missed by −5.5 dB and an estimator b
 the estimator predicted with the node's shift missed by 16.2 dB, further than the models alone;
 on Trashcan every node missed by −7 to −8 dB, and a node without points of its own predicted
 with the others' shift missed by under 1 dB. Its ± (:meth:`Calibration.spread_for`) comes from
-the points of the node's family: the RMS of their residuals around the shift (each point left out
-of its own shift), at least :data:`MIN_SPREAD_DB`; :data:`ONE_POINT_SPREAD_DB` while the family
-has one point; 0 while it has none (no shift is applied then either). Taken over every point, a
-family without peers would count its first point's whole miss as the ± of the others: on
-Trashcan, after the window check (−7.4 dB, a cached node) and an estimator (−8.5 dB), that made
-a ± of 8 dB and no cached node could be offered for any level.
+the node's own points when it has any, else from the points of its family: the RMS of their
+residuals around the shift (each point left out of its own shift), at least
+:data:`MIN_SPREAD_DB`; :data:`ONE_POINT_SPREAD_DB` for one point; 0 with none (no shift is
+applied then either). One point's 1.5 dB: a node's window check (training frames) against its
+validations (the whole session, other Δn) differed by 0.0–1.3 dB on the default profiles at
+3f32fb5 (Marble n2442 0.5, 0.5, 0.5; the temple's n2495 1.3; Trashcan's n715 0.0). Why not the
+family's spread for a node with points of its own: the family's says how far one node's shift is
+from another's (the demo scene: n935 −7.1 dB, n959 −1.4 dB, a ± of 5.7 dB that kept n935, with
+its own point, from every level). Taken over every point, a family without peers would count its
+first point's whole miss as the ± of the others: on Trashcan, after the window check (−7.4 dB, a
+cached node) and an estimator (−8.5 dB), that made a ± of 8 dB and no cached node could be
+offered for any level.
 
 The calibration is refitted as points arrive (:meth:`Calibration.add` returns the new one):
 validation uses it to re-check the next levels' choices and the candidates after a miss
@@ -109,19 +115,28 @@ class Calibration:
         return 0.0
 
     def spread_for(self, node: Optional[str] = None) -> float:
-        """The ± (dB) of a calibrated prediction for ``node``, from its family's points (see the
-        module docstring); 0 while the family has none.
+        """The ± (dB) of a calibrated prediction for ``node`` (see the module docstring): from
+        its own points when it has any, else from its family's; 0 while the family has none.
 
         >>> cal = Calibration().add("n1", 45.0, 37.6).add("est:e1", 37.8, 29.3)
         >>> cal.spread_for("n2"), cal.spread_for("est:e2"), Calibration().spread_for("n1")
         (1.5, 1.5, 0.0)
+        >>> cal = Calibration().add("n1", 55.6, 48.5).add("n2", 30.2, 28.7)  # two nodes' checks
+        >>> cal.spread_for("n1"), round(cal.spread_for("n3"), 2)
+        (1.5, 5.6)
         """
-        kin = self._kin(node)
-        if len(kin) <= 1:
-            return ONE_POINT_SPREAD_DB if kin else 0.0
+        own = tuple(p for p in self.points if node is not None and p.node == node)
+        return self._spread_of(own) if own else self._spread_of(self._kin(node))
+
+    def _spread_of(self, points: tuple) -> float:
+        """The RMS of ``points``' residuals, each predicted with the shift of the others
+        (:meth:`shift`), at least :data:`MIN_SPREAD_DB`; :data:`ONE_POINT_SPREAD_DB` for one
+        point, 0 for none."""
+        if len(points) <= 1:
+            return ONE_POINT_SPREAD_DB if points else 0.0
         residuals = []
-        for i, p in enumerate(kin):
-            others = Calibration(kin[:i] + kin[i + 1:])
+        for i, p in enumerate(points):
+            others = Calibration(points[:i] + points[i + 1:])
             residuals.append(p.measured - (p.predicted + others.shift(p.node)))
         return max(MIN_SPREAD_DB, float(math.sqrt(np.mean(np.square(residuals)))))
 
