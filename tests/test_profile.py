@@ -456,6 +456,7 @@ def test_the_window_check_probes_each_levels_node_once_and_the_estimator():
               est.replace(parts=(AmortizedLoop("e1", 2, 0.6),)), original]
     assert [s.describe() for s in probe_choices(levels)] == ["n2 Δn=8", "n4 Δn=6", "e1 m=4 λ=0.6"]
     assert probe_choices([original, cache("n1", 1)]) == []
+    assert [s.describe() for s in probe_choices(levels, estimators=False)] == ["n2 Δn=8", "n4 Δn=6"]
 
 
 def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkeypatch):
@@ -464,7 +465,8 @@ def test_a_windowed_profile_checks_its_window_before_validation(tmp_path, monkey
     import rrcache.profiler.window_check as window_check
 
     calls = []
-    monkeypatch.setattr(window_check, "check_window", lambda v, choices, frames: calls.append(list(frames)))
+    monkeypatch.setattr(window_check, "check_window",
+                        lambda v, choices, frames, estimators=True: calls.append(list(frames)))
     shader, session = write_scene(tmp_path)
     windowed = TrainingSettings(**dict(SETTINGS, resolution=None), frames=10, validation_frames=4, max_sets=0)
     first = profile(shader, session, tmp_path / "a", windowed, plots=False)

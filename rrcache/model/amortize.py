@@ -356,8 +356,8 @@ class AnchoredFit:
     anchor_samples: tuple  # the m of the runs
     anchor_ratios: tuple  # per m of anchor_samples: ((λ, log measured/predicted), ...) by λ
 
-    def __getattr__(self, name):
-        if name.startswith("__"):
+    def __getattr__(self, name):  # only what the dataclass does not hold: the fit's
+        if name.startswith("__") or name in ("fit", "anchor_samples", "anchor_ratios"):
             raise AttributeError(name)
         return getattr(self.fit, name)
 
@@ -382,18 +382,19 @@ def anchored(fit, samples: Sequence[int], blends: Sequence[float], errors: Seque
     """``fit`` held to the runs (``samples[i]``, ``blends[i]``, ``errors[i]``)
     (:class:`AnchoredFit`); ``fit`` itself where no run has a finite error > 0 and a prediction
     > 0 to compare it with."""
-    by_m: dict[int, list] = {}
+    by_m: dict[int, dict] = {}
     for m, lam, e in zip(samples, blends, errors):
         if not (e is not None and math.isfinite(float(e)) and float(e) > 0):
             continue
         pred = float(fit.predict(int(m), float(lam)))
         if not (math.isfinite(pred) and pred > 0):
             continue
-        by_m.setdefault(int(m), []).append((float(lam), math.log(float(e) / pred)))
+        by_m.setdefault(int(m), {}).setdefault(float(lam), []).append(math.log(float(e) / pred))
     if not by_m:
         return fit
-    ms = tuple(sorted(by_m))
-    return AnchoredFit(fit, ms, tuple(tuple(sorted(by_m[m])) for m in ms))
+    ms = tuple(sorted(by_m))  # runs repeated at one (m, λ): their mean ratio
+    return AnchoredFit(fit, ms, tuple(tuple((lam, float(np.mean(r))) for lam, r in sorted(by_m[m].items()))
+                                      for m in ms))
 
 
 def error_fit_from_json(history: str, data: dict):

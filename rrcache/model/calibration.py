@@ -18,8 +18,9 @@ on Trashcan every node missed by −7 to −8 dB, and a node without points of i
 with the others' shift missed by under 1 dB. Its ± (:meth:`Calibration.spread_for`) comes from
 the node's own points when it has any, else from the points of its family: the RMS of their
 residuals around the shift (each point left out of its own shift), at least
-:data:`MIN_SPREAD_DB`; :data:`ONE_POINT_SPREAD_DB` for one point; 0 with none (no shift is
-applied then either). One point's 1.5 dB: a node's window check (training frames) against its
+:data:`MIN_SPREAD_DB`; :data:`ONE_POINT_SPREAD_DB` for one point, and at least that for a
+borrowed shift (no surer than a point of the node's own); 0 with none (no shift is applied then
+either). One point's 1.5 dB: a node's window check (training frames) against its
 validations (the whole session, other Δn) differed by 0.0–1.3 dB on the default profiles at
 3f32fb5 (Marble n2442 0.5, 0.5, 0.5; the temple's n2495 1.3; Trashcan's n715 0.0). Why not the
 family's spread for a node with points of its own: the family's says how far one node's shift is
@@ -124,9 +125,14 @@ class Calibration:
         >>> cal = Calibration().add("n1", 55.6, 48.5).add("n2", 30.2, 28.7)  # two nodes' checks
         >>> cal.spread_for("n1"), round(cal.spread_for("n3"), 2)
         (1.5, 5.6)
+        >>> Calibration().add("n1", 40.0, 35.0).add("n2", 40.0, 34.8).add("n3", 40.0, 35.1).spread_for("n9")
+        1.5
         """
         own = tuple(p for p in self.points if node is not None and p.node == node)
-        return self._spread_of(own) if own else self._spread_of(self._kin(node))
+        if own:
+            return self._spread_of(own)
+        kin = self._kin(node)  # a borrowed shift is no surer than a point of the node's own
+        return max(ONE_POINT_SPREAD_DB, self._spread_of(kin)) if kin else 0.0
 
     def _spread_of(self, points: tuple) -> float:
         """The RMS of ``points``' residuals, each predicted with the shift of the others

@@ -306,7 +306,7 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
         from rrcache.profiler.window_check import check_window
 
         try:
-            check_window(validator, choices, result.plan.error_frames(settings.frames))
+            check_window(validator, choices, result.plan.error_frames(settings.frames), estimators=settings.validate)
         except BaseException:
             validator.close()
             raise

@@ -77,62 +77,69 @@ def probe_estimator(choices) -> Optional[object]:
     return None
 
 
-def probe_choices(choices) -> list:
+def probe_choices(choices, estimators: bool = True) -> list:
     """What the window check measures: for each node the levels cache alone (at most
     :data:`MAX_NODES`), the first of ``choices`` caching it as :func:`probe_choice` asks, then
-    :func:`probe_estimator`'s choice."""
+    :func:`probe_estimator`'s choice (unless not ``estimators``)."""
     out, nodes = [], set()
     for sel in choices:
         if (sel.parts and not sel.exact and not sel.multi and sel.kind == "cache" and sel.predicted_psnr is not None
                 and int(sel.period or 0) > 1 and sel.node not in nodes and len(nodes) < MAX_NODES):
             nodes.add(sel.node)
             out.append(sel)
-    estimator = probe_estimator(choices)
+    estimator = probe_estimator(choices) if estimators else None
     return out + ([estimator] if estimator is not None else [])
 
 
-def check_window(validator, choices, frames) -> list:
+def check_window(validator, choices, frames, estimators: bool = True) -> list:
     """Run the window check (module docstring) on ``validator`` (a
     :class:`rrcache.profiler.validate.Validator`: its work, session, settings, store, region and
     executor) for :func:`probe_choices` of ``choices`` over the training ``frames``; add their
     points to ``validator.calibration`` (unless exact) and return them (``key``, ``node``,
-    ``predicted``, ``measured``, ``error``, ``frames``): none when no choice is of either kind."""
-    probes = probe_choices(choices)
+    ``predicted``, ``measured``, ``error``, ``frames``): none when no choice is of either kind.
+    ``estimators`` False leaves the estimator out (a profile that only predicts applies no
+    estimator's shift: :meth:`rrcache.profiles.document.Profile.threshold_selections`)."""
+    probes = probe_choices(choices, estimators)
     measured = [_stored(validator.store, CHECK_PREFIX + c.describe()) for c in probes]
     missing = [i for i, m in enumerate(measured) if m is None]
     if missing:
-        for i, m in zip(missing, _measure(validator, [probes[i] for i in missing], frames)):
-            measured[i] = m
-        validator.store.set_meta(META, json.dumps(measured, allow_nan=False))
+        def keep(i: int, point: dict) -> None:  # each as it arrives: an interrupted check keeps the others
+            measured[i] = point
+            validator.store.set_meta(META, json.dumps([m for m in measured if m is not None], allow_nan=False))
+
+        _measure(validator, [(i, probes[i]) for i in missing], frames, keep)
     return [_add_point(validator, c, m) for c, m in zip(probes, measured)]
 
 
-def _measure(validator, probes, frames) -> list:
-    """One ``error`` run of each of ``probes`` over ``frames`` at the full resolution in the
-    validator's region, with a progress stage of its own; the measurements, in order."""
+def _measure(validator, probes, frames, keep) -> None:
+    """One ``error`` run of each of ``probes`` (``(index, choice)`` pairs) over ``frames`` at the
+    full resolution in the validator's region, with a progress stage of its own; ``keep(index,
+    measurement)`` as each run ends (an executor may end them in any order)."""
     from rrcache.pipeline import variant_for_selection
 
-    runs = []
-    for choice in probes:
+    runs = {}
+    for i, choice in probes:
         key = CHECK_PREFIX + choice.describe()
         variant, period = variant_for_selection(validator.work, choice)
         spec = runtime_spec(variant, None, period=period, **validator.settings.cache_options())
-        runs.append(RunSpec("error", spec, tuple(int(f) for f in frames), tuple(validator.session.resolution),
-                            validator.window, ERROR_FORMAT, key=("window check", key), label=key))
-    total = sum(r.cost for r in runs)
+        runs[("window check", key)] = (i, RunSpec("error", spec, tuple(int(f) for f in frames),
+                                                  tuple(validator.session.resolution), validator.window, ERROR_FORMAT,
+                                                  key=("window check", key), label=key))
+    total = sum(run.cost for _, run in runs.values())
     executor = validator._executor()
     done = [0]
 
-    def step(_, units):  # the progress of a stage of its own (not validation's)
+    def step(run, units):  # the progress of a stage of its own (not validation's)
         done[0] += units
         if validator.progress is not None:
-            validator.progress(ProgressEvent("check", min(done[0], total), total, "window check"))
+            validator.progress(ProgressEvent("check", min(done[0], total), total, run.label))
 
-    results = list(executor.run(runs, on_frame=step))
+    for result in executor.run([run for _, run in runs.values()], on_frame=step):
+        i, run = runs[result.spec.key]
+        keep(i, {"key": run.label, "measured": float(result.steady_psnr), "error": float(result.steady_error),
+                 "frames": len(frames)})
     if getattr(executor, "release", None) is not None:  # the original's frames: validation draws its own
         executor.release()
-    return [{"key": r.label, "measured": float(res.steady_psnr), "error": float(res.steady_error),
-             "frames": len(frames)} for r, res in zip(runs, results)]
 
 
 def _add_point(validator, choice, measured: dict) -> dict:

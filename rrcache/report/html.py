@@ -356,7 +356,8 @@ def _estimators(prof) -> str:
             "against the original ε = a·sqrt(s(m)(1−λ)/(1+λ)) + b·sqrt(λ/(1−λ)), s(m) = (N−m)/(m(N−1)). The "
             "slots history keeps the N/m subset sums apart, each blended with its own reprojected value by λ "
             "(where they fit the payload); ε = sqrt(c<sub>m</sub>² + b²·λ/(1−λ)), a floor c<sub>m</sub> per "
-            "trained m. Time per evaluated term (per frame, over every evaluated term) from timed frames, per "
+            "trained m. Predictions are held to the error runs: each run's measured/predicted ratio, "
+            "interpolated between runs, scales the fit. Time per evaluated term (per frame, over every evaluated term) from timed frames, per "
             "history. Their options compete with the cached nodes at every level.</p><table><tr>"
             "<th>estimator</th><th>history</th><th class=num>line</th><th class=num>N</th><th>loop</th>"
             "<th>error model</th><th class=num>ms per 1e6 terms</th></tr>" + "".join(rows) + "</table>")
