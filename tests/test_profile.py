@@ -433,6 +433,14 @@ def test_the_window_check_is_one_error_run_where_validation_measures(trained, tm
         again = Validator(work, session, settings, store, events.append, fallback=False)
         assert check_window(again, choices, frames) == [point] and not events
         assert again.calibration.shift(node.id) == pytest.approx(point["measured"] - point["predicted"])
+        # a later round checks another choice: the store keeps both (older stores held one dict)
+        other = choice.replace(parts=(choice.parts[0].__class__(node.id, int(choice.period) + 1),))
+        store.set_meta(META, json.dumps(json.loads(store.meta()[META])[0]))
+        (second,) = check_window(again, [other], frames)
+        assert second["key"] == f"window check: {other.describe()}"
+        assert [p["key"] for p in json.loads(store.meta()[META])] == [point["key"], second["key"]]
+        assert [p.key for p in again.calibration.points] == [point["key"], second["key"]]
+        events.clear()
         # then validation: its progress ends at its total, each render counted once
         again.run(choices)
         steps = [e for e in events if e.stage == "validate"]
@@ -488,12 +496,16 @@ def test_a_predicted_only_profile_predicts_with_its_window_check(tmp_path):
     prof = profile(DEMO_SHADER, DEMO_SESSION, tmp_path / "out", TrainingSettings(**DEMO_SETTINGS, validate=False),
                    plots=False)
     assert prof.plan["error_window"] is not None
+    from rrcache.model.calibration import Calibration
+
     points = prof.calibration["points"]
-    assert len(points) == 1 and points[0]["key"].startswith("window check: "), prof.calibration
-    shift = points[0]["measured"] - points[0]["predicted"]
+    assert points and all(p["key"].startswith("window check: ") for p in points), prof.calibration
+    cal = Calibration.from_json(prof.calibration)
     cached = [s for s in prof.selections if s.parts]
     assert cached, prof.selections
-    single = [s for s in cached if s.kind == "cache" and not s.multi]  # the check's node, or borrowing its shift
-    assert single and all(s.calibration_db == pytest.approx(shift) for s in single), single
+    single = [s for s in cached if s.kind == "cache" and not s.multi]  # a checked node, or borrowing
+    assert single and all(s.calibration_db == pytest.approx(cal.shift(s.node)) for s in single), single
+    checked = {p["node"] for p in points}
+    assert any(s.node in checked and s.calibration_db != 0 for s in single), (single, points)
     assert all(s.measured_psnr is None for s in prof.selections)  # nothing validated
 

@@ -303,18 +303,23 @@ def _selections(prof: Profile, work, session, settings, result: TrainingResult, 
                           window=result.plan.timing_window if result.plan is not None else None,
                           candidates=prof.front_candidates, executor=executor)
     if result.plan is not None and result.plan.error_window is not None:  # trained in a window: check it first
-        from rrcache.profiler.window_check import check_window
+        from rrcache.profiler.window_check import ROUNDS, check_window
 
         try:
-            check_window(validator, choices, result.plan.error_frames(settings.frames), estimators=settings.validate)
+            for _ in range(ROUNDS):  # the checks move the predictions: the levels' choices again, new ones checked
+                before = {c.key for c in choices}
+                check_window(validator, choices, result.plan.error_frames(settings.frames),
+                             estimators=settings.validate)
+                if validator.calibration.points:
+                    prof.calibration = validator.calibration.to_json()
+                    choices = prof.threshold_selections()
+                if {c.key for c in choices} <= before:
+                    break
         except BaseException:
             validator.close()
             raise
     if not settings.validate:  # predicted only: with what the window check taught the models
         validator.close()
-        if validator.calibration.points:
-            prof.calibration = validator.calibration.to_json()
-            return prof.threshold_selections()
         return choices
     measured = validator.run(choices)
     if max_flip is not None:  # a level of mean FLIP, answered from the measurements above first

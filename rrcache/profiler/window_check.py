@@ -18,9 +18,12 @@ timing) of each node the levels cache alone, with the first of the levels' choic
 Δn > 1 (:func:`probe_choices`), over the training frames, at the full resolution in the region
 validation measures, and adds each to the validation's calibration as a point of its node
 (:mod:`rrcache.model.calibration`: the models' predicted PSNR against the measured mean PSNR of
-the steady frames, as validation measures it). Cached nodes without points of their own (a
-candidate validation tries after a miss) borrow their shift until validation measures points of
-theirs. Why every level's node, not only the first's: a node's miss in the window is not only
+the steady frames, as validation measures it). The checks move the predictions, so the levels
+choose again with them, and a choice not checked yet is checked in a second round
+(:data:`ROUNDS`; sdf at 804d438: the check of n1139 made n241 e2's choice, which, borrowing
+n1139's −1.7 dB, was predicted 2.5 dB under what validation measured). Cached nodes without
+points of their own (a candidate validation tries after a miss) borrow their shift until
+validation measures points of theirs. Why every level's node, not only the first's: a node's miss in the window is not only
 the window's but its model's, and a node borrowing another's shift missed by up to 3 dB
 (many_lights at 3f32fb5: the check of n3235 at Δn = 50 measured 5.6 dB under its model and
 n10886 at Δn = 2, predicted with that shift, 3.0 dB over it; sdf: n1139's −1.7 dB moved n240's
@@ -56,8 +59,11 @@ META = "window_check"
 CHECK_PREFIX = "window check: "
 
 
-#: at most this many cached nodes are checked (the levels choose at most four)
+#: at most this many cached nodes are checked per round (the levels choose at most four)
 MAX_NODES = 4
+#: rounds of checks: after each, the levels choose again with the calibration, and a choice of a
+#: node not checked yet is checked in the next (:func:`rrcache.profiler.run._selections`)
+ROUNDS = 2
 
 
 def probe_choice(choices) -> Optional[object]:
@@ -105,7 +111,8 @@ def check_window(validator, choices, frames, estimators: bool = True) -> list:
     if missing:
         def keep(i: int, point: dict) -> None:  # each as it arrives: an interrupted check keeps the others
             measured[i] = point
-            validator.store.set_meta(META, json.dumps([m for m in measured if m is not None], allow_nan=False))
+            validator.store.set_meta(META, json.dumps(_stored_all(validator.store, exclude=point["key"]) + [point],
+                                                      allow_nan=False))
 
         _measure(validator, [(i, probes[i]) for i in missing], frames, keep)
     return [_add_point(validator, c, m) for c, m in zip(probes, measured)]
@@ -156,19 +163,24 @@ def _add_point(validator, choice, measured: dict) -> dict:
 
 
 def _stored(store, key: str) -> Optional[dict]:
-    """The store's window-check measurement of ``key`` (None when absent or unreadable; the meta
-    holds a list of them, or one, as written before estimators were checked)."""
+    """The store's window-check measurement of ``key`` (None when absent or unreadable)."""
+    return next((p for p in _stored_all(store) if p["key"] == key), None)
+
+
+def _stored_all(store, exclude: Optional[str] = None) -> list:
+    """The store's window-check measurements, readable ones only, but that of ``exclude`` (the
+    meta holds a list of them, or one, as written before every level's node was checked)."""
     raw = store.meta().get(META)
     try:
         points = json.loads(raw) if raw else []
     except ValueError:
-        return None
+        return []
+    out = []
     for point in points if isinstance(points, list) else [points]:
-        if not isinstance(point, dict) or point.get("key") != key:
-            continue
         try:
-            return {"key": key, "measured": float(point["measured"]), "error": float(point["error"]),
-                    "frames": int(point["frames"])}
+            if point["key"] != exclude:
+                out.append({"key": str(point["key"]), "measured": float(point["measured"]),
+                            "error": float(point["error"]), "frames": int(point["frames"])})
         except (KeyError, TypeError, ValueError):
-            return None
-    return None
+            continue
+    return out
