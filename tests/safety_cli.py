@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sqlite3
 import subprocess
 import sys
@@ -74,10 +75,16 @@ def rrcache(cwd, *args, stdout=subprocess.PIPE, timeout=300, file_size=None):
     return proc.returncode, proc.stdout, [line for line in proc.stderr.splitlines() if line.strip()]
 
 
+#: a progress line off a terminal (rrcache/cli/progress.py): a resumed profile that still had work
+#: when it was refused (its first run's budget ran out early on a loaded machine) prints some
+PROGRESS_LINE = re.compile(r"^\[\s*\d+(\.\d+)? s\] ")
+
+
 def one_error_line(code, lines) -> str:
-    """The run failed cleanly: exit code 2, one line on stderr, no traceback."""
+    """The run failed cleanly: exit code 2, one line on stderr besides warnings, notes and
+    progress, no traceback."""
     assert code == 2, (code, lines)
-    errors = [line for line in lines if not line.startswith(("warning:", "note:"))]
+    errors = [line for line in lines if not line.startswith(("warning:", "note:")) and not PROGRESS_LINE.match(line)]
     assert len(errors) == 1, lines
     assert "Traceback" not in "\n".join(lines)
     assert errors[0].startswith("rrcache: error: "), errors[0]
