@@ -96,6 +96,10 @@ class Calibration:
             return Calibration(tuple(point if p.key == key else p for p in self.points))
         return Calibration(self.points + (point,))
 
+    def _own(self, node: Optional[str]) -> tuple:
+        """The points of ``node`` itself (none for None)."""
+        return tuple(p for p in self.points if node is not None and p.node == node)
+
     def _kin(self, node: Optional[str]) -> tuple:
         """The points of ``node``'s family (:func:`family`)."""
         return tuple(p for p in self.points if family(p.node) == family(node))
@@ -106,7 +110,7 @@ class Calibration:
     def shift(self, node: Optional[str] = None) -> float:
         """``d`` (dB) for ``node``: its own points' mean miss, else that of its family's points
         when they all miss the same way, else 0 (see the module docstring)."""
-        own = [p for p in self.points if node is not None and p.node == node]
+        own = self._own(node)
         if own:
             return self._shift_of(own)
         kin = self._kin(node)
@@ -128,7 +132,7 @@ class Calibration:
         >>> Calibration().add("n1", 40.0, 35.0).add("n2", 40.0, 34.8).add("n3", 40.0, 35.1).spread_for("n9")
         1.5
         """
-        own = tuple(p for p in self.points if node is not None and p.node == node)
+        own = self._own(node)
         if own:
             return self._spread_of(own)
         kin = self._kin(node)  # a borrowed shift is no surer than a point of the node's own
