@@ -29,16 +29,15 @@ def main(size: str = "640x480", frames: int = 40) -> dict:
     indices = list(range(frames))
     exact = render(str(ROOT / "shaders" / "trashcan.glsl"), session, frames=indices, resolution=resolution)
     mse = {}
-    folder = tempfile.TemporaryDirectory()
-    stale_path, _ = variants.write(folder.name)
-    for k in range(9):
-        stale = render(str(stale_path), session, frames=indices, resolution=resolution,
-                       defines={"STALE_DEG": f"{float(k):.1f}"})
-        per_frame = [float(((np.clip(a.image[..., :3], 0, 1) - np.clip(b.image[..., :3], 0, 1)) ** 2).mean())
-                     for a, b in zip(stale.frames, exact.frames)]
-        mse[k] = float(np.mean(per_frame))
-        print(f"k={k}: {10 * math.log10(1 / mse[k]) if mse[k] else math.inf:.1f} dB", flush=True)
-    folder.cleanup()
+    with tempfile.TemporaryDirectory() as folder:
+        stale_path, _ = variants.write(folder)
+        for k in range(9):
+            stale = render(str(stale_path), session, frames=indices, resolution=resolution,
+                           defines={"STALE_DEG": f"{float(k):.1f}"})
+            per_frame = [float(((np.clip(a.image[..., :3], 0, 1) - np.clip(b.image[..., :3], 0, 1)) ** 2).mean())
+                         for a, b in zip(stale.frames, exact.frames)]
+            mse[k] = float(np.mean(per_frame))
+            print(f"k={k}: {10 * math.log10(1 / mse[k]) if mse[k] else math.inf:.1f} dB", flush=True)
     for period in (2, 3, 4, 6, 8):
         pooled = float(np.mean([mse[k] for k in range(period)]))
         print(f"Δn={period}: entries 0..{period - 1} frames old: {10 * math.log10(1 / pooled):.1f} dB")
