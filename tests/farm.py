@@ -29,11 +29,7 @@ def local_farm(folder, workers: int = 2, env=None):
     try:
         spawn("scheduler", ["scheduler", "--host", "127.0.0.1", "--port", "0", "--dashboard-address", ":0",
                             "--scheduler-file", str(file)])
-        deadline = time.time() + 60
-        while not file.exists() and time.time() < deadline:
-            assert procs[0].poll() is None, (folder / "scheduler.log").read_text()
-            time.sleep(0.1)
-        address = json.loads(file.read_text())["address"]
+        address = _scheduler_address(file, procs[0], folder / "scheduler.log")
         for i in range(workers):
             spawn(f"worker{i}", ["worker", address, "--nthreads", "1", "--nworkers", "1", "--host", "127.0.0.1",
                                  "--name", f"farm-{i}", "--no-dashboard"])
@@ -50,6 +46,20 @@ def local_farm(folder, workers: int = 2, env=None):
                 proc.wait()
         for log in logs:
             log.close()
+
+
+def _scheduler_address(file, proc, log, within_s: float = 60.0) -> str:
+    """The address in the scheduler's file once it is whole: the scheduler creates the file
+    before it writes it, so an empty or half-written file is read again (a fresh-clone CI run at
+    load 4 read it empty)."""
+    deadline = time.time() + within_s
+    while True:
+        assert proc.poll() is None, log.read_text()
+        try:
+            return json.loads(file.read_text())["address"]
+        except (FileNotFoundError, json.JSONDecodeError, KeyError):
+            assert time.time() < deadline, f"no scheduler address in {file} after {within_s:.0f} s"
+            time.sleep(0.1)
 
 
 @contextlib.contextmanager

@@ -156,3 +156,26 @@ def test_profile_library_with_workers_prints_the_dashboard(scene, tmp_path):
     assert "[1/1] noise-orbit" in proc.stderr and "noise-orbit" in proc.stdout
     doc = json.loads((tmp_path / "lib" / "noise-orbit" / "profile.json").read_text())
     assert doc["cluster"]["workers"] == 2 and doc["settings"]["frames"] == 8
+
+
+def test_the_farm_waits_for_a_whole_scheduler_file(tmp_path):
+    """The scheduler creates its file before writing it: an empty file is read again until the
+    address is there (a fresh-clone CI run read it empty once)."""
+    import threading
+
+    from farm import _scheduler_address
+
+    class Running:
+        def poll(self):
+            return None
+
+    file = tmp_path / "scheduler.json"
+    file.write_text("")
+    writer = threading.Timer(0.3, lambda: file.write_text(json.dumps({"address": "tcp://127.0.0.1:1"})))
+    writer.start()
+    try:
+        assert _scheduler_address(file, Running(), tmp_path / "scheduler.log") == "tcp://127.0.0.1:1"
+    finally:
+        writer.join()
+    with pytest.raises(AssertionError, match="no scheduler address"):
+        _scheduler_address(tmp_path / "never.json", Running(), tmp_path / "scheduler.log", within_s=0.3)
