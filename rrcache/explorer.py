@@ -166,13 +166,20 @@ class Explorer:
     def _show_choice(self, choice) -> None:
         import ipywidgets as w
 
-        images = self.shots.selection_images(choice)
-        boxes = []
-        for name in CAPTIONS:
-            if name in images.arrays:
-                boxes.append(w.VBox([w.Image(value=images.png(name), format="png",
-                                             width=2 * images.size[0] if images.size[0] <= 200 else images.size[0]),
-                                     w.HTML(f"<small>{html.escape(images.caption(name))}</small>")]))
+        kind = choice.choice if choice.parts else None
+        if kind is not None and not kind.has_frames:  # several nodes at once: measured, not shown
+            images = None
+            boxes = [w.HTML(f"<small>{html.escape(choice.describe())}: a choice of {html.escape(kind.title)} has no "
+                            "frames here (as in the report); each node's are shown by "
+                            "<code>FrameShots.images(node, period)</code></small>")]
+        else:
+            images = self.shots.selection_images(choice)
+            boxes = []
+            for name in CAPTIONS:
+                if name in images.arrays:
+                    boxes.append(w.VBox([w.Image(value=images.png(name), format="png",
+                                                 width=2 * images.size[0] if images.size[0] <= 200 else images.size[0]),
+                                         w.HTML(f"<small>{html.escape(images.caption(name))}</small>")]))
         self.frames.children = boxes
         self.images = images
         if self.measure or not choice.parts:

@@ -300,3 +300,27 @@ def test_the_bench_keeps_a_set_only_where_it_beats_the_single_choice(tiny):
     assert prefer_singles(back, [fast_pair], measured(2.0)) == [fast_pair]
     # no set: nothing measured again
     assert prefer_singles(back, [measured(2.0)(single)], lambda s: 1 / 0)[0].key == single.key
+
+
+def test_the_explorer_measures_a_set_it_cannot_show(tiny, gl_ctx):
+    """A level whose choice is several nodes at once: the notebook's explorer shows why there
+    are no frames and still measures it (a fresh-clone CI run's demo profile chose a set at load
+    4, and the explorer raised instead)."""
+    from rrcache.explorer import Explorer
+
+    prof, work, _, _ = tiny
+    albedo = _by_text(work, "mix(vec3(0.9")
+    wave = next(n for n in prof.trained_nodes if n.text.startswith("0.0625 * wave"))
+    option = SetOption([albedo, wave.id], [8, 4])
+    option.trained, option.trained_error, option.trained_ms, option.trained_psnr = True, 0.01, 1e-3, 40.0
+    chosen = option.selection(float(prof.original_ms), max_error=1.0, algorithm=prof.algorithm)
+    assert chosen.multi and not chosen.choice.has_frames
+    prof = dataclasses.replace(prof)
+    prof.select = lambda max_error: chosen.replace(max_error=max_error)
+    ui = Explorer(prof, value=1.0, measure=True)
+    assert ui.error is None, ui.status.value
+    assert ui.choice.key == chosen.key and ui.images is None
+    assert len(ui.frames.children) == 1 and "has no frames here" in ui.frames.children[0].value
+    m = ui.measured
+    assert m is not None and not m["stored"] and m["frames"] > 0 and 0 < m["hit_rate"] < 1
+    assert "rendering" not in ui.summary.value and "speed-up <b>" in ui.summary.value
