@@ -14,6 +14,7 @@ import tempfile
 
 import numpy as np
 
+from rrcache.harness.metrics import squared_error_map
 from rrcache.harness.renderer import render
 from rrcache.session import load_session
 
@@ -34,8 +35,7 @@ def main(size: str = "640x480", frames: int = 40) -> dict:
         for k in range(9):
             stale = render(str(stale_path), session, frames=indices, resolution=resolution,
                            defines={"STALE_DEG": f"{float(k):.1f}"})
-            per_frame = [float(((np.clip(a.image[..., :3], 0, 1) - np.clip(b.image[..., :3], 0, 1)) ** 2).mean())
-                         for a, b in zip(stale.frames, exact.frames)]
+            per_frame = [float(squared_error_map(a.image, b.image).mean()) for a, b in zip(stale.frames, exact.frames)]
             mse[k] = float(np.mean(per_frame))
             print(f"k={k}: {10 * math.log10(1 / mse[k]) if mse[k] else math.inf:.1f} dB", flush=True)
     for period in (2, 3, 4, 6, 8):

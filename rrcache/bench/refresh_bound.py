@@ -52,6 +52,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from rrcache.gl.formats import DEFAULT_TIMING_FORMAT, ERROR_FORMAT
+from rrcache.harness.metrics import clamped_rgb, squared_error_map
 
 #: the block sizes compared by default: pixels, GPU quads, llvmpipe's 4×4, the runtime's 8×8
 BLOCKS = (1, 2, 4, 8)
@@ -71,12 +72,6 @@ class FrameErrors:
     total_se: float = 0.0
 
 
-def _squared_error(image: np.ndarray, original: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    a = np.clip(np.nan_to_num(image[..., :3], nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)
-    b = np.clip(np.nan_to_num(original[..., :3], nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)
-    return ((a - b) ** 2).mean(axis=2), a
-
-
 def frame_errors(image: np.ndarray, original: np.ndarray, hit_map: np.ndarray, mask: np.ndarray) -> FrameErrors:
     """The :class:`FrameErrors` of one cached frame against the original (RGB clamped to [0, 1],
     squared error averaged over the channels, as :func:`rrcache.harness.metrics.psnr`).
@@ -86,7 +81,7 @@ def frame_errors(image: np.ndarray, original: np.ndarray, hit_map: np.ndarray, m
     >>> float(f.se[0, 0]), float(f.se[2, 2]), float(f.spread[1, 1]), float(f.spread[2, 2]), f.covered
     (0.25, 0.0, 0.5, 0.0, 9)
     """
-    se, a = _squared_error(image, original)
+    se, a = squared_error_map(image, original), clamped_rgb(image)
     hits = np.asarray(hit_map, bool) & np.asarray(mask, bool)
     p = np.pad(a, ((1, 1), (1, 1), (0, 0)), mode="edge")
     h, w = a.shape[:2]

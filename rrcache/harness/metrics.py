@@ -73,6 +73,23 @@ def mean_l2(img: np.ndarray, ref: np.ndarray, mask: Optional[np.ndarray] = None)
     return float(dist.mean()), left_out
 
 
+def clamped_rgb(img: np.ndarray) -> np.ndarray:
+    """RGB as displayed: clamped to [0, 1], NaN as 0 and ±inf as 1 or 0 (what :func:`psnr` compares)."""
+    return np.clip(np.nan_to_num(_rgb(img, "image"), nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)
+
+
+def squared_error_map(img: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """H×W: each pixel's squared error of the :func:`clamped_rgb` colours, averaged over RGB (its
+    mean is :func:`psnr`'s mean squared error).
+
+    >>> import numpy as np
+    >>> squared_error_map(np.full((1, 2, 3), 0.5), np.zeros((1, 2, 3))).tolist()
+    [[0.25, 0.25]]
+    """
+    _check_same(_rgb(img, "image"), _rgb(ref, "reference"))
+    return ((clamped_rgb(img) - clamped_rgb(ref)) ** 2).mean(axis=2)
+
+
 def psnr(img: np.ndarray, ref: np.ndarray) -> float:
     """Peak signal-to-noise ratio in dB over the whole frame, RGB clamped to [0, 1] (NaN counts as
     0); ``inf`` when the clamped images are identical.
@@ -83,11 +100,7 @@ def psnr(img: np.ndarray, ref: np.ndarray) -> float:
     >>> psnr(np.zeros((1, 1, 3)), np.ones((1, 1, 3)))
     0.0
     """
-    a, b = _rgb(img, "image"), _rgb(ref, "reference")
-    _check_same(a, b)
-    a = np.clip(np.nan_to_num(a, nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)
-    b = np.clip(np.nan_to_num(b, nan=0.0, posinf=1.0, neginf=0.0), 0.0, 1.0)
-    mse = float(((a - b) ** 2).mean())
+    mse = float(squared_error_map(img, ref).mean())
     if mse == 0.0:
         return math.inf
     return 10.0 * math.log10(1.0 / mse)
